@@ -1,0 +1,1 @@
+//! Reverse-mode automatic differentiation over `ndarray` (filled in by issue 3).

@@ -1,0 +1,100 @@
+//! Macro-action multi-agent domains: Box Pushing and Warehouse Tool Delivery.
+//!
+//! Both follow the reference's step contract (spec `algorithms.md` 1.1): an agent picks a new
+//! macro-action only when its previous one finished; the value passed for a busy agent is ignored;
+//! the executed macro-actions, the held macro-observations, one shared team reward, the episode-done
+//! flag and the per-agent macro-action-done flags come back from every primitive step.
+//!
+//! Stepping allocates nothing: observations live in buffers owned by the environment and are read
+//! through [`MacroEnv::obs`].
+
+use rand_chacha::ChaCha8Rng;
+
+/// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the
+/// caller, so a checkpoint can save it and a run derives it from its seed (spec `algorithms.md` 8).
+pub type EnvRng = ChaCha8Rng;
+
+/// Why an environment refused its input. Messages name the offending value and the allowed range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EnvError {
+    #[error("agent {agent}: macro-action {action} is out of range 0..{n_actions}")]
+    ActionOutOfRange {
+        agent: usize,
+        action: usize,
+        n_actions: usize,
+    },
+    #[error("expected one action per agent ({expected}), got {got}")]
+    WrongActionCount { expected: usize, got: usize },
+    #[error("step called after the episode ended; call reset first")]
+    EpisodeOver,
+    #[error("invalid environment parameter `{name}`: {reason}")]
+    InvalidParameter { name: &'static str, reason: String },
+}
+
+/// What one primitive step returns besides the observations (read them with [`MacroEnv::obs`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepOutcome {
+    /// The shared team reward of this primitive step (f64 so sums match the reference bit for bit).
+    pub reward: f64,
+    /// Episode over: goal reached or horizon hit (spec: the horizon cut is terminal, quirk Q7).
+    pub done: bool,
+}
+
+/// A macro-action multi-agent domain with the reference's step contract.
+pub trait MacroEnv {
+    /// Number of agents (Box Pushing 2, Warehouse 3).
+    fn n_agents(&self) -> usize;
+    /// Size of each agent's macro-observation, in agent order.
+    fn obs_sizes(&self) -> &[usize];
+    /// Number of macro-actions of each agent, in agent order.
+    fn n_actions(&self) -> &[usize];
+    /// Names of agent `agent`'s macro-actions, indexed by action. Panics if `agent` is out of range.
+    fn action_names(&self, agent: usize) -> &'static [&'static str];
+    /// Names of the elements of agent `agent`'s observation, in layout order (for exported
+    /// policies and replays). Panics if `agent` is out of range.
+    fn obs_names(&self, agent: usize) -> Vec<String>;
+    /// The horizon in primitive steps.
+    fn horizon(&self) -> usize;
+
+    /// Start a new episode; every agent is free afterwards.
+    fn reset(&mut self, rng: &mut EnvRng);
+    /// One primitive step. `actions[i]` is used only if agent i is free (see [`Self::is_free`]);
+    /// a busy agent's entry is ignored and may hold any value.
+    fn step(&mut self, actions: &[usize], rng: &mut EnvRng) -> Result<StepOutcome, EnvError>;
+
+    /// Agent `agent`'s current (held) macro-observation. Panics if `agent` is out of range.
+    fn obs(&self, agent: usize) -> &[f32];
+    /// The macro-action each agent executed in the last step.
+    fn executed(&self) -> &[usize];
+    /// Whether each agent's macro-action finished in the last step (all true after reset).
+    fn mac_done(&self) -> &[bool];
+    /// Whether agent `agent` picks a new macro-action at the next step.
+    fn is_free(&self, agent: usize) -> bool {
+        self.mac_done()[agent]
+    }
+    /// Primitive steps taken since reset.
+    fn t(&self) -> usize;
+
+    /// A human-readable picture of the state, for debugging and `--verbose` replays.
+    fn render_ascii(&self) -> String;
+
+    /// Total joint observation size (sum of the agents' sizes), the centralized nets' input.
+    fn joint_obs_size(&self) -> usize {
+        self.obs_sizes().iter().sum()
+    }
+    /// Number of joint macro-actions (product of the agents' counts), the centralized nets' output.
+    fn n_joint_actions(&self) -> usize {
+        self.n_actions().iter().product()
+    }
+    /// Write the joint observation (agents' observations concatenated in agent order) into `out`,
+    /// which must have length [`Self::joint_obs_size`] (panics otherwise).
+    fn write_joint_obs(&self, out: &mut [f32]) {
+        let mut at = 0;
+        for agent in 0..self.n_agents() {
+            let o = self.obs(agent);
+            out[at..at + o.len()].copy_from_slice(o);
+            at += o.len();
+        }
+        assert_eq!(at, out.len(), "joint observation buffer has the wrong length");
+    }
+}

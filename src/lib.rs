@@ -1,0 +1,10 @@
+//! macdec: macro-action multi-agent deep reinforcement learning.
+//!
+//! A pure-Rust reproduction of *Learning Multi-Robot Decentralized Macro-Action-Based Policies via
+//! a Centralized Q-Net* (Xiao, Hoffman, Xia, Amato, ICRA 2020). Data flows one way:
+//! `experiment` (config, runner) -> `algos` (trainer) -> `envs` + `nn` (on `autograd`), and the
+//! results feed `plot` and `deploy`. Lower layers never name higher ones.
+
+pub mod autograd;
+pub mod nn;
+pub mod envs;
