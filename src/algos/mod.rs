@@ -1,0 +1,3 @@
+//! The five learning methods: replay, squeezing, exploration, targets and the training loop.
+
+pub mod method;

@@ -1,0 +1,6 @@
+//! Experiments: configs, seeds, the parallel runner, metrics and checkpoints.
+
+pub mod atomic;
+pub mod config;
+pub mod metrics;
+pub mod seeds;
