@@ -3,4 +3,5 @@
 pub mod atomic;
 pub mod config;
 pub mod metrics;
+pub mod runner;
 pub mod seeds;
