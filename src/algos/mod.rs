@@ -1,3 +1,4 @@
 //! The five learning methods: replay, squeezing, exploration, targets and the training loop.
 
+pub mod hyper;
 pub mod method;
