@@ -17,16 +17,6 @@ pub enum EnvName {
     Warehouse,
 }
 
-/// How next-state Q-values get their history (spec quirk Q3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum NextHistory {
-    /// Faithful: unroll from a zero state over the squeezed next observations only.
-    Separate,
-    /// Fixed: h'_k continues h_k (unroll over z_1..z_K then z'_K), as the paper's notation reads.
-    Continued,
-}
-
 /// The resolved configuration of one run: every hyperparameter concrete and validated.
 /// Saved as `config.toml` beside the run's results.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -90,8 +80,6 @@ pub struct RunConfig {
     /// Quirk Q9: when one agent's view of a batch is empty, skip every decentralized update of
     /// that iteration (faithful) instead of just that agent's.
     pub early_return_skips_all: bool,
-    /// Quirk Q3: how next-state histories are built.
-    pub next_history: NextHistory,
 }
 
 /// The paper's settings for a domain and method (spec `algorithms.md` 10), before user keys.
@@ -142,7 +130,6 @@ pub fn paper_defaults(env: EnvName, grid_dim: usize, method: Method) -> RunConfi
                 eval_num_epi,
                 checkpoint_freq: 500,
                 early_return_skips_all: true,
-                next_history: NextHistory::Separate,
             }
         }
         EnvName::Warehouse => RunConfig {
@@ -178,7 +165,6 @@ pub fn paper_defaults(env: EnvName, grid_dim: usize, method: Method) -> RunConfi
             eval_num_epi,
             checkpoint_freq: 500,
             early_return_skips_all: true,
-            next_history: NextHistory::Separate,
         },
     }
 }

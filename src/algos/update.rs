@@ -1,0 +1,185 @@
+//! One training iteration of any of the five methods (spec `algorithms.md` 5 and 12).
+//!
+//! Every method runs the same steps; the [`Method`] value decides which of them exist:
+//! A, the centralized TD step (Cen-DDRQN, Our-1, Our-1-R, Our-2); B, the conditional joint argmax
+//! with the just-updated centralized net (Our-1, Our-2; quirk Q2); C, one TD step per agent, whose
+//! target action comes from B or from the agent's own double-Q selection.
+
+use crate::algos::cond_argmax::{cond_argmax_rows, unravel_component};
+use crate::algos::method::{DecTargetAction, Method};
+use crate::algos::record::Layout;
+use crate::algos::replay::Batch;
+use crate::algos::squeeze::{joint_rows_of_agent, squeeze_agent, squeeze_joint, AgentView, JointView};
+use crate::algos::ReplayError;
+use crate::autograd::Tape;
+use crate::nn::{Adam, QNet};
+use ndarray::{Array2, Array3};
+use serde::{Deserialize, Serialize};
+
+/// A policy net, its target copy and its optimizer.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Nets {
+    pub policy: QNet,
+    pub target: QNet,
+    pub adam: Adam,
+}
+
+impl Nets {
+    /// Target = policy at the start (spec 2.2).
+    pub fn new(policy: QNet, l_rate: f64) -> Self {
+        let adam = Adam::new(&policy, l_rate as f32);
+        Nets {
+            target: policy.clone(),
+            policy,
+            adam,
+        }
+    }
+
+    /// Hard target update (spec 2.4).
+    pub fn sync_target(&mut self) {
+        self.target.copy_params_from(&self.policy);
+    }
+}
+
+/// The knobs of one iteration that change during training or differ by config.
+#[derive(Debug, Clone, Copy)]
+pub struct IterationParams {
+    pub method: Method,
+    pub discount: f32,
+    /// Current hysteresis h (spec 5.6), applied where the method says.
+    pub h: f32,
+    /// Quirk Q9: an empty agent view skips every decentralized step of this iteration.
+    pub early_return_skips_all: bool,
+}
+
+/// What one iteration did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct IterationLoss {
+    /// Sum of the losses of the nets that took a step.
+    pub total: f64,
+    /// Number of nets that took a step.
+    pub steps: usize,
+}
+
+/// One training iteration. `dec_batch` feeds the decentralized nets; `cen_batch` the centralized
+/// net (the same batch except in Our-2, spec 5.5).
+pub fn train_iteration(
+    p: IterationParams,
+    layout: &Layout,
+    dec: &mut [Nets],
+    cen: Option<&mut Nets>,
+    dec_batch: &Batch<'_>,
+    cen_batch: &Batch<'_>,
+    tape: &mut Tape,
+) -> Result<IterationLoss, ReplayError> {
+    let mut loss = IterationLoss::default();
+    let n_actions = layout.n_actions();
+    // Step A and B.
+    let mut joint_star: Option<(JointView, Vec<usize>)> = None;
+    if let Some(cen) = cen {
+        let joint = squeeze_joint(cen_batch, layout)?;
+        if joint.is_empty() {
+            return Ok(loss); // Q9: the learner returns at once.
+        }
+        let qn = cen.policy.forward_infer(&joint.next_inputs, &joint.lengths);
+        let a_star = cond_argmax_rows(qn.view(), n_actions, &joint.cond)?;
+        let qt = cen.target.forward_infer(&joint.next_inputs, &joint.lengths);
+        let y = targets(&joint.rewards, &joint.dones, &qt, &a_star, p.discount);
+        let h = if p.method.cen_loss_is_hysteretic() { p.h } else { 1.0 };
+        loss.total += td_step(cen, tape, &joint.inputs, &joint.lengths, &joint.joint_actions, &y, h);
+        loss.steps += 1;
+        if p.method.dec_target_action() == Some(DecTargetAction::CenCondArgmax) {
+            let view = if p.method == Method::Our2 {
+                squeeze_joint(dec_batch, layout)?
+            } else {
+                joint
+            };
+            if view.is_empty() {
+                return Ok(loss);
+            }
+            // Q2: the selection uses the centralized net right after its own step.
+            let qn2 = cen.policy.forward_infer(&view.next_inputs, &view.lengths);
+            let star = cond_argmax_rows(qn2.view(), n_actions, &view.cond)?;
+            joint_star = Some((view, star));
+        }
+    }
+    // Step C.
+    let Some(rule) = p.method.dec_target_action() else {
+        return Ok(loss);
+    };
+    let views: Vec<AgentView> = (0..dec.len())
+        .map(|i| squeeze_agent(dec_batch, layout, i))
+        .collect::<Result<_, _>>()?;
+    if p.early_return_skips_all && views.iter().any(|v| v.is_empty()) {
+        return Ok(loss); // Q9 (faithful): one empty view skips every agent's step.
+    }
+    for (agent, (nets, view)) in dec.iter_mut().zip(&views).enumerate() {
+        if view.is_empty() {
+            continue;
+        }
+        let a_star: Vec<usize> = match rule {
+            DecTargetAction::CenCondArgmax => {
+                let (joint, star) = joint_star.as_ref().expect("step B ran for this method");
+                joint_rows_of_agent(joint, agent)
+                    .iter()
+                    .map(|&k| unravel_component(star[k], n_actions, agent))
+                    .collect()
+            }
+            DecTargetAction::OwnDoubleQ => {
+                let qn = nets.policy.forward_infer(&view.next_inputs, &view.lengths);
+                row_argmax(&qn)
+            }
+        };
+        let qt = nets.target.forward_infer(&view.next_inputs, &view.lengths);
+        let y = targets(&view.rewards, &view.dones, &qt, &a_star, p.discount);
+        loss.total += td_step(nets, tape, &view.inputs, &view.lengths, &view.actions, &y, p.h);
+        loss.steps += 1;
+    }
+    Ok(loss)
+}
+
+/// Double-Q targets y_k = r_k + gamma (1 - done_k) Q_target[k, a*_k] (detached; quirks Q5, Q7).
+pub fn targets(rewards: &[f32], dones: &[f32], q_target: &Array2<f32>, a_star: &[usize], gamma: f32) -> Vec<f32> {
+    rewards
+        .iter()
+        .zip(dones)
+        .zip(a_star)
+        .enumerate()
+        .map(|(k, ((&r, &d), &a))| r + gamma * (1.0 - d) * q_target[[k, a]])
+        .collect()
+}
+
+/// First maximal column of each row (quirk Q14).
+pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
+    q.rows()
+        .into_iter()
+        .map(|row| crate::algos::acting::argmax(row.as_slice().expect("rows of a standard-layout array are contiguous")))
+        .collect()
+}
+
+/// One Adam step on `nets.policy` for loss = mean_k (max(h d_k, d_k))^2, d_k = y_k - Q(h_k, a_k)
+/// (spec 5, quirk Q4: the hysteretic transform is a leaky ReLU of slope h before squaring, and
+/// the mean runs over all kept records of the batch, quirk Q17). Returns the loss.
+fn td_step(
+    nets: &mut Nets,
+    tape: &mut Tape,
+    inputs: &Array3<f32>,
+    lengths: &[usize],
+    actions: &[usize],
+    y: &[f32],
+    h: f32,
+) -> f64 {
+    tape.reset();
+    let (q, params) = nets.policy.forward_train(tape, inputs, lengths);
+    let q_taken = tape.gather(q, actions);
+    let y = tape.constant_column(y);
+    let delta = tape.sub(y, q_taken);
+    let delta = tape.leaky_relu(delta, h);
+    let sq = tape.square(delta);
+    let loss = tape.mean(sq);
+    let value = tape.scalar(loss) as f64;
+    tape.backward(loss);
+    let grads = nets.policy.gradients(tape, &params);
+    nets.adam.step(&mut nets.policy, &grads);
+    value
+}
