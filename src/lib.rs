@@ -5,6 +5,7 @@
 //! `experiment` (config, runner) -> `algos` (trainer) -> `envs` + `nn` (on `autograd`), and the
 //! results feed `plot` and `deploy`. Lower layers never name higher ones.
 
+pub mod algos;
 pub mod autograd;
-pub mod nn;
 pub mod envs;
+pub mod nn;
