@@ -37,7 +37,7 @@ pub enum FirstRecordObs {
 /// Use: after every `env.reset(..)` call [`Recorder::begin_from_env`]; after every `env.step(..)`
 /// call [`Recorder::record_from_env`], which returns the finished episode when `done` (the caller
 /// pushes it into the replay and resets the env). The raw forms take the values directly.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Recorder {
     layout: Layout,
     first_obs: FirstRecordObs,

@@ -74,6 +74,8 @@ pub struct EvalPoint {
     pub epsilon: f64,
     pub hysteresis: f64,
     pub loss: Option<f64>,
+    /// Wall-clock seconds since the run started, over all resumed segments (not reproducible).
+    pub wall_seconds: f64,
 }
 
 /// What [`Trainer::advance`] stopped at.
@@ -110,6 +112,10 @@ pub struct Trainer {
     loss_sum: f64,
     loss_count: u64,
     evals: Vec<EvalPoint>,
+    /// Wall-clock seconds of earlier segments of this run (before the last resume).
+    elapsed_before: f64,
+    #[serde(skip, default)]
+    segment_start: Option<std::time::Instant>,
     #[serde(skip, default)]
     tape: Tape,
 }
@@ -218,6 +224,8 @@ impl Trainer {
             loss_sum: 0.0,
             loss_count: 0,
             evals: Vec::new(),
+            elapsed_before: 0.0,
+            segment_start: None,
             tape: Tape::new(),
         })
     }
@@ -252,6 +260,17 @@ impl Trainer {
         self.cen.as_ref().map(|n| &n.policy)
     }
 
+    /// Wall-clock seconds this run has trained, over all segments.
+    pub fn wall_seconds(&self) -> f64 {
+        self.elapsed_before + self.segment_start.map_or(0.0, |t| t.elapsed().as_secs_f64())
+    }
+
+    /// Fold the running segment's time into the saved total (call before checkpointing).
+    pub fn mark_time(&mut self) {
+        self.elapsed_before = self.wall_seconds();
+        self.segment_start = Some(std::time::Instant::now());
+    }
+
     /// Whether training is complete.
     pub fn is_finished(&self) -> bool {
         self.episodes >= self.config.total_epi as u64
@@ -259,6 +278,7 @@ impl Trainer {
 
     /// Run main-loop iterations until a training episode finishes or training is complete.
     pub fn advance(&mut self) -> Result<Advance, TrainError> {
+        self.segment_start.get_or_insert_with(std::time::Instant::now);
         loop {
             if self.is_finished() {
                 return Ok(Advance::Finished);
@@ -435,6 +455,7 @@ impl Trainer {
             epsilon: self.epsilon,
             hysteresis: self.h,
             loss,
+            wall_seconds: self.wall_seconds(),
         });
         Ok(())
     }

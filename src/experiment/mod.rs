@@ -3,5 +3,7 @@
 pub mod atomic;
 pub mod config;
 pub mod metrics;
+pub mod report;
 pub mod runner;
 pub mod seeds;
+// pub mod train_run;
