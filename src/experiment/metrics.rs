@@ -10,6 +10,9 @@
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// The file name of a run's learning curve.
+pub const METRICS_FILE: &str = "metrics.csv";
+
 /// One evaluation point of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MetricsRow {

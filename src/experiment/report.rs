@@ -2,8 +2,7 @@
 //! evenly spaced evaluation points, with a bar per point.
 
 use crate::experiment::config::RunSpec;
-use crate::experiment::metrics;
-use crate::experiment::train_run::METRICS;
+use crate::experiment::metrics::{self, METRICS_FILE};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -27,7 +26,7 @@ pub fn mean_curve(curves: &[Vec<(u64, f64)>]) -> Vec<(u64, f64, usize)> {
 pub fn print_curves(results: &Path, runs: &[RunSpec]) -> Result<(), metrics::MetricsError> {
     let mut by_curve: BTreeMap<String, Vec<Vec<(u64, f64)>>> = BTreeMap::new();
     for run in runs {
-        let path = run.dir(results).join(METRICS);
+        let path = run.dir(results).join(METRICS_FILE);
         if !path.exists() {
             continue;
         }

@@ -11,7 +11,7 @@ use crate::algos::method::Method;
 use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
 use crate::experiment::atomic::write_atomic;
 use crate::experiment::config::RunSpec;
-use crate::experiment::metrics::{self, MetricsRow};
+use crate::experiment::metrics::{self, MetricsRow, METRICS_FILE};
 use crate::experiment::runner::{Progress, FINISHED_MARKER};
 use crate::experiment::seeds::{stream, Role};
 use serde::{Deserialize, Serialize};
@@ -21,8 +21,6 @@ use std::path::{Path, PathBuf};
 pub const CHECKPOINT: &str = "checkpoint.bin";
 /// The resolved config of a run.
 pub const CONFIG: &str = "config.toml";
-/// The learning curve of a run.
-pub const METRICS: &str = "metrics.csv";
 
 /// What a run directory's `config.toml` holds: who ran and with which hyperparameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -97,7 +95,7 @@ fn save_metrics(dir: &Path, trainer: &Trainer) -> Result<(), RunError> {
             wall_seconds: e.wall_seconds,
         })
         .collect();
-    let path = dir.join(METRICS);
+    let path = dir.join(METRICS_FILE);
     metrics::write(&path, &rows).map_err(|e| io(&path, e))
 }
 
