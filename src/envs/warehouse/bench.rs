@@ -38,7 +38,11 @@ pub fn run_random_macro_actions<E: MacroEnv>(
     env.reset(rng);
     while stats.steps < n_steps {
         for (i, a) in actions.iter_mut().enumerate() {
-            *a = if env.is_free(i) { rng.gen_range(0..n_actions[i]) } else { 0 };
+            *a = if env.is_free(i) {
+                rng.gen_range(0..n_actions[i])
+            } else {
+                0
+            };
         }
         let out = env.step(&actions, rng)?;
         stats.steps += 1;

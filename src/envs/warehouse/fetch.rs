@@ -153,7 +153,11 @@ impl Fetch {
         }
         tb.done = true;
         tb.tl = 0.0;
-        self.ready = if self.n_staged == 1 { [1.0, 0.0] } else { [0.0, 0.0] };
+        self.ready = if self.n_staged == 1 {
+            [1.0, 0.0]
+        } else {
+            [0.0, 0.0]
+        };
         0.0
     }
 
@@ -163,7 +167,11 @@ impl Fetch {
             self.found_count[i] += 1;
             self.staging[self.n_staged] = i;
             self.n_staged += 1;
-            self.ready = if self.n_staged == 2 { [0.0, 1.0] } else { [1.0, 0.0] };
+            self.ready = if self.n_staged == 2 {
+                [0.0, 1.0]
+            } else {
+                [1.0, 0.0]
+            };
         }
     }
 }

@@ -81,12 +81,11 @@ impl Warehouse {
     pub fn new(params: WarehouseParams) -> Result<Self, EnvError> {
         params.validate()?;
         let noise = if params.tb_move_noisy > 0.0 {
-            let normal = Normal::new(0.0, params.tb_move_noisy).map_err(|e| {
-                EnvError::InvalidParameter {
+            let normal =
+                Normal::new(0.0, params.tb_move_noisy).map_err(|e| EnvError::InvalidParameter {
                     name: "tb_move_noisy",
                     reason: e.to_string(),
-                }
-            })?;
+                })?;
             Some(normal)
         } else {
             None

@@ -55,10 +55,15 @@ pub fn write_fetch_obs(out: &mut [f32; FETCH_OBS], fetch: &Fetch, tbs: &[Turtleb
 
 /// Element names of a Turtlebot observation, in layout order.
 pub fn turtlebot_obs_names() -> Vec<String> {
-    let mut names: Vec<String> = ["loc_workshop", "loc_tool_room_wait", "loc_table", "loc_none"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let mut names: Vec<String> = [
+        "loc_workshop",
+        "loc_tool_room_wait",
+        "loc_table",
+        "loc_none",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     names.extend((0..4).map(|k| format!("human_step_{k}")));
     names.extend((0..3).map(|t| format!("basket_tool_{t}")));
     names.extend(["ready_one_tool".to_string(), "ready_two_tools".to_string()]);
@@ -67,10 +72,15 @@ pub fn turtlebot_obs_names() -> Vec<String> {
 
 /// Element names of the Fetch observation, in layout order.
 pub fn fetch_obs_names() -> Vec<String> {
-    ["ready_one_tool", "ready_two_tools", "t0_beside_table", "t1_beside_table"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+    [
+        "ready_one_tool",
+        "ready_two_tools",
+        "t0_beside_table",
+        "t1_beside_table",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
 }
 
 #[cfg(test)]

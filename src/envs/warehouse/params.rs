@@ -82,7 +82,8 @@ impl WarehouseParams {
 
     /// Reject values the dynamics are not defined for, or that the fixed layout cannot hold.
     pub fn validate(&self) -> Result<(), EnvError> {
-        let bad = |name: &'static str, reason: String| Err(EnvError::InvalidParameter { name, reason });
+        let bad =
+            |name: &'static str, reason: String| Err(EnvError::InvalidParameter { name, reason });
         if self.n_objs != N_TOOLS {
             return bad(
                 "n_objs",
@@ -142,7 +143,10 @@ mod tests {
         let p = WarehouseParams::default();
         assert_eq!(p, WarehouseParams::paper(150));
         assert_eq!((p.n_objs, p.n_each_obj, p.terminate_step), (3, 1, 150));
-        assert_eq!((p.human_speed_per_step, p.tb_move_speed, p.tb_move_noisy), (18.0, 0.6, 0.0));
+        assert_eq!(
+            (p.human_speed_per_step, p.tb_move_speed, p.tb_move_noisy),
+            (18.0, 0.6, 0.0)
+        );
         assert_eq!((p.fetch_pass_obj_tc, p.fetch_look_for_obj_tc), (4, 6));
         assert!(!p.delay_delivery_penalty);
         assert_eq!(p.get_tool_wait(), 10.0);
@@ -152,16 +156,76 @@ mod tests {
     #[test]
     fn invalid_values_are_named_errors() {
         let ok = WarehouseParams::default();
-        rejects(WarehouseParams { terminate_step: 0, ..ok.clone() }, "terminate_step");
-        rejects(WarehouseParams { n_objs: 4, ..ok.clone() }, "n_objs");
-        rejects(WarehouseParams { n_each_obj: 0, ..ok.clone() }, "n_each_obj");
-        rejects(WarehouseParams { tb_move_speed: -0.6, ..ok.clone() }, "tb_move_speed");
-        rejects(WarehouseParams { tb_move_speed: f64::NAN, ..ok.clone() }, "tb_move_speed");
-        rejects(WarehouseParams { tb_move_noisy: -0.1, ..ok.clone() }, "tb_move_noisy");
-        rejects(WarehouseParams { tb_move_noisy: f64::INFINITY, ..ok.clone() }, "tb_move_noisy");
-        rejects(WarehouseParams { human_speed_per_step: 0.0, ..ok.clone() }, "human_speed_per_step");
-        rejects(WarehouseParams { fetch_pass_obj_tc: 0, ..ok.clone() }, "fetch_pass_obj_tc");
-        rejects(WarehouseParams { fetch_look_for_obj_tc: 0, ..ok }, "fetch_look_for_obj_tc");
+        rejects(
+            WarehouseParams {
+                terminate_step: 0,
+                ..ok.clone()
+            },
+            "terminate_step",
+        );
+        rejects(
+            WarehouseParams {
+                n_objs: 4,
+                ..ok.clone()
+            },
+            "n_objs",
+        );
+        rejects(
+            WarehouseParams {
+                n_each_obj: 0,
+                ..ok.clone()
+            },
+            "n_each_obj",
+        );
+        rejects(
+            WarehouseParams {
+                tb_move_speed: -0.6,
+                ..ok.clone()
+            },
+            "tb_move_speed",
+        );
+        rejects(
+            WarehouseParams {
+                tb_move_speed: f64::NAN,
+                ..ok.clone()
+            },
+            "tb_move_speed",
+        );
+        rejects(
+            WarehouseParams {
+                tb_move_noisy: -0.1,
+                ..ok.clone()
+            },
+            "tb_move_noisy",
+        );
+        rejects(
+            WarehouseParams {
+                tb_move_noisy: f64::INFINITY,
+                ..ok.clone()
+            },
+            "tb_move_noisy",
+        );
+        rejects(
+            WarehouseParams {
+                human_speed_per_step: 0.0,
+                ..ok.clone()
+            },
+            "human_speed_per_step",
+        );
+        rejects(
+            WarehouseParams {
+                fetch_pass_obj_tc: 0,
+                ..ok.clone()
+            },
+            "fetch_pass_obj_tc",
+        );
+        rejects(
+            WarehouseParams {
+                fetch_look_for_obj_tc: 0,
+                ..ok
+            },
+            "fetch_look_for_obj_tc",
+        );
     }
 
     #[test]

@@ -1,5 +1,8 @@
 //! Property tests over many seeded random episodes, and the noisy mode's reproducibility.
 
+// Trajectories are indexed by step number t, as in the spec's tables.
+#![allow(clippy::needless_range_loop)]
+
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -13,7 +16,12 @@ const REWARDS: [f64; 4] = [-1.0, 99.0, -11.0, 89.0];
 
 /// Joint action: the simple policy, each free agent's choice replaced by a uniform one with
 /// probability `eps` (so episodes both wander and reach deliveries).
-fn mixed_action(env: &Warehouse, p: &mut SimplePolicy, eps: f64, rng: &mut ChaCha8Rng) -> [usize; 3] {
+fn mixed_action(
+    env: &Warehouse,
+    p: &mut SimplePolicy,
+    eps: f64,
+    rng: &mut ChaCha8Rng,
+) -> [usize; 3] {
     let mut a = p.act(env);
     for (i, n) in env.n_actions().iter().enumerate() {
         if env.is_free(i) && rng.gen_bool(eps) {
@@ -31,7 +39,11 @@ fn check_turtlebot_obs(env: &Warehouse, i: usize) {
     assert_eq!(ob[0..4].iter().sum::<f32>(), 1.0, "one location: {ob:?}");
     let at_ws = ob[0] == 1.0;
     let human: f32 = ob[4..8].iter().sum();
-    assert_eq!(human, if at_ws { 1.0 } else { 0.0 }, "human step only at the workshop");
+    assert_eq!(
+        human,
+        if at_ws { 1.0 } else { 0.0 },
+        "human step only at the workshop"
+    );
     let ready: f32 = ob[11..13].iter().sum();
     assert!(ready <= 1.0);
     if at_ws {
@@ -72,7 +84,11 @@ fn check_tool_conservation(env: &Warehouse, deliveries: usize) {
         let staged = f.staged().iter().filter(|&&t| t == tool).count() as f64;
         let carried = env.turtlebot(0).basket[tool] + env.turtlebot(1).basket[tool];
         let delivered = if tool < deliveries { 1.0 } else { 0.0 };
-        assert_eq!(staged + carried + delivered, f.found_count[tool] as f64, "tool {tool}");
+        assert_eq!(
+            staged + carried + delivered,
+            f.found_count[tool] as f64,
+            "tool {tool}"
+        );
     }
 }
 
@@ -107,7 +123,11 @@ fn random_episodes_keep_every_invariant() {
                 if was_free[i] {
                     assert_eq!(env.executed()[i], a[i]);
                 } else {
-                    assert_eq!(env.executed()[i], prev_exec[i], "busy agent keeps its action");
+                    assert_eq!(
+                        env.executed()[i],
+                        prev_exec[i],
+                        "busy agent keeps its action"
+                    );
                 }
                 if !env.mac_done()[i] {
                     assert_eq!(env.obs(i), prev_obs[i], "held observation");
@@ -137,7 +157,10 @@ fn random_episodes_keep_every_invariant() {
         }
     }
     assert_eq!(seen, [true; 4], "every reward value occurred");
-    assert!(terminal_episodes > 100, "only {terminal_episodes} terminal episodes");
+    assert!(
+        terminal_episodes > 100,
+        "only {terminal_episodes} terminal episodes"
+    );
 }
 
 #[test]
@@ -156,7 +179,11 @@ fn paper_settings_draw_nothing_and_ignore_the_seed() {
                 break;
             }
         }
-        (trace, env_rng.next_u64(), EnvRng::seed_from_u64(seed).next_u64())
+        (
+            trace,
+            env_rng.next_u64(),
+            EnvRng::seed_from_u64(seed).next_u64(),
+        )
     };
     let (a, after_a, fresh_a) = run(1);
     let (b, _, _) = run(2);

@@ -8,24 +8,27 @@
 //! exact value, and the final `n / 100.0` is one correctly rounded division, which is the nearest
 //! f64 to the decimal `n/100` — exactly what CPython's string round-trip produces.
 
-/// `round(x, 2)` as CPython computes it. For finite `x` with |x| < 2^40 (distances here are < 10).
+/// `round(x, 2)` as CPython computes it, for finite `0 <= x < 2^40` (distances here are < 10);
+/// NaN, negative or huge inputs give unspecified (non-panicking) results.
 pub fn round2(x: f64) -> f64 {
     let p = x * 100.0;
     let e = product_error(x, p);
-    // floor of the exact value p + e (p may have rounded up onto an integer).
-    let mut lo = p.floor();
-    if lo == p && e < 0.0 {
-        lo -= 1.0;
+    // floor of the exact value p + e (p may have rounded up onto an integer). Truncation is the
+    // floor for p >= 0 and avoids a libm call.
+    let mut lo = p as u64;
+    if lo as f64 == p && e < 0.0 && lo > 0 {
+        lo -= 1;
     }
+    let lo_f = lo as f64;
     // Sign of (p + e) - (lo + 0.5): `p - lo - 0.5` is exact (or far from zero), `e` exact, and a
     // rounded sum keeps the sign of the exact sum.
-    let above_half = (p - lo - 0.5) + e;
-    let n = if above_half > 0.0 || (above_half == 0.0 && lo % 2.0 != 0.0) {
-        lo + 1.0
+    let above_half = (p - lo_f - 0.5) + e;
+    let n = if above_half > 0.0 || (above_half == 0.0 && lo % 2 == 1) {
+        lo + 1
     } else {
         lo
     };
-    n / 100.0
+    n as f64 / 100.0
 }
 
 /// The exact rounding error of `p = x * 100.0`, so that `x * 100 = p + e` exactly (Dekker).
@@ -85,7 +88,16 @@ mod tests {
             // Values right at the half-way points, where naive rounding goes wrong.
             let k: u32 = rng.gen_range(0..1000);
             let h = (f64::from(k) + 0.5) / 100.0;
-            for y in [h, f64::from_bits(h.to_bits() + 1), f64::from_bits(h.to_bits() - 1)] {
+            // And right at multiples of 0.01, where x * 100 may round onto an integer.
+            let m = f64::from(k + 1) / 100.0;
+            let near = [h, m].map(|v| {
+                [
+                    v,
+                    f64::from_bits(v.to_bits() + 1),
+                    f64::from_bits(v.to_bits() - 1),
+                ]
+            });
+            for y in near.into_iter().flatten() {
                 assert_eq!(round2(y).to_bits(), oracle(y).to_bits(), "y = {y:e}");
             }
         }

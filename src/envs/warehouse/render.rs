@@ -15,7 +15,9 @@ const ROWS: usize = 20; // 5 m
 
 fn cell(p: [f64; 2]) -> (usize, usize) {
     let c = (p[0] / CELL_M).floor().clamp(0.0, (COLS - 1) as f64) as usize;
-    let r = ((5.0 - p[1]) / CELL_M).floor().clamp(0.0, (ROWS - 1) as f64) as usize;
+    let r = ((5.0 - p[1]) / CELL_M)
+        .floor()
+        .clamp(0.0, (ROWS - 1) as f64) as usize;
     (r, c)
 }
 
@@ -76,7 +78,10 @@ pub(super) fn render(env: &Warehouse) -> String {
         env.t(),
         env.horizon(),
         env.last_reward,
-        env.mac_done().iter().map(|&d| u8::from(d)).collect::<Vec<_>>()
+        env.mac_done()
+            .iter()
+            .map(|&d| u8::from(d))
+            .collect::<Vec<_>>()
     );
     for i in 0..2 {
         let tb = env.turtlebot(i);

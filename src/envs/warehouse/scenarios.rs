@@ -1,5 +1,8 @@
 //! Spec section 14: every scenario (values from the reference) and the S2 optimum, as tests.
 
+// Trajectories are indexed by step number t, as in the spec's tables.
+#![allow(clippy::needless_range_loop)]
+
 use rand::SeedableRng;
 
 use super::testkit::{o, run_policy, run_queues, Rec, SimplePolicy};
@@ -12,7 +15,11 @@ fn ret(recs: &[Rec]) -> f64 {
 
 /// Steps (t >= 1) at which agent `i`'s done flag is set, within `recs`.
 fn done_steps(recs: &[Rec], i: usize) -> Vec<usize> {
-    recs.iter().skip(1).filter(|r| r.mac_done[i]).map(|r| r.t).collect()
+    recs.iter()
+        .skip(1)
+        .filter(|r| r.mac_done[i])
+        .map(|r| r.t)
+        .collect()
 }
 
 fn nonstandard_rewards(recs: &[Rec]) -> Vec<(usize, f64)> {
@@ -36,7 +43,16 @@ fn s1_reset_observations_and_human() {
 
 /// S2's event table (spec section 14): step, executed, r, mac_done, T0/T1/Fetch obs after the
 /// step (None = held from before), human step.
-type Event = (usize, [usize; 3], f64, [u8; 3], Option<&'static str>, Option<&'static str>, Option<&'static str>, usize);
+type Event = (
+    usize,
+    [usize; 3],
+    f64,
+    [u8; 3],
+    Option<&'static str>,
+    Option<&'static str>,
+    Option<&'static str>,
+    usize,
+);
 
 #[rustfmt::skip]
 const S2_EVENTS: [Event; 16] = [
@@ -60,7 +76,11 @@ const S2_EVENTS: [Event; 16] = [
 
 #[test]
 fn s2_scripted_plan_reaches_the_optimum_262_at_step_38() {
-    let recs = run_queues([&[2, 2, 0], &[2, 0, 2, 0], &[3, 2, 4, 1, 5, 2]], [0, 0, 0], 150);
+    let recs = run_queues(
+        [&[2, 2, 0], &[2, 0, 2, 0], &[3, 2, 4, 1, 5, 2]],
+        [0, 0, 0],
+        150,
+    );
     assert_eq!(recs.len() - 1, 38, "terminal at step 38");
     assert!(recs[38].done);
     assert!(recs[1..38].iter().all(|r| !r.done));
@@ -104,8 +124,16 @@ fn s3_go_actions_finish_on_arrival_then_repeat_in_one_step() {
     assert_eq!(done_steps(&recs, 0), (6..=20).collect::<Vec<_>>());
     assert_eq!(done_steps(&recs, 2), (1..=20).collect::<Vec<_>>());
     assert_eq!(recs[2].obs[1], o("0100 0000 000 00"));
-    assert_eq!(recs[6].obs[0], o("1000 1000 000 00"), "human step 0 seen at the workshop");
-    assert_eq!(recs[5].obs[0], o("0001 0000 000 00"), "held while travelling");
+    assert_eq!(
+        recs[6].obs[0],
+        o("1000 1000 000 00"),
+        "human step 0 seen at the workshop"
+    );
+    assert_eq!(
+        recs[5].obs[0],
+        o("0001 0000 000 00"),
+        "held while travelling"
+    );
     assert!(recs.iter().all(|r| r.obs[2] == o("00 00")));
     assert!(nonstandard_rewards(&recs).is_empty());
 }
@@ -177,7 +205,10 @@ fn s7a_pass_started_on_the_arrival_step_fails() {
 #[test]
 fn s7b_pass_after_one_waiting_step_succeeds_with_empty_staging() {
     let recs = run_queues([&[1], &[2], &[0, 0, 0, 0, 2]], [1, 2, 0], 10);
-    assert!(nonstandard_rewards(&recs).is_empty(), "no reward change (Q5)");
+    assert!(
+        nonstandard_rewards(&recs).is_empty(),
+        "no reward change (Q5)"
+    );
     assert_eq!(done_steps(&recs, 1)[0], 8);
     assert_eq!(recs[8].obs[1], o("0010 0000 000 00"));
     assert_eq!(recs[8].tbs[1].tl, 0.0);
@@ -233,11 +264,18 @@ fn s10_horizon_ends_the_episode_and_further_steps_are_refused() {
 
 #[test]
 fn s11_time_outs_coinciding_with_passes_and_queued_tool() {
-    let recs = run_queues([&[2, 2, 2, 0], &[2, 2, 0], &[3, 4, 2, 5, 1, 1]], [0, 0, 0], 150);
+    let recs = run_queues(
+        [&[2, 2, 2, 0], &[2, 2, 0], &[3, 4, 2, 5, 1, 1]],
+        [0, 0, 0],
+        150,
+    );
     assert_eq!(recs.len() - 1, 43);
     assert!(recs[43].done);
     assert_eq!(ret(&recs), 257.0);
-    assert_eq!(nonstandard_rewards(&recs), vec![(24, 99.0), (39, 99.0), (43, 99.0)]);
+    assert_eq!(
+        nonstandard_rewards(&recs),
+        vec![(24, 99.0), (39, 99.0), (43, 99.0)]
+    );
     // T1 times out at 15, re-chooses GT at 16, and P1 (13..16) hands it tool 0 (FIFO).
     assert!(recs[15].mac_done[1]);
     assert_eq!(recs[15].tbs[1].tl, -1.0);
@@ -329,6 +367,9 @@ fn search_before_pass_policy_returns_243_in_47_steps() {
     let recs = run_policy(&mut env, 150, |e| p.act(e));
     assert_eq!(recs.len() - 1, 47);
     assert_eq!(ret(&recs), 243.0);
-    let failed = recs.iter().filter(|r| r.reward == -11.0 || r.reward == 89.0).count();
+    let failed = recs
+        .iter()
+        .filter(|r| r.reward == -11.0 || r.reward == 89.0)
+        .count();
     assert_eq!(failed, 1, "one failed Pass");
 }

@@ -46,14 +46,14 @@ impl Warehouse {
         let mut r = -1.0;
         self.count += 1;
 
-        for i in 0..2 {
-            let tb = &mut self.tbs[i];
+        // Turtlebot 0 then 1: the order of their noise draws and of deliveries.
+        for ((tb, &passed), executed) in self.tbs.iter_mut().zip(actions).zip(&mut self.executed) {
             let a = match (tb.done, tb.cur) {
                 (false, Some(cur)) => cur,
-                _ => TbAction::ALL[actions[i]],
+                _ => TbAction::ALL[passed],
             };
             r += tb.step(a, &self.tb_dyn, &mut self.human, rng);
-            self.executed[i] = a as usize;
+            *executed = a as usize;
         }
 
         let fa = match (self.fetch.done, self.fetch.cur) {

@@ -78,13 +78,24 @@ impl Turtlebot {
 
     /// One primitive step of macro-action `a` (spec section 5). Returns the step's reward
     /// (0, or the delivery bonus). Draws two normals (x then y) only on a travel step with noise.
-    pub fn step(&mut self, a: TbAction, dyn_: &TbDynamics, human: &mut Human, rng: &mut EnvRng) -> f64 {
+    pub fn step(
+        &mut self,
+        a: TbAction,
+        dyn_: &TbDynamics,
+        human: &mut Human,
+        rng: &mut EnvRng,
+    ) -> f64 {
         self.cur = Some(a);
         self.done = false;
         let goal = self.targets[a as usize];
         let (gx, gy) = (goal[0] - self.pos[0], goal[1] - self.pos[1]);
         // Squares then sqrt, as numpy does (not hypot, which rounds differently); Q3 rounding.
-        let d = round2((gx * gx + gy * gy).sqrt());
+        // Most steps wait or repeat at the goal itself, where the distance is exactly 0.
+        let d = if gx == 0.0 && gy == 0.0 {
+            0.0
+        } else {
+            round2((gx * gx + gy * gy).sqrt())
+        };
         if d <= dyn_.speed {
             self.pos = goal;
             self.loc = Some(a as usize);
@@ -193,9 +204,8 @@ mod tests {
             [GoWorkshop, GoToolRoom, GetTool].map(|a| leg_steps(1, TURTLEBOT_STARTS[1], a)),
             [6, 2, 4]
         );
-        for r in 0..2 {
-            let table = WAYPOINTS[r][2];
-            assert_eq!(leg_steps(r, table, GoToolRoom), 3);
+        for (r, wps) in WAYPOINTS.iter().enumerate() {
+            assert_eq!(leg_steps(r, wps[2], GoToolRoom), 3);
         }
         assert_eq!(leg_steps(0, WAYPOINTS[0][2], GoWorkshop), 9);
         assert_eq!(leg_steps(1, WAYPOINTS[1][2], GoWorkshop), 8);
@@ -207,7 +217,15 @@ mod tests {
         let mut tb = Turtlebot::new(WAYPOINTS[1][2], WAYPOINTS[1]);
         let mut h = Human::new(18.0);
         let mut rng = EnvRng::seed_from_u64(0);
-        let want = [4.2, 3.6, 3.0, 2.4, 1.7999999999999998, 1.2000000000000002, 0.6];
+        let want = [
+            4.2,
+            3.6,
+            3.0,
+            2.4,
+            1.7999999999999998,
+            1.2000000000000002,
+            0.6,
+        ];
         for w in want {
             tb.step(TbAction::GoWorkshop, &dynamics(), &mut h, &mut rng);
             assert_eq!(tb.tl, w);
