@@ -72,7 +72,7 @@ pub struct Fetch {
     pub n_staged: usize,
     /// How often each tool was found this episode (never decreases).
     pub found_count: [usize; N_TOOLS],
-    /// Staging signal: [0,0] empty, [1,0] one tool, [0,1] two (section 6 update rules).
+    /// Staging signal: `[0,0]` empty, `[1,0]` one tool, `[0,1]` two (section 6 update rules).
     pub ready: [f64; 2],
     /// Set when a Pass starts without a Turtlebot waiting at the table; checked at its end.
     pub serving_failed: bool,
