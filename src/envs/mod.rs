@@ -10,6 +10,8 @@
 
 use rand_chacha::ChaCha8Rng;
 
+pub mod warehouse;
+
 /// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the
 /// caller, so a checkpoint can save it and a run derives it from its seed (spec `algorithms.md` 8).
 pub type EnvRng = ChaCha8Rng;
