@@ -6,5 +6,5 @@
 //! results feed `plot` and `deploy`. Lower layers never name higher ones.
 
 pub mod autograd;
-pub mod nn;
 pub mod envs;
+pub mod nn;

@@ -4,7 +4,11 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "macdec", version, about = "Macro-action multi-agent deep RL (MacDec-MADDRQN, ICRA 2020)")]
+#[command(
+    name = "macdec",
+    version,
+    about = "Macro-action multi-agent deep RL (MacDec-MADDRQN, ICRA 2020)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

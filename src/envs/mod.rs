@@ -10,6 +10,8 @@
 
 use rand_chacha::ChaCha8Rng;
 
+pub mod box_pushing;
+
 /// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the
 /// caller, so a checkpoint can save it and a run derives it from its seed (spec `algorithms.md` 8).
 pub type EnvRng = ChaCha8Rng;
@@ -95,6 +97,10 @@ pub trait MacroEnv {
             out[at..at + o.len()].copy_from_slice(o);
             at += o.len();
         }
-        assert_eq!(at, out.len(), "joint observation buffer has the wrong length");
+        assert_eq!(
+            at,
+            out.len(),
+            "joint observation buffer has the wrong length"
+        );
     }
 }
