@@ -206,6 +206,7 @@ impl MacroEnv for BoxPushing {
         &[OBS_SIZE; N_AGENTS]
     }
 
+    #[inline]
     fn n_actions(&self) -> &[usize] {
         &[N_ACTIONS; N_AGENTS]
     }
@@ -228,10 +229,12 @@ impl MacroEnv for BoxPushing {
         self.reset_state();
     }
 
+    #[inline]
     fn step(&mut self, actions: &[usize], _rng: &mut EnvRng) -> Result<StepOutcome, EnvError> {
         self.step_primitive(actions)
     }
 
+    #[inline]
     fn obs(&self, agent: usize) -> &[f32] {
         &self.obs[agent]
     }
@@ -241,6 +244,7 @@ impl MacroEnv for BoxPushing {
         &self.executed
     }
 
+    #[inline]
     fn mac_done(&self) -> &[bool] {
         &self.mac_done
     }

@@ -62,6 +62,7 @@ fn joint_push_starts(actions: &[usize], robots: &[Robot; N_AGENTS]) -> bool {
 impl BoxPushing {
     /// The body of [`crate::envs::MacroEnv::step`]. Input is validated before any state changes,
     /// so an error leaves the environment as it was.
+    #[inline]
     pub(super) fn step_primitive(&mut self, actions: &[usize]) -> Result<StepOutcome, EnvError> {
         if self.done {
             return Err(EnvError::EpisodeOver);
