@@ -107,14 +107,9 @@ impl BoxPushing {
             });
         }
         let layout = Layout::new(grid as i32);
-        let mut env = Self {
-            robots: layout
-                .robot_starts
-                .map(|(cell, heading)| Robot::at_start(cell, heading)),
-            boxes: Boxes {
-                small: layout.small_boxes,
-                big_left: layout.big_box_left,
-            },
+        Ok(Self {
+            robots: start_robots(&layout),
+            boxes: start_boxes(&layout),
             layout,
             horizon,
             joint_push: false,
@@ -124,9 +119,7 @@ impl BoxPushing {
             executed: [0; N_AGENTS],
             mac_done: [true; N_AGENTS],
             stats: DeliveryStats::default(),
-        };
-        env.reset_state();
-        Ok(env)
+        })
     }
 
     /// Grid side N.
@@ -167,14 +160,8 @@ impl BoxPushing {
 
     /// Back to the start configuration (spec 2). Statistics persist (Q14).
     fn reset_state(&mut self) {
-        self.robots = self
-            .layout
-            .robot_starts
-            .map(|(cell, heading)| Robot::at_start(cell, heading));
-        self.boxes = Boxes {
-            small: self.layout.small_boxes,
-            big_left: self.layout.big_box_left,
-        };
+        self.robots = start_robots(&self.layout);
+        self.boxes = start_boxes(&self.layout);
         self.joint_push = false;
         self.t = 0;
         self.done = false;
@@ -183,7 +170,7 @@ impl BoxPushing {
         self.mac_done = [true; N_AGENTS];
     }
 
-    /// Put robot `agent` on `cell` facing `heading`, free, for tests that start from a
+    /// Put robot `agent` on `cell` facing `heading` (other state untouched), for tests that start from a
     /// hand-made configuration.
     #[cfg(test)]
     pub(crate) fn place_robot(
@@ -194,6 +181,20 @@ impl BoxPushing {
     ) {
         self.robots[agent].cell = cell;
         self.robots[agent].heading = heading;
+    }
+}
+
+/// Both robots at their start cells, free, remembering no waypoint (spec 2).
+fn start_robots(layout: &Layout) -> [Robot; N_AGENTS] {
+    layout
+        .robot_starts
+        .map(|(cell, heading)| Robot::at_start(cell, heading))
+}
+
+fn start_boxes(layout: &Layout) -> Boxes {
+    Boxes {
+        small: layout.small_boxes,
+        big_left: layout.big_box_left,
     }
 }
 
