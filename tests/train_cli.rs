@@ -103,9 +103,16 @@ fn a_killed_run_resumes_to_the_uninterrupted_metrics() {
         "the run finished before it could be killed; make it longer"
     );
     let resumed = train(&config, &killed, &args);
-    assert!(resumed.status.success(), "{}", String::from_utf8_lossy(&resumed.stderr));
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
     let rel = "tiny/our1/seed-0/metrics.csv";
-    assert_eq!(metrics_without_time(&whole.join(rel)), metrics_without_time(&killed.join(rel)));
+    assert_eq!(
+        metrics_without_time(&whole.join(rel)),
+        metrics_without_time(&killed.join(rel))
+    );
 }
 
 #[test]
@@ -121,7 +128,10 @@ fn finished_runs_are_not_recomputed() {
     let again = train(&config, &out, &args);
     assert!(again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("already finished"));
-    assert_eq!(before, std::fs::metadata(&metrics).unwrap().modified().unwrap());
+    assert_eq!(
+        before,
+        std::fs::metadata(&metrics).unwrap().modified().unwrap()
+    );
 }
 
 #[test]
