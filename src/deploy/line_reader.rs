@@ -132,14 +132,25 @@ mod tests {
 
     #[test]
     fn a_line_at_the_limit_passes_and_one_byte_more_is_discarded_whole() {
-        assert_eq!(events(b"12345\n", 5), vec![line("12345"), LineEvent::Eof { partial: false }]);
+        assert_eq!(
+            events(b"12345\n", 5),
+            vec![line("12345"), LineEvent::Eof { partial: false }]
+        );
         assert_eq!(
             events(b"123456789012345\nok\n", 5),
-            vec![LineEvent::TooLong, line("ok"), LineEvent::Eof { partial: false }]
+            vec![
+                LineEvent::TooLong,
+                line("ok"),
+                LineEvent::Eof { partial: false }
+            ]
         );
         assert_eq!(
             events(b"123456\nok\n", 5),
-            vec![LineEvent::TooLong, line("ok"), LineEvent::Eof { partial: false }]
+            vec![
+                LineEvent::TooLong,
+                line("ok"),
+                LineEvent::Eof { partial: false }
+            ]
         );
     }
 

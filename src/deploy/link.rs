@@ -89,7 +89,12 @@ impl JsonLink<BufReader<TcpStream>, TcpStream> {
 
 impl<R: BufRead, W: Write> JsonLink<R, W> {
     /// Wrap a stream to a robot and check that it serves agent `agent` of `manifest`.
-    pub fn open(reader: R, writer: W, agent: usize, manifest: &Manifest) -> Result<Self, LinkError> {
+    pub fn open(
+        reader: R,
+        writer: W,
+        agent: usize,
+        manifest: &Manifest,
+    ) -> Result<Self, LinkError> {
         let mut link = JsonLink {
             reader: LineReader::new(reader, MAX_REPLY_BYTES),
             writer,

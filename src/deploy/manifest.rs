@@ -96,7 +96,9 @@ pub enum ManifestError {
     Parse { path: PathBuf, message: String },
     #[error("manifest format is `{found}`, expected `{FORMAT}`")]
     Format { found: String },
-    #[error("manifest format_version {found} is not supported (this version reads {FORMAT_VERSION})")]
+    #[error(
+        "manifest format_version {found} is not supported (this version reads {FORMAT_VERSION})"
+    )]
     Version { found: u32 },
     #[error("manifest `{key}`: {reason}")]
     InvalidValue { key: &'static str, reason: String },
@@ -108,7 +110,9 @@ pub enum ManifestError {
         expected: usize,
         got: usize,
     },
-    #[error("manifest agents[{position}] has index {index}; agents must be listed in order 0, 1, ...")]
+    #[error(
+        "manifest agents[{position}] has index {index}; agents must be listed in order 0, 1, ..."
+    )]
     AgentIndex { position: usize, index: usize },
     #[error("agent {agent}: `{field}` is {got}, the domain has {expected}")]
     Layout {
@@ -247,11 +251,10 @@ impl Manifest {
     pub fn read(dir: &Path) -> Result<Manifest, ManifestError> {
         let path = dir.join(MANIFEST_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| io_err(&path, e))?;
-        let manifest: Manifest =
-            serde_json::from_str(&text).map_err(|e| ManifestError::Parse {
-                path: path.clone(),
-                message: e.to_string(),
-            })?;
+        let manifest: Manifest = serde_json::from_str(&text).map_err(|e| ManifestError::Parse {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
         manifest.validate()?;
         Ok(manifest)
     }
@@ -277,7 +280,10 @@ impl Manifest {
             });
         }
         for (key, value) in [
-            ("architecture.mlp_layer_size", self.architecture.mlp_layer_size),
+            (
+                "architecture.mlp_layer_size",
+                self.architecture.mlp_layer_size,
+            ),
             ("architecture.rnn_h_size", self.architecture.rnn_h_size),
         ] {
             if value == 0 {
@@ -549,7 +555,9 @@ mod tests {
             "{err}"
         );
         export(dir.path());
-        rewrite_manifest(dir.path(), |v| v["agents"][1]["action_names"][0] = "Fly".into());
+        rewrite_manifest(dir.path(), |v| {
+            v["agents"][1]["action_names"][0] = "Fly".into()
+        });
         let err = Manifest::read(dir.path()).unwrap_err().to_string();
         assert!(
             err.contains("agent 1") && err.contains("action_names") && err.contains("Fly"),
@@ -566,7 +574,10 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let cases: Vec<(Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
             (Box::new(|v| v["format"] = "onnx".into()), "onnx"),
-            (Box::new(|v| v["format_version"] = 2.into()), "format_version 2"),
+            (
+                Box::new(|v| v["format_version"] = 2.into()),
+                "format_version 2",
+            ),
             (Box::new(|v| v["discount"] = 1.5.into()), "discount"),
             (Box::new(|v| v["agents"][0]["index"] = 1.into()), "index 1"),
             (
@@ -578,8 +589,14 @@ mod tests {
                 "share",
             ),
             (Box::new(|v| v["agents"][0]["sha256"] = "abc".into()), "hex"),
-            (Box::new(|v| v["agents"][0]["colour"] = "red".into()), "colour"),
-            (Box::new(|v| v["architecture"]["rnn_h_size"] = 0.into()), "rnn_h_size"),
+            (
+                Box::new(|v| v["agents"][0]["colour"] = "red".into()),
+                "colour",
+            ),
+            (
+                Box::new(|v| v["architecture"]["rnn_h_size"] = 0.into()),
+                "rnn_h_size",
+            ),
         ];
         for (edit, needle) in cases {
             export(dir.path());

@@ -9,7 +9,7 @@ use crate::deploy::AgentPolicy;
 use crate::envs::{EnvSpec, MacroEnv};
 use std::path::Path;
 
-/// `state_k <- 0.5 state_k + b_k + sum_j w_kj obs_j + 0.25 ((calls (k + 1)) mod 5)`,
+/// `state_k <- 0.5 state_k + b_k + sum_j w_kj obs_j + 2 ((calls (k + 1)) mod 5)`,
 /// `q_k = state_k`, with weights in [-1, 1) from a hash of (salt, k, j). Only exact float
 /// operations in a fixed order, so two processes on one machine agree bit for bit.
 #[derive(Debug, Clone)]
@@ -60,7 +60,11 @@ impl AgentPolicy for MockPolicy {
         self.calls = 0;
     }
     fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
-        assert_eq!(obs.len(), self.obs_len, "mock policy: wrong observation length");
+        assert_eq!(
+            obs.len(),
+            self.obs_len,
+            "mock policy: wrong observation length"
+        );
         assert_eq!(q.len(), self.n_actions, "mock policy: wrong Q length");
         self.calls += 1;
         for k in 0..self.n_actions {
@@ -68,7 +72,7 @@ impl AgentPolicy for MockPolicy {
             for (j, &x) in obs.iter().enumerate() {
                 drive += self.weight(k, j + 1) * x;
             }
-            let beat = 0.25 * ((self.calls * (k as u64 + 1)) % 5) as f32;
+            let beat = 2.0 * ((self.calls * (k as u64 + 1)) % 5) as f32;
             self.state[k] = 0.5 * self.state[k] + drive + beat;
             q[k] = self.state[k];
         }
@@ -94,7 +98,11 @@ fn mock_weights(env: EnvSpec) -> Result<Vec<Vec<u8>>, ManifestError> {
     let built = env.build().map_err(|e| ManifestError::Env(e.to_string()))?;
     let arch = mock_architecture();
     Ok((0..built.n_agents())
-        .map(|i| synthetic_weights(&arch, built.obs_sizes()[i], built.n_actions()[i], |_, _| 0.0))
+        .map(|i| {
+            synthetic_weights(&arch, built.obs_sizes()[i], built.n_actions()[i], |_, _| {
+                0.0
+            })
+        })
         .collect())
 }
 

@@ -54,7 +54,12 @@ pub fn exit_when_stdin_closes() {
 
 /// The command line of agent `agent`'s robot: `EXE robot --policy DIR --agent I --listen
 /// 127.0.0.1:0 --exit-on-stdin-close`, plus `extra_args` (e.g. the hidden `--mock`).
-pub fn robot_command(exe: &Path, policy_dir: &Path, agent: usize, extra_args: &[String]) -> Command {
+pub fn robot_command(
+    exe: &Path,
+    policy_dir: &Path,
+    agent: usize,
+    extra_args: &[String],
+) -> Command {
     let mut cmd = Command::new(exe);
     cmd.arg("robot")
         .arg("--policy")

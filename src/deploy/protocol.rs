@@ -34,7 +34,10 @@ pub enum Request {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 enum Wire<T> {
     Reset {},
-    Observe { obs: Vec<T>, macro_action_done: bool },
+    Observe {
+        obs: Vec<T>,
+        macro_action_done: bool,
+    },
     Info {},
 }
 
@@ -90,8 +93,7 @@ pub enum ProtocolError {
     NonFiniteQ { action: usize, value: f32 },
 }
 
-const NON_FINITE_HINT: &str =
-    " (JSON has no NaN or Infinity; observations must be finite numbers)";
+const NON_FINITE_HINT: &str = " (JSON has no NaN or Infinity; observations must be finite numbers)";
 
 impl Request {
     /// Parse and validate one line (without its newline) for agent `agent`, whose observations
@@ -112,7 +114,14 @@ impl Request {
                         hint,
                     }
                 }
-                Category::Data => ProtocolError::BadMessage(e.to_string()),
+                Category::Data => {
+                    let first = line.iter().find(|b| !b.is_ascii_whitespace());
+                    if first == Some(&b'{') {
+                        ProtocolError::BadMessage(e.to_string())
+                    } else {
+                        ProtocolError::BadMessage("a message must be a JSON object".into())
+                    }
+                }
             }
         })?;
         match wire {
@@ -269,6 +278,8 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("missing field `macro_action_done`"), "{err}");
+        let err = parse("[1, 2]").unwrap_err().to_string();
+        assert!(err.contains("must be a JSON object"), "{err}");
         let err = parse(r#"{"obs":[1,2,3]}"#).unwrap_err().to_string();
         assert!(err.contains("type"), "{err}");
         let err = parse(r#"{"type":"reset","extra":1}"#)
@@ -283,7 +294,14 @@ mod tests {
 
     #[test]
     fn garbage_is_malformed_json_not_a_panic() {
-        for line in [&b""[..], b"{", b"\xff\xfe\x00", b"[1,2,3]", b"null", b"{\"type\":"] {
+        for line in [
+            &b""[..],
+            b"{",
+            b"\xff\xfe\x00",
+            b"[1,2,3]",
+            b"null",
+            b"{\"type\":",
+        ] {
             assert!(Request::parse(line, 0, 3).is_err());
         }
     }
@@ -295,7 +313,10 @@ mod tests {
             name: "Push".into(),
             q: vec![0.5, -1.0, 2.0],
         };
-        assert_eq!(d.to_line(), r#"{"action":2,"name":"Push","q":[0.5,-1.0,2.0]}"#);
+        assert_eq!(
+            d.to_line(),
+            r#"{"action":2,"name":"Push","q":[0.5,-1.0,2.0]}"#
+        );
         assert_eq!(
             Reply::Ack { ok: Ack::Continue }.to_line(),
             r#"{"ok":"continue"}"#

@@ -287,7 +287,11 @@ mod tests {
             panic!()
         };
         assert_eq!(q, expected_q(&[a, b], 0));
-        assert_ne!(q, expected_q(&[b], 0), "the mock's Q must depend on history");
+        assert_ne!(
+            q,
+            expected_q(&[b], 0),
+            "the mock's Q must depend on history"
+        );
         assert_eq!(
             reply(&mut s, r#"{"type":"reset"}"#),
             Reply::Ack { ok: Ack::Reset }
