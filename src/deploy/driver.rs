@@ -283,7 +283,7 @@ mod tests {
             2,
         );
         assert_eq!(traces.len(), 2);
-        assert_eq!(traces[0].trajectory.last().unwrap().done, true);
+        assert!(traces[0].trajectory.last().unwrap().done);
     }
 
     #[test]

@@ -572,7 +572,8 @@ mod tests {
     #[test]
     fn format_version_typos_and_bad_values_are_named() {
         let dir = tempfile::tempdir().unwrap();
-        let cases: Vec<(Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+        type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+        let cases: Vec<(Edit, &str)> = vec![
             (Box::new(|v| v["format"] = "onnx".into()), "onnx"),
             (
                 Box::new(|v| v["format_version"] = 2.into()),
