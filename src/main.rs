@@ -6,6 +6,7 @@ use macdec::algos::method::Method;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
+use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
 //TMP use macdec::experiment::train_run::train_run;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -34,6 +35,8 @@ enum Command {
         #[arg(long)]
         verbose: bool,
     },
+    /// Write a Slurm job-array script (one task per run) to stdout.
+    Slurm(SlurmArgs),
     /// Measure speed.
     Bench {
         /// What to measure.
@@ -73,12 +76,51 @@ struct TrainArgs {
     /// No progress bars; one line per finished run.
     #[arg(long)]
     quiet: bool,
+    /// Run only the run with this index in the experiment's run list (Slurm array tasks).
+    #[arg(long)]
+    run_index: Option<usize>,
+}
+
+/// Which runs of an experiment, as `train` and `slurm` both select them.
+#[derive(clap::Args)]
+struct Selection {
+    /// Experiment TOML (see experiments/).
+    #[arg(long)]
+    config: PathBuf,
+    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
+    #[arg(long, value_delimiter = ',')]
+    methods: Option<Vec<String>>,
+    /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
+    #[arg(long)]
+    seeds: Option<String>,
+    /// Override a config key, e.g. total_epi=300 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(clap::Args)]
+struct SlurmArgs {
+    #[command(flatten)]
+    select: Selection,
+    /// Results root shared by the cluster's nodes.
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+    /// Wall-clock limit per array task.
+    #[arg(long, default_value = "12:00:00")]
+    time: String,
+    /// Memory per array task.
+    #[arg(long, default_value = "4G")]
+    mem: String,
+    /// Extra #SBATCH lines, e.g. --sbatch=--partition=cpu (repeatable).
+    #[arg(long = "sbatch", value_name = "LINE", allow_hyphen_values = true)]
+    sbatch: Vec<String>,
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Train(args) => train(args),
         Command::Replay { actions, verbose } => replay(&actions, verbose),
+        Command::Slurm(args) => slurm(args),
         Command::Bench { what } => match what {
             BenchTarget::Envs => bench_envs(),
         },
@@ -86,21 +128,7 @@ fn main() -> Result<()> {
 }
 
 fn train(args: TrainArgs) -> Result<()> {
-    let methods = args
-        .methods
-        .map(|names| {
-            names
-                .iter()
-                .map(|n| n.parse::<Method>())
-                .collect::<Result<Vec<_>, _>>()
-        })
-        .transpose()?;
-    let seeds = args.seeds.as_deref().map(parse_seeds).transpose()?;
-    let overrides = Overrides {
-        methods,
-        seeds,
-        set: args.set,
-    };
+    let overrides = overrides(args.methods, args.seeds.as_deref(), args.set)?;
     let experiment = match &args.config {
         Some(path) => Experiment::load(path, &overrides)
             .with_context(|| format!("loading {}", path.display()))?,
@@ -111,7 +139,17 @@ fn train(args: TrainArgs) -> Result<()> {
             &overrides,
         )?,
     };
-    let runs = experiment.runs()?;
+    let mut runs = experiment.runs()?;
+    if let Some(i) = args.run_index {
+        if i >= runs.len() {
+            bail!(
+                "--run-index {i}: the experiment has {} runs (0..{})",
+                runs.len(),
+                runs.len()
+            );
+        }
+        runs = vec![runs.swap_remove(i)];
+    }
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -150,6 +188,68 @@ fn train(args: TrainArgs) -> Result<()> {
     if failed > 0 {
         bail!("{failed} of {} run(s) failed", runs.len());
     }
+    Ok(())
+}
+
+fn overrides(
+    methods: Option<Vec<String>>,
+    seeds: Option<&str>,
+    set: Vec<String>,
+) -> Result<Overrides> {
+    let methods = methods
+        .map(|names| {
+            names
+                .iter()
+                .map(|n| n.parse::<Method>())
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .transpose()?;
+    let seeds = seeds.map(parse_seeds).transpose()?;
+    Ok(Overrides {
+        methods,
+        seeds,
+        set,
+    })
+}
+
+fn slurm(args: SlurmArgs) -> Result<()> {
+    let sel = args.select;
+    let mut train_args = Vec::new();
+    if let Some(m) = &sel.methods {
+        train_args.extend(["--methods".to_string(), shell_quote(&m.join(","))]);
+    }
+    if let Some(s) = &sel.seeds {
+        train_args.extend(["--seeds".to_string(), shell_quote(s)]);
+    }
+    for item in &sel.set {
+        train_args.extend(["--set".to_string(), shell_quote(item)]);
+    }
+    let o = overrides(sel.methods, sel.seeds.as_deref(), sel.set)?;
+    let experiment = Experiment::load(&sel.config, &o)
+        .with_context(|| format!("loading {}", sel.config.display()))?;
+    let labels: Vec<String> = experiment
+        .runs()?
+        .iter()
+        .map(|r| format!("{}/seed-{}", r.curve_name(), r.seed))
+        .collect();
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let config = absolute(&sel.config);
+    let out = absolute(&args.out);
+    let binary = std::env::current_exe().context("locating the macdec binary")?;
+    let script = job_script(
+        &experiment.name,
+        &labels,
+        &SlurmOptions {
+            config: &config,
+            out: &out,
+            binary: &binary,
+            train_args,
+            time: &args.time,
+            mem: &args.mem,
+            extra_sbatch: args.sbatch,
+        },
+    );
+    print!("{script}");
     Ok(())
 }
 

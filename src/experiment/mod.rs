@@ -7,3 +7,4 @@ pub mod report;
 pub mod runner;
 pub mod seeds;
 // pub mod train_run;
+pub mod slurm;
