@@ -35,6 +35,15 @@ enum Command {
         #[arg(long)]
         verbose: bool,
     },
+    /// Draw every experiment's learning curves (PNG + SVG) and summary tables from a results tree.
+    Plot {
+        /// Results root: <results>/<experiment>/<curve>/seed-<k>/metrics.csv.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        /// Where the figures and <experiment>_summary.csv files go.
+        #[arg(long, default_value = "plots")]
+        out: PathBuf,
+    },
     /// Write a Slurm job-array script (one task per run) to stdout.
     Slurm(SlurmArgs),
     /// Measure speed.
@@ -121,6 +130,7 @@ fn main() -> Result<()> {
         Command::Train(args) => train(args),
         Command::Replay { actions, verbose } => replay(&actions, verbose),
         Command::Slurm(args) => slurm(args),
+        Command::Plot { results, out } => plot(&results, &out),
         Command::Bench { what } => match what {
             BenchTarget::Envs => bench_envs(),
         },
@@ -250,6 +260,24 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         },
     );
     print!("{script}");
+    Ok(())
+}
+
+fn plot(results: &Path, out: &Path) -> Result<()> {
+    let report = macdec::plot::plot_results(results, out)
+        .with_context(|| format!("plotting {} into {}", results.display(), out.display()))?;
+    for note in &report.notes {
+        eprintln!("{note}");
+    }
+    for p in &report.plots {
+        eprintln!(
+            "wrote {}, {}, {}",
+            p.png.display(),
+            p.svg.display(),
+            p.summary_csv.display()
+        );
+    }
+    print!("{}", report.markdown());
     Ok(())
 }
 
