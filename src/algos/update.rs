@@ -5,7 +5,7 @@
 //! with the just-updated centralized net (Our-1, Our-2; quirk Q2); C, one TD step per agent, whose
 //! target action comes from B or from the agent's own double-Q selection.
 
-use crate::algos::cond_argmax::{cond_argmax_rows, unravel_component};
+use crate::algos::cond_argmax::{cond_argmax_rows, unravel_component, CondArgmaxError};
 use crate::algos::method::{DecTargetAction, Method};
 use crate::algos::record::Layout;
 use crate::algos::replay::Batch;
@@ -82,9 +82,8 @@ pub fn train_iteration(
             return Ok(loss); // Q9: the learner returns at once.
         }
         let qn = cen.policy.forward_infer(&joint.next_inputs, &joint.lengths);
-        let a_star = cond_argmax_rows(qn.view(), n_actions, &joint.cond)?;
         let qt = cen.target.forward_infer(&joint.next_inputs, &joint.lengths);
-        let y = targets(&joint.rewards, &joint.dones, &qt, &a_star, p.discount);
+        let y = cen_targets(&joint, &qn, &qt, n_actions, p.discount)?;
         let h = if p.method.cen_loss_is_hysteretic() { p.h } else { 1.0 };
         loss.total += td_step(cen, tape, &joint.inputs, &joint.lengths, &joint.joint_actions, &y, h);
         loss.steps += 1;
@@ -117,25 +116,51 @@ pub fn train_iteration(
         if view.is_empty() {
             continue;
         }
-        let a_star: Vec<usize> = match rule {
-            DecTargetAction::CenCondArgmax => {
-                let (joint, star) = joint_star.as_ref().expect("step B ran for this method");
-                joint_rows_of_agent(joint, agent)
-                    .iter()
-                    .map(|&k| unravel_component(star[k], n_actions, agent))
-                    .collect()
-            }
-            DecTargetAction::OwnDoubleQ => {
-                let qn = nets.policy.forward_infer(&view.next_inputs, &view.lengths);
-                row_argmax(&qn)
-            }
-        };
+        let own_qn = (rule == DecTargetAction::OwnDoubleQ)
+            .then(|| nets.policy.forward_infer(&view.next_inputs, &view.lengths));
+        let a_star = dec_target_actions(rule, agent, n_actions, joint_star.as_ref(), own_qn.as_ref());
         let qt = nets.target.forward_infer(&view.next_inputs, &view.lengths);
         let y = targets(&view.rewards, &view.dones, &qt, &a_star, p.discount);
         loss.total += td_step(nets, tape, &view.inputs, &view.lengths, &view.actions, &y, p.h);
         loss.steps += 1;
     }
     Ok(loss)
+}
+
+/// Centralized double-Q targets (spec 5.2): a*_k is the conditional argmax of the online net's
+/// next Q-values under the record's conditioning, evaluated by the target net.
+pub fn cen_targets(
+    joint: &JointView,
+    q_next_online: &Array2<f32>,
+    q_next_target: &Array2<f32>,
+    n_actions: &[usize],
+    gamma: f32,
+) -> Result<Vec<f32>, CondArgmaxError> {
+    let a_star = cond_argmax_rows(q_next_online.view(), n_actions, &joint.cond)?;
+    Ok(targets(&joint.rewards, &joint.dones, q_next_target, &a_star, gamma))
+}
+
+/// The action each of agent `agent`'s records bootstraps from: its component of the centralized
+/// conditional argmax `joint_star` (Our-1/Our-2, Eq. 4; rows paired by `joint_rows_of_agent`) or the
+/// argmax of its own online net's next Q-values `own_q_next` (Dec-HDDRQN, Our-1-R).
+/// Panics if the input its rule needs is missing (a bug in the caller).
+pub fn dec_target_actions(
+    rule: DecTargetAction,
+    agent: usize,
+    n_actions: &[usize],
+    joint_star: Option<&(JointView, Vec<usize>)>,
+    own_q_next: Option<&Array2<f32>>,
+) -> Vec<usize> {
+    match rule {
+        DecTargetAction::CenCondArgmax => {
+            let (joint, star) = joint_star.expect("the centralized selection ran for this method");
+            joint_rows_of_agent(joint, agent)
+                .iter()
+                .map(|&k| unravel_component(star[k], n_actions, agent))
+                .collect()
+        }
+        DecTargetAction::OwnDoubleQ => row_argmax(own_q_next.expect("own next Q-values were computed")),
+    }
 }
 
 /// Double-Q targets y_k = r_k + gamma (1 - done_k) Q_target[k, a*_k] (detached; quirks Q5, Q7).
