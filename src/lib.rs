@@ -6,5 +6,6 @@
 //! results feed `plot` and `deploy`. Lower layers never name higher ones.
 
 pub mod autograd;
+pub mod bench;
 pub mod nn;
 pub mod envs;
