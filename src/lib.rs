@@ -7,6 +7,7 @@
 
 pub mod algos;
 pub mod autograd;
+pub mod bench;
 pub mod envs;
 pub mod experiment;
 pub mod nn;

@@ -3,10 +3,12 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use macdec::algos::method::Method;
+use macdec::bench::nets;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
 use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
+use macdec::nn::demo;
 //TMP use macdec::experiment::train_run::train_run;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -24,6 +26,15 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The learning engine on a toy memory task: an LSTM Q-net learns delayed recall.
+    Demo {
+        /// Number of Adam steps.
+        #[arg(long, default_value_t = demo::DemoConfig::default().steps)]
+        steps: usize,
+        /// Seed of the run.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
     /// Train methods on an experiment config, one run per (method, variant, seed), in parallel.
     Train(TrainArgs),
     /// Replay a macro-action log and print the trajectory as JSON lines.
@@ -50,6 +61,9 @@ enum Command {
     Bench {
         /// What to measure.
         what: BenchTarget,
+        /// Timed iterations per configuration (nets).
+        #[arg(long, default_value_t = 200)]
+        iters: usize,
     },
 }
 
@@ -57,6 +71,8 @@ enum Command {
 enum BenchTarget {
     /// Environment primitive steps per second with random macro-actions (single thread).
     Envs,
+    /// One Q-net training update (forward, backward, Adam) at the paper's shapes, 1 thread.
+    Nets,
 }
 
 #[derive(clap::Args)]
@@ -131,8 +147,17 @@ fn main() -> Result<()> {
         Command::Replay { actions, verbose } => replay(&actions, verbose),
         Command::Slurm(args) => slurm(args),
         Command::Plot { results, out } => plot(&results, &out),
-        Command::Bench { what } => match what {
+        Command::Demo { steps, seed } => demo_run(steps, seed),
+        Command::Bench { what, iters } => match what {
             BenchTarget::Envs => bench_envs(),
+            BenchTarget::Nets => {
+                let results: Vec<_> = nets::SHAPES
+                    .iter()
+                    .map(|shape| nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)))
+                    .collect();
+                print!("{}", nets::format_table(&results));
+                Ok(())
+            }
         },
     }
 }
@@ -260,6 +285,28 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         },
     );
     print!("{script}");
+    Ok(())
+}
+
+fn demo_run(steps: usize, seed: u64) -> Result<()> {
+    let cfg = demo::DemoConfig {
+        steps,
+        seed,
+        ..demo::DemoConfig::default()
+    };
+    println!(
+        "delayed recall with an LSTM Q-net: {} steps, batch {}, seed {} \
+         (a net without memory cannot go below {:.4})",
+        cfg.steps,
+        cfg.batch,
+        cfg.seed,
+        demo::MEMORYLESS_LOSS
+    );
+    let t0 = std::time::Instant::now();
+    demo::run(&cfg, |step, loss| {
+        println!("step {step:>6}  loss {loss:.5}")
+    })?;
+    println!("done in {:.1} s", t0.elapsed().as_secs_f64());
     Ok(())
 }
 
