@@ -8,8 +8,8 @@ use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
 use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
+use macdec::experiment::train_run::train_run;
 use macdec::nn::demo;
-//TMP use macdec::experiment::train_run::train_run;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -205,8 +205,7 @@ fn train(args: TrainArgs) -> Result<()> {
     );
     let force = args.force;
     let statuses = run_all(&runs, &opts, |spec, dir, progress| {
-        let _ = (spec, dir, progress, force);
-        Err("trainer not merged yet".to_string())
+        train_run(spec, dir, progress, force).map_err(|e| e.to_string())
     });
     let failed = statuses
         .iter()

@@ -9,35 +9,62 @@ use crate::algos::cond_argmax::{cond_argmax_rows, unravel_component, CondArgmaxE
 use crate::algos::method::{DecTargetAction, Method};
 use crate::algos::record::Layout;
 use crate::algos::replay::Batch;
-use crate::algos::squeeze::{joint_rows_of_agent, squeeze_agent, squeeze_joint, AgentView, JointView};
+use crate::algos::squeeze::{
+    joint_rows_of_agent, squeeze_agent, squeeze_joint, AgentView, JointView,
+};
 use crate::algos::ReplayError;
-use crate::autograd::Tape;
-use crate::nn::{Adam, QNet};
-use ndarray::{Array2, Array3};
+use crate::autograd::SeqPacking;
+use crate::nn::{flatten_padded, Adam, AdamConfig, QNet, TdBatch, Updater};
+use ndarray::{Array1, Array2, Array3};
 use serde::{Deserialize, Serialize};
 
 /// A policy net, its target copy and its optimizer.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Serialize, Deserialize)]
 pub struct Nets {
     pub policy: QNet,
     pub target: QNet,
     pub adam: Adam,
+    /// Reusable tape and gradient buffers (rebuilt after a resume).
+    #[serde(skip)]
+    updater: Option<Updater>,
+}
+
+impl Clone for Nets {
+    fn clone(&self) -> Self {
+        Nets {
+            policy: self.policy.clone(),
+            target: self.target.clone(),
+            adam: self.adam.clone(),
+            updater: None,
+        }
+    }
 }
 
 impl Nets {
     /// Target = policy at the start (spec 2.2).
     pub fn new(policy: QNet, l_rate: f64) -> Self {
-        let adam = Adam::new(&policy, l_rate as f32);
+        let adam = Adam::new(AdamConfig::with_lr(l_rate), &policy.params);
         Nets {
             target: policy.clone(),
             policy,
             adam,
+            updater: None,
         }
     }
 
     /// Hard target update (spec 2.4).
     pub fn sync_target(&mut self) {
-        self.target.copy_params_from(&self.policy);
+        self.target.copy_from(&self.policy);
+    }
+
+    /// Whether every parameter is a finite number.
+    pub fn is_finite(&self) -> bool {
+        use crate::nn::Params;
+        self.policy
+            .params
+            .slices()
+            .iter()
+            .all(|s| s.iter().all(|v| v.is_finite()))
     }
 }
 
@@ -70,8 +97,7 @@ pub fn train_iteration(
     cen: Option<&mut Nets>,
     dec_batch: &Batch<'_>,
     cen_batch: &Batch<'_>,
-    tape: &mut Tape,
-) -> Result<IterationLoss, ReplayError> {
+) -> Result<IterationLoss, UpdateError> {
     let mut loss = IterationLoss::default();
     let n_actions = layout.n_actions();
     // Step A and B.
@@ -81,11 +107,26 @@ pub fn train_iteration(
         if joint.is_empty() {
             return Ok(loss); // Q9: the learner returns at once.
         }
-        let qn = cen.policy.forward_infer(&joint.next_inputs, &joint.lengths);
-        let qt = cen.target.forward_infer(&joint.next_inputs, &joint.lengths);
+        let qn = cen
+            .policy
+            .forward_nograd_padded(joint.next_inputs.view(), &joint.lengths);
+        let qt = cen
+            .target
+            .forward_nograd_padded(joint.next_inputs.view(), &joint.lengths);
         let y = cen_targets(&joint, &qn, &qt, n_actions, p.discount)?;
-        let h = if p.method.cen_loss_is_hysteretic() { p.h } else { 1.0 };
-        loss.total += td_step(cen, tape, &joint.inputs, &joint.lengths, &joint.joint_actions, &y, h);
+        let h = if p.method.cen_loss_is_hysteretic() {
+            p.h
+        } else {
+            1.0
+        };
+        loss.total += td_step(
+            cen,
+            &joint.inputs,
+            &joint.lengths,
+            &joint.joint_actions,
+            &y,
+            h,
+        );
         loss.steps += 1;
         if p.method.dec_target_action() == Some(DecTargetAction::CenCondArgmax) {
             let view = if p.method == Method::Our2 {
@@ -97,7 +138,9 @@ pub fn train_iteration(
                 return Ok(loss);
             }
             // Q2: the selection uses the centralized net right after its own step.
-            let qn2 = cen.policy.forward_infer(&view.next_inputs, &view.lengths);
+            let qn2 = cen
+                .policy
+                .forward_nograd_padded(view.next_inputs.view(), &view.lengths);
             let star = cond_argmax_rows(qn2.view(), n_actions, &view.cond)?;
             joint_star = Some((view, star));
         }
@@ -116,12 +159,17 @@ pub fn train_iteration(
         if view.is_empty() {
             continue;
         }
-        let own_qn = (rule == DecTargetAction::OwnDoubleQ)
-            .then(|| nets.policy.forward_infer(&view.next_inputs, &view.lengths));
-        let a_star = dec_target_actions(rule, agent, n_actions, joint_star.as_ref(), own_qn.as_ref());
-        let qt = nets.target.forward_infer(&view.next_inputs, &view.lengths);
+        let own_qn = (rule == DecTargetAction::OwnDoubleQ).then(|| {
+            nets.policy
+                .forward_nograd_padded(view.next_inputs.view(), &view.lengths)
+        });
+        let a_star =
+            dec_target_actions(rule, agent, n_actions, joint_star.as_ref(), own_qn.as_ref());
+        let qt = nets
+            .target
+            .forward_nograd_padded(view.next_inputs.view(), &view.lengths);
         let y = targets(&view.rewards, &view.dones, &qt, &a_star, p.discount);
-        loss.total += td_step(nets, tape, &view.inputs, &view.lengths, &view.actions, &y, p.h);
+        loss.total += td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, p.h);
         loss.steps += 1;
     }
     Ok(loss)
@@ -137,7 +185,13 @@ pub fn cen_targets(
     gamma: f32,
 ) -> Result<Vec<f32>, CondArgmaxError> {
     let a_star = cond_argmax_rows(q_next_online.view(), n_actions, &joint.cond)?;
-    Ok(targets(&joint.rewards, &joint.dones, q_next_target, &a_star, gamma))
+    Ok(targets(
+        &joint.rewards,
+        &joint.dones,
+        q_next_target,
+        &a_star,
+        gamma,
+    ))
 }
 
 /// The action each of agent `agent`'s records bootstraps from: its component of the centralized
@@ -159,12 +213,20 @@ pub fn dec_target_actions(
                 .map(|&k| unravel_component(star[k], n_actions, agent))
                 .collect()
         }
-        DecTargetAction::OwnDoubleQ => row_argmax(own_q_next.expect("own next Q-values were computed")),
+        DecTargetAction::OwnDoubleQ => {
+            row_argmax(own_q_next.expect("own next Q-values were computed"))
+        }
     }
 }
 
 /// Double-Q targets y_k = r_k + gamma (1 - done_k) Q_target[k, a*_k] (detached; quirks Q5, Q7).
-pub fn targets(rewards: &[f32], dones: &[f32], q_target: &Array2<f32>, a_star: &[usize], gamma: f32) -> Vec<f32> {
+pub fn targets(
+    rewards: &[f32],
+    dones: &[f32],
+    q_target: &Array2<f32>,
+    a_star: &[usize],
+    gamma: f32,
+) -> Vec<f32> {
     rewards
         .iter()
         .zip(dones)
@@ -178,7 +240,12 @@ pub fn targets(rewards: &[f32], dones: &[f32], q_target: &Array2<f32>, a_star: &
 pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
     q.rows()
         .into_iter()
-        .map(|row| crate::algos::acting::argmax(row.as_slice().expect("rows of a standard-layout array are contiguous")))
+        .map(|row| {
+            crate::algos::acting::argmax(
+                row.as_slice()
+                    .expect("rows of a standard-layout array are contiguous"),
+            )
+        })
         .collect()
 }
 
@@ -187,24 +254,30 @@ pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
 /// the mean runs over all kept records of the batch, quirk Q17). Returns the loss.
 fn td_step(
     nets: &mut Nets,
-    tape: &mut Tape,
     inputs: &Array3<f32>,
     lengths: &[usize],
     actions: &[usize],
     y: &[f32],
     h: f32,
 ) -> f64 {
-    tape.reset();
-    let (q, params) = nets.policy.forward_train(tape, inputs, lengths);
-    let q_taken = tape.gather(q, actions);
-    let y = tape.constant_column(y);
-    let delta = tape.sub(y, q_taken);
-    let delta = tape.leaky_relu(delta, h);
-    let sq = tape.square(delta);
-    let loss = tape.mean(sq);
-    let value = tape.scalar(loss) as f64;
-    tape.backward(loss);
-    let grads = nets.policy.gradients(tape, &params);
-    nets.adam.step(&mut nets.policy, &grads);
-    value
+    let updater = nets
+        .updater
+        .get_or_insert_with(|| Updater::new(&nets.policy));
+    let mut pool = crate::autograd::Pool::default();
+    let batch = TdBatch {
+        x: flatten_padded(inputs.view(), lengths, &mut pool),
+        packing: SeqPacking::new(lengths),
+        actions: actions.to_vec(),
+        targets: Array1::from(y.to_vec()),
+    };
+    updater.td_step(&mut nets.policy, &mut nets.adam, &batch, h) as f64
+}
+
+/// Why a training iteration failed.
+#[derive(Debug, thiserror::Error)]
+pub enum UpdateError {
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+    #[error(transparent)]
+    CondArgmax(#[from] CondArgmaxError),
 }

@@ -54,7 +54,7 @@ impl EnvSpec {
 }
 
 /// Any built domain. Each method is one `match`, so the trainer pays no dynamic dispatch.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub enum AnyEnv {
     BoxPushing(BoxPushing),
     Warehouse(Warehouse),

@@ -6,5 +6,5 @@ pub mod metrics;
 pub mod report;
 pub mod runner;
 pub mod seeds;
-// pub mod train_run;
 pub mod slurm;
+pub mod train_run;
