@@ -10,3 +10,4 @@ pub mod autograd;
 pub mod envs;
 pub mod experiment;
 pub mod nn;
+pub mod render;
