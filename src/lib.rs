@@ -12,3 +12,4 @@ pub mod envs;
 pub mod experiment;
 pub mod nn;
 pub mod plot;
+pub mod render;
