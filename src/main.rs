@@ -55,6 +55,21 @@ enum Command {
         #[arg(long, default_value = "plots")]
         out: PathBuf,
     },
+    /// Animate a trained run's greedy policy as a GIF.
+    Render {
+        /// A run directory: <results>/<experiment>/<method>/seed-<k>.
+        #[arg(long)]
+        run: PathBuf,
+        /// Episodes to show, one after another.
+        #[arg(long, default_value_t = 1)]
+        episodes: usize,
+        /// The GIF to write.
+        #[arg(long, default_value = "rollout.gif")]
+        out: PathBuf,
+        /// Milliseconds per primitive step.
+        #[arg(long, default_value_t = 150)]
+        frame_ms: u32,
+    },
     /// Write a Slurm job-array script (one task per run) to stdout.
     Slurm(SlurmArgs),
     /// Measure speed.
@@ -146,6 +161,21 @@ fn main() -> Result<()> {
         Command::Train(args) => train(args),
         Command::Replay { actions, verbose } => replay(&actions, verbose),
         Command::Slurm(args) => slurm(args),
+        Command::Render {
+            run,
+            episodes,
+            out,
+            frame_ms,
+        } => {
+            let returns = macdec::experiment::rollout::render_run(&run, episodes, &out, frame_ms)
+                .with_context(|| format!("rendering {}", run.display()))?;
+            eprintln!(
+                "wrote {} ({} episode(s), team returns {returns:?})",
+                out.display(),
+                returns.len()
+            );
+            Ok(())
+        }
         Command::Plot { results, out } => plot(&results, &out),
         Command::Demo { steps, seed } => demo_run(steps, seed),
         Command::Bench { what, iters } => match what {

@@ -238,6 +238,22 @@ impl Trainer {
         &self.config
     }
 
+    /// The method being trained.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// The run's seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The policy the paper evaluates for this method (spec 7.1): the decentralized nets, or the
+    /// centralized net for Cen-DDRQN. `dec` must be [`Self::dec_policies`].
+    pub fn greedy_policy<'a>(&'a self, dec: &'a [&'a QNet]) -> GreedyPolicy<'a> {
+        policy_of(self.method, dec, self.cen.as_ref())
+    }
+
     /// Completed training episodes.
     pub fn episodes(&self) -> u64 {
         self.episodes
@@ -492,16 +508,7 @@ impl Trainer {
     fn evaluate(&mut self) -> Result<(), TrainError> {
         let c = &self.config;
         let dec: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
-        let policy = match self.method {
-            Method::CenDdrqn => GreedyPolicy::Cen(
-                &self
-                    .cen
-                    .as_ref()
-                    .expect("Cen-DDRQN has a centralized net")
-                    .policy,
-            ),
-            _ => GreedyPolicy::Dec(&dec),
-        };
+        let policy = policy_of(self.method, &dec, self.cen.as_ref());
         let deterministic = c.env_name == EnvName::BoxPushing || c.tb_m_noisy == 0.0;
         let eval_return = evaluate(
             &mut self.eval_env,
@@ -525,6 +532,16 @@ impl Trainer {
             wall_seconds: self.wall_seconds(),
         });
         Ok(())
+    }
+}
+
+/// The evaluated policy of `method` (spec 7.1): Cen-DDRQN acts centrally, all others by agent.
+fn policy_of<'a>(method: Method, dec: &'a [&'a QNet], cen: Option<&'a Nets>) -> GreedyPolicy<'a> {
+    match method {
+        Method::CenDdrqn => {
+            GreedyPolicy::Cen(&cen.expect("Cen-DDRQN has a centralized net").policy)
+        }
+        _ => GreedyPolicy::Dec(dec),
     }
 }
 

@@ -4,6 +4,7 @@ pub mod atomic;
 pub mod config;
 pub mod metrics;
 pub mod report;
+pub mod rollout;
 pub mod runner;
 pub mod seeds;
 pub mod slurm;
