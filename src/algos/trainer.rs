@@ -308,7 +308,9 @@ impl Trainer {
             }
             let finished = self.main_loop_iteration()?;
             if finished {
-                let due = self.episodes % self.config.checkpoint_freq as u64 == 0;
+                let due = self
+                    .episodes
+                    .is_multiple_of(self.config.checkpoint_freq as u64);
                 return Ok(Advance::Episode {
                     checkpoint_due: due,
                 });
@@ -329,12 +331,12 @@ impl Trainer {
         }
         if finished {
             self.episodes += 1;
-            if self.episodes % self.config.eval_freq as u64 == 0 {
+            if self.episodes.is_multiple_of(self.config.eval_freq as u64) {
                 self.evaluate()?;
             }
         }
         let c = self.config.clone();
-        if self.step % c.train_freq as u64 == 0 && self.episodes >= c.start_train as u64 {
+        if self.step.is_multiple_of(c.train_freq as u64) && self.episodes >= c.start_train as u64 {
             let e = self.episodes as f64;
             if c.dynamic_h {
                 self.h = HysteresisSchedule::new(c.init_h, c.end_h, c.h_stable_at as f64)
@@ -353,7 +355,10 @@ impl Trainer {
                 c.eps_end + (1.0 - c.eps_end) * (-((e / 8.0).floor()) / 2000.0).exp()
             };
         }
-        if self.step % self.config.target_update_freq as u64 == 0 {
+        if self
+            .step
+            .is_multiple_of(self.config.target_update_freq as u64)
+        {
             for n in self.dec.iter_mut().chain(self.cen.as_mut()) {
                 n.sync_target();
             }

@@ -142,23 +142,18 @@ pub fn train_run(
             run_rngs(spec.seed),
         )?
     };
-    loop {
-        match trainer.advance()? {
-            Advance::Episode { checkpoint_due } => {
-                progress.update(
-                    trainer.episodes(),
-                    format!(
-                        "eps {:.3} return {:.2}",
-                        trainer.epsilon(),
-                        trainer.evals().last().map_or(f64::NAN, |e| e.eval_return)
-                    ),
-                );
-                if checkpoint_due {
-                    save_metrics(dir, &trainer)?;
-                    save_checkpoint(&checkpoint, &mut trainer)?;
-                }
-            }
-            Advance::Finished => break,
+    while let Advance::Episode { checkpoint_due } = trainer.advance()? {
+        progress.update(
+            trainer.episodes(),
+            format!(
+                "eps {:.3} return {:.2}",
+                trainer.epsilon(),
+                trainer.evals().last().map_or(f64::NAN, |e| e.eval_return)
+            ),
+        );
+        if checkpoint_due {
+            save_metrics(dir, &trainer)?;
+            save_checkpoint(&checkpoint, &mut trainer)?;
         }
     }
     save_metrics(dir, &trainer)?;
