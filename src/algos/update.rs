@@ -281,3 +281,149 @@ pub enum UpdateError {
     #[error(transparent)]
     CondArgmax(#[from] CondArgmaxError),
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::record::{Episode, RecordRef};
+    use crate::algos::replay::Sequence;
+    use ndarray::array;
+
+    /// Two agents with one observation value and two macro-actions each. Step 0: agent 0 ran
+    /// macro-action 1 and finished, agent 1 (running 0) did not; step 1: both finished, terminal.
+    fn two_step_episode() -> (Layout, Episode) {
+        let layout = Layout::new(&[1, 1], &[2, 2]).unwrap();
+        let mut ep = Episode::new(2, 2, 2);
+        ep.push(RecordRef {
+            obs: &[0.1, 0.2],
+            executed: &[1, 0],
+            acc_id: &[-1.0, -1.0],
+            acc_joint: -1.0,
+            next_obs: &[0.3, 0.2],
+            done: false,
+            valid: &[true, false],
+        })
+        .unwrap();
+        ep.push(RecordRef {
+            obs: &[0.3, 0.2],
+            executed: &[0, 0],
+            acc_id: &[-1.0, -2.0],
+            acc_joint: -1.0,
+            next_obs: &[0.5, 0.6],
+            done: true,
+            valid: &[true, true],
+        })
+        .unwrap();
+        (layout, ep)
+    }
+
+    fn batch(ep: &Episode) -> Batch<'_> {
+        Batch {
+            sequences: vec![Sequence {
+                episode: ep,
+                start: 0,
+                end: 2,
+                lead_pad: 0,
+            }],
+            padded_len: 2,
+        }
+    }
+
+    /// Next-state Q of the centralized online net, joint index = 2 m_0 + m_1.
+    fn cen_q_next() -> Array2<f32> {
+        // Row 0: agent 1 is still running 0, so only (0,0)=5 and (1,0)=7 are allowed -> a* = 2
+        // although (1,1)=9 is larger. Row 1: both free -> plain argmax, (0,1)=3 -> a* = 1.
+        array![[5.0, 1.0, 7.0, 9.0], [1.0, 3.0, 2.0, 0.0]]
+    }
+
+    #[test]
+    fn centralized_target_uses_the_conditional_argmax() {
+        let (layout, ep) = two_step_episode();
+        let joint = squeeze_joint(&batch(&ep), &layout).unwrap();
+        assert_eq!(joint.cond, vec![-1, 0, -1, -1]);
+        assert_eq!(joint.joint_actions, vec![2, 0]);
+        let q_target = array![[10.0, 20.0, 30.0, 40.0], [1.0, 2.0, 3.0, 4.0]];
+        let y = cen_targets(&joint, &cen_q_next(), &q_target, layout.n_actions(), 0.9).unwrap();
+        // y_0 = r^c + gamma * Q^-[0, a*=2] = -1 + 0.9 * 30 = 26; y_1 is terminal: r^c = -1.
+        assert_eq!(y, vec![-1.0 + 0.9 * 30.0, -1.0]);
+    }
+
+    #[test]
+    fn our1_decentralized_target_takes_the_agents_component_of_the_joint_argmax() {
+        let (layout, ep) = two_step_episode();
+        let b = batch(&ep);
+        let joint = squeeze_joint(&b, &layout).unwrap();
+        let star = cond_argmax_rows(cen_q_next().view(), layout.n_actions(), &joint.cond).unwrap();
+        assert_eq!(star, vec![2, 1]);
+        let joint_star = (joint, star);
+        // Agent 0 finished at both steps: components of (1,0) and (0,1) -> 1 then 0.
+        let a0 = dec_target_actions(
+            DecTargetAction::CenCondArgmax,
+            0,
+            &[2, 2],
+            Some(&joint_star),
+            None,
+        );
+        assert_eq!(a0, vec![1, 0]);
+        // Agent 1 finished only at step 1: component of (0,1) -> 1.
+        let a1 = dec_target_actions(
+            DecTargetAction::CenCondArgmax,
+            1,
+            &[2, 2],
+            Some(&joint_star),
+            None,
+        );
+        assert_eq!(a1, vec![1]);
+        let view0 = squeeze_agent(&b, &layout, 0).unwrap();
+        let qt0 = array![[4.0, 8.0], [1.0, 1.0]];
+        // y = -1 + 0.9 * Q^-_0[0, 1] = 6.2; terminal -> -1.
+        assert_eq!(
+            targets(&view0.rewards, &view0.dones, &qt0, &a0, 0.9),
+            vec![-1.0 + 0.9 * 8.0, -1.0]
+        );
+        let view1 = squeeze_agent(&b, &layout, 1).unwrap();
+        // Agent 1's macro-reward sums both primitive steps (-2) and its only record is terminal.
+        assert_eq!(
+            targets(&view1.rewards, &view1.dones, &array![[5.0, 6.0]], &a1, 0.9),
+            vec![-2.0]
+        );
+    }
+
+    #[test]
+    fn dec_hddrqn_and_our1_r_targets_use_the_agents_own_double_q() {
+        let (layout, ep) = two_step_episode();
+        let view0 = squeeze_agent(&batch(&ep), &layout, 0).unwrap();
+        let own_next = array![[3.0, 1.0], [0.0, 2.0]];
+        let a0 = dec_target_actions(
+            DecTargetAction::OwnDoubleQ,
+            0,
+            &[2, 2],
+            None,
+            Some(&own_next),
+        );
+        assert_eq!(a0, vec![0, 1]);
+        let qt0 = array![[4.0, 8.0], [1.0, 1.0]];
+        // y = -1 + 0.9 * Q^-_0[0, 0] = 2.6 (Our-1 would bootstrap from 8 instead).
+        assert_eq!(
+            targets(&view0.rewards, &view0.dones, &qt0, &a0, 0.9),
+            vec![-1.0 + 0.9 * 4.0, -1.0]
+        );
+        assert_eq!(
+            Method::DecHddrqn.dec_target_action(),
+            Some(DecTargetAction::OwnDoubleQ)
+        );
+        assert_eq!(
+            Method::Our1R.dec_target_action(),
+            Some(DecTargetAction::OwnDoubleQ)
+        );
+        assert_eq!(
+            Method::Our2.dec_target_action(),
+            Some(DecTargetAction::CenCondArgmax)
+        );
+    }
+
+    #[test]
+    fn argmax_rows_take_the_first_maximum() {
+        assert_eq!(row_argmax(&array![[1.0, 1.0], [0.0, 2.0]]), vec![0, 1]);
+    }
+}
