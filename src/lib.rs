@@ -7,7 +7,10 @@
 
 pub mod algos;
 pub mod autograd;
+pub mod bench;
 pub mod deploy;
 pub mod envs;
 pub mod experiment;
 pub mod nn;
+pub mod plot;
+pub mod render;

@@ -3,10 +3,13 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use macdec::algos::method::Method;
+use macdec::bench::nets;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
-//TMP use macdec::experiment::train_run::train_run;
+use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
+use macdec::experiment::train_run::train_run;
+use macdec::nn::demo;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -23,6 +26,15 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The learning engine on a toy memory task: an LSTM Q-net learns delayed recall.
+    Demo {
+        /// Number of Adam steps.
+        #[arg(long, default_value_t = demo::DemoConfig::default().steps)]
+        steps: usize,
+        /// Seed of the run.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
     /// Train methods on an experiment config, one run per (method, variant, seed), in parallel.
     Train(TrainArgs),
     /// Replay a macro-action log and print the trajectory as JSON lines.
@@ -34,6 +46,32 @@ enum Command {
         #[arg(long)]
         verbose: bool,
     },
+    /// Draw every experiment's learning curves (PNG + SVG) and summary tables from a results tree.
+    Plot {
+        /// Results root: <results>/<experiment>/<curve>/seed-<k>/metrics.csv.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        /// Where the figures and <experiment>_summary.csv files go.
+        #[arg(long, default_value = "plots")]
+        out: PathBuf,
+    },
+    /// Animate a trained run's greedy policy as a GIF.
+    Render {
+        /// A run directory: <results>/<experiment>/<method>/seed-<k>.
+        #[arg(long)]
+        run: PathBuf,
+        /// Episodes to show, one after another.
+        #[arg(long, default_value_t = 1)]
+        episodes: usize,
+        /// The GIF to write.
+        #[arg(long, default_value = "rollout.gif")]
+        out: PathBuf,
+        /// Milliseconds per primitive step.
+        #[arg(long, default_value_t = 150)]
+        frame_ms: u32,
+    },
+    /// Write a Slurm job-array script (one task per run) to stdout.
+    Slurm(SlurmArgs),
     /// Serve one agent of an exported policy to a robot: JSON lines on stdin/stdout, or over TCP
     /// with --listen (one hidden state per connection). See README "Exporting and running a policy".
     Robot(RobotArgs),
@@ -44,6 +82,9 @@ enum Command {
     Bench {
         /// What to measure.
         what: BenchTarget,
+        /// Timed iterations per configuration (nets).
+        #[arg(long, default_value_t = 200)]
+        iters: usize,
     },
 }
 
@@ -51,6 +92,8 @@ enum Command {
 enum BenchTarget {
     /// Environment primitive steps per second with random macro-actions (single thread).
     Envs,
+    /// One Q-net training update (forward, backward, Adam) at the paper's shapes, 1 thread.
+    Nets,
 }
 
 #[derive(clap::Args)]
@@ -79,6 +122,44 @@ struct TrainArgs {
     /// No progress bars; one line per finished run.
     #[arg(long)]
     quiet: bool,
+    /// Run only the run with this index in the experiment's run list (Slurm array tasks).
+    #[arg(long)]
+    run_index: Option<usize>,
+}
+
+/// Which runs of an experiment, as `train` and `slurm` both select them.
+#[derive(clap::Args)]
+struct Selection {
+    /// Experiment TOML (see experiments/).
+    #[arg(long)]
+    config: PathBuf,
+    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
+    #[arg(long, value_delimiter = ',')]
+    methods: Option<Vec<String>>,
+    /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
+    #[arg(long)]
+    seeds: Option<String>,
+    /// Override a config key, e.g. total_epi=300 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(clap::Args)]
+struct SlurmArgs {
+    #[command(flatten)]
+    select: Selection,
+    /// Results root shared by the cluster's nodes.
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+    /// Wall-clock limit per array task.
+    #[arg(long, default_value = "12:00:00")]
+    time: String,
+    /// Memory per array task.
+    #[arg(long, default_value = "4G")]
+    mem: String,
+    /// Extra #SBATCH lines, e.g. --sbatch=--partition=cpu (repeatable).
+    #[arg(long = "sbatch", value_name = "LINE", allow_hyphen_values = true)]
+    sbatch: Vec<String>,
 }
 
 #[derive(clap::Args)]
@@ -139,28 +220,40 @@ fn main() -> Result<()> {
         Command::Replay { actions, verbose } => replay(&actions, verbose),
         Command::Robot(args) => robot(args),
         Command::Deploy(args) => deploy(args),
-        Command::Bench { what } => match what {
+        Command::Slurm(args) => slurm(args),
+        Command::Render {
+            run,
+            episodes,
+            out,
+            frame_ms,
+        } => {
+            let returns = macdec::experiment::rollout::render_run(&run, episodes, &out, frame_ms)
+                .with_context(|| format!("rendering {}", run.display()))?;
+            eprintln!(
+                "wrote {} ({} episode(s), team returns {returns:?})",
+                out.display(),
+                returns.len()
+            );
+            Ok(())
+        }
+        Command::Plot { results, out } => plot(&results, &out),
+        Command::Demo { steps, seed } => demo_run(steps, seed),
+        Command::Bench { what, iters } => match what {
             BenchTarget::Envs => bench_envs(),
+            BenchTarget::Nets => {
+                let results: Vec<_> = nets::SHAPES
+                    .iter()
+                    .map(|shape| nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)))
+                    .collect();
+                print!("{}", nets::format_table(&results));
+                Ok(())
+            }
         },
     }
 }
 
 fn train(args: TrainArgs) -> Result<()> {
-    let methods = args
-        .methods
-        .map(|names| {
-            names
-                .iter()
-                .map(|n| n.parse::<Method>())
-                .collect::<Result<Vec<_>, _>>()
-        })
-        .transpose()?;
-    let seeds = args.seeds.as_deref().map(parse_seeds).transpose()?;
-    let overrides = Overrides {
-        methods,
-        seeds,
-        set: args.set,
-    };
+    let overrides = overrides(args.methods, args.seeds.as_deref(), args.set)?;
     let experiment = match &args.config {
         Some(path) => Experiment::load(path, &overrides)
             .with_context(|| format!("loading {}", path.display()))?,
@@ -171,7 +264,17 @@ fn train(args: TrainArgs) -> Result<()> {
             &overrides,
         )?,
     };
-    let runs = experiment.runs()?;
+    let mut runs = experiment.runs()?;
+    if let Some(i) = args.run_index {
+        if i >= runs.len() {
+            bail!(
+                "--run-index {i}: the experiment has {} runs (0..{})",
+                runs.len(),
+                runs.len()
+            );
+        }
+        runs = vec![runs.swap_remove(i)];
+    }
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -192,8 +295,7 @@ fn train(args: TrainArgs) -> Result<()> {
     );
     let force = args.force;
     let statuses = run_all(&runs, &opts, |spec, dir, progress| {
-        let _ = (spec, dir, progress, force);
-        Err("trainer not merged yet".to_string())
+        train_run(spec, dir, progress, force).map_err(|e| e.to_string())
     });
     let failed = statuses
         .iter()
@@ -210,6 +312,108 @@ fn train(args: TrainArgs) -> Result<()> {
     if failed > 0 {
         bail!("{failed} of {} run(s) failed", runs.len());
     }
+    Ok(())
+}
+
+fn overrides(
+    methods: Option<Vec<String>>,
+    seeds: Option<&str>,
+    set: Vec<String>,
+) -> Result<Overrides> {
+    let methods = methods
+        .map(|names| {
+            names
+                .iter()
+                .map(|n| n.parse::<Method>())
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .transpose()?;
+    let seeds = seeds.map(parse_seeds).transpose()?;
+    Ok(Overrides {
+        methods,
+        seeds,
+        set,
+    })
+}
+
+fn slurm(args: SlurmArgs) -> Result<()> {
+    let sel = args.select;
+    let mut train_args = Vec::new();
+    if let Some(m) = &sel.methods {
+        train_args.extend(["--methods".to_string(), shell_quote(&m.join(","))]);
+    }
+    if let Some(s) = &sel.seeds {
+        train_args.extend(["--seeds".to_string(), shell_quote(s)]);
+    }
+    for item in &sel.set {
+        train_args.extend(["--set".to_string(), shell_quote(item)]);
+    }
+    let o = overrides(sel.methods, sel.seeds.as_deref(), sel.set)?;
+    let experiment = Experiment::load(&sel.config, &o)
+        .with_context(|| format!("loading {}", sel.config.display()))?;
+    let labels: Vec<String> = experiment
+        .runs()?
+        .iter()
+        .map(|r| format!("{}/seed-{}", r.curve_name(), r.seed))
+        .collect();
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let config = absolute(&sel.config);
+    let out = absolute(&args.out);
+    let binary = std::env::current_exe().context("locating the macdec binary")?;
+    let script = job_script(
+        &experiment.name,
+        &labels,
+        &SlurmOptions {
+            config: &config,
+            out: &out,
+            binary: &binary,
+            train_args,
+            time: &args.time,
+            mem: &args.mem,
+            extra_sbatch: args.sbatch,
+        },
+    );
+    print!("{script}");
+    Ok(())
+}
+
+fn demo_run(steps: usize, seed: u64) -> Result<()> {
+    let cfg = demo::DemoConfig {
+        steps,
+        seed,
+        ..demo::DemoConfig::default()
+    };
+    println!(
+        "delayed recall with an LSTM Q-net: {} steps, batch {}, seed {} \
+         (a net without memory cannot go below {:.4})",
+        cfg.steps,
+        cfg.batch,
+        cfg.seed,
+        demo::MEMORYLESS_LOSS
+    );
+    let t0 = std::time::Instant::now();
+    demo::run(&cfg, |step, loss| {
+        println!("step {step:>6}  loss {loss:.5}")
+    })?;
+    println!("done in {:.1} s", t0.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn plot(results: &Path, out: &Path) -> Result<()> {
+    let report = macdec::plot::plot_results(results, out)
+        .with_context(|| format!("plotting {} into {}", results.display(), out.display()))?;
+    for note in &report.notes {
+        eprintln!("{note}");
+    }
+    for p in &report.plots {
+        eprintln!(
+            "wrote {}, {}, {}",
+            p.png.display(),
+            p.svg.display(),
+            p.summary_csv.display()
+        );
+    }
+    print!("{}", report.markdown());
     Ok(())
 }
 

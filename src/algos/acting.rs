@@ -4,6 +4,7 @@
 use crate::algos::cond_argmax::{cond_argmax, unravel};
 use crate::envs::MacroEnv;
 use crate::nn::{LstmState, QNet};
+use ndarray::ArrayView1;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
@@ -31,22 +32,13 @@ pub fn argmax(q: &[f32]) -> usize {
 /// Scratch space for one acting lane, so selection allocates nothing per step.
 #[derive(Debug, Clone)]
 pub struct ActScratch {
-    q: Vec<f32>,
     joint_obs: Vec<f32>,
     cond: Vec<i32>,
 }
 
 impl ActScratch {
     pub fn new<E: MacroEnv + ?Sized>(env: &E) -> Self {
-        let widest = env
-            .n_actions()
-            .iter()
-            .copied()
-            .max()
-            .unwrap_or(0)
-            .max(env.n_joint_actions());
         ActScratch {
-            q: vec![0.0; widest],
             joint_obs: vec![0.0; env.joint_obs_size()],
             cond: vec![-1; env.n_agents()],
         }
@@ -60,7 +52,6 @@ pub fn select_dec<E: MacroEnv + ?Sized>(
     nets: &[&QNet],
     states: &mut [LstmState],
     mut explore: Option<Explore<'_>>,
-    scratch: &mut ActScratch,
     actions: &mut [usize],
 ) {
     for agent in 0..env.n_agents() {
@@ -68,13 +59,17 @@ pub fn select_dec<E: MacroEnv + ?Sized>(
             continue;
         }
         let n = env.n_actions()[agent];
-        let q = &mut scratch.q[..n];
         let state = &mut states[agent];
-        if matches!(explore, Some(Explore { carry_state: false, .. })) {
+        if matches!(
+            explore,
+            Some(Explore {
+                carry_state: false,
+                ..
+            })
+        ) {
             state.reset();
         }
-        nets[agent].act(env.obs(agent), state, q);
-        let mut a = argmax(q);
+        let mut a = argmax(nets[agent].act_step(env.obs(agent), state));
         if let Some(e) = explore.as_mut() {
             if e.rng.gen::<f64>() < e.epsilon {
                 a = e.rng.gen_range(0..n);
@@ -101,16 +96,26 @@ pub fn select_cen<E: MacroEnv + ?Sized>(
         return;
     }
     env.write_joint_obs(&mut scratch.joint_obs);
-    if matches!(explore, Some(Explore { carry_state: false, .. })) {
+    if matches!(
+        explore,
+        Some(Explore {
+            carry_state: false,
+            ..
+        })
+    ) {
         state.reset();
     }
     let n_joint = env.n_joint_actions();
-    let q = &mut scratch.q[..n_joint];
-    net.act(&scratch.joint_obs, state, q);
     for (i, c) in scratch.cond.iter_mut().enumerate() {
-        *c = if env.is_free(i) { -1 } else { env.executed()[i] as i32 };
+        *c = if env.is_free(i) {
+            -1
+        } else {
+            env.executed()[i] as i32
+        };
     }
-    let mut joint = cond_argmax(q, env.n_actions(), &scratch.cond);
+    let q = net.act_step(&scratch.joint_obs, state);
+    let mut joint = cond_argmax(ArrayView1::from(q), env.n_actions(), &scratch.cond)
+        .expect("the centralized net's output matches the env's joint action space");
     if let Some(e) = explore.as_mut() {
         if e.rng.gen::<f64>() < e.epsilon {
             joint = e.rng.gen_range(0..n_joint);

@@ -65,7 +65,7 @@ impl<'a> GreedyActor<'a> {
         actions: &mut [usize],
     ) {
         match self {
-            GreedyActor::Dec(nets, states) => select_dec(env, nets, states, None, scratch, actions),
+            GreedyActor::Dec(nets, states) => select_dec(env, nets, states, None, actions),
             GreedyActor::Cen(net, state) => select_cen(env, net, state, None, scratch, actions),
         }
     }

@@ -33,7 +33,7 @@ pub enum DecTargetAction {
 }
 
 /// How the training environment(s) pick actions (spec 4.6).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Exploration {
     /// Each agent epsilon-greedy on its own net (spec 4.2).
     Decentralized,

@@ -8,10 +8,10 @@
 //! under the conditioning of busy agents (spec 4.5); [`schedule`] gives epsilon and the hysteresis
 //! value from the episode count (spec 4.1, 5.6).
 
-// pub mod acting;
+pub mod acting;
 pub mod cond_argmax;
 pub mod episode_buffer;
-// pub mod evaluate;
+pub mod evaluate;
 pub mod hyper;
 pub mod method;
 pub mod record;
@@ -19,8 +19,8 @@ pub mod recorder;
 pub mod replay;
 pub mod schedule;
 pub mod squeeze;
-// pub mod trainer;
-// pub mod update;
+pub mod trainer;
+pub mod update;
 pub mod window_buffer;
 
 /// Why a record, an episode, a buffer or a squeeze request was refused. Messages name the

@@ -13,9 +13,8 @@ use crate::algos::record::Layout;
 use crate::algos::recorder::{FirstRecordObs, Recorder};
 use crate::algos::replay::ReplayBuffer;
 use crate::algos::schedule::{EpsilonSchedule, HysteresisSchedule};
-use crate::algos::update::{train_iteration, IterationParams, Nets};
+use crate::algos::update::{train_iteration, IterationParams, Nets, UpdateError};
 use crate::algos::ReplayError;
-use crate::autograd::Tape;
 use crate::envs::{AnyEnv, EnvError, EnvRng, EnvSpec, MacroEnv};
 use crate::nn::{LstmState, QNet, QNetConfig};
 use rand_chacha::ChaCha8Rng;
@@ -39,6 +38,8 @@ pub enum TrainError {
     Env(#[from] EnvError),
     #[error(transparent)]
     Replay(#[from] ReplayError),
+    #[error(transparent)]
+    Update(#[from] UpdateError),
     #[error("{method} seed {seed}: non-finite {what} at episode {episode}")]
     NonFinite {
         method: Method,
@@ -57,7 +58,7 @@ struct Lane {
     recorder: Recorder,
     buffer: ReplayBuffer,
     dec_states: Vec<LstmState>,
-    cen_state: LstmState,
+    cen_state: Option<LstmState>,
     actions: Vec<usize>,
     discarded: Vec<usize>,
     #[serde(skip, default)]
@@ -116,8 +117,6 @@ pub struct Trainer {
     elapsed_before: f64,
     #[serde(skip, default)]
     segment_start: Option<std::time::Instant>,
-    #[serde(skip, default)]
-    tape: Tape,
 }
 
 /// The environment a config describes.
@@ -136,7 +135,12 @@ pub fn env_spec(c: &RunConfig) -> EnvSpec {
 
 impl Trainer {
     /// Build nets, envs and buffers for `method` with seed `seed` (spec 2.2, 6).
-    pub fn new(config: RunConfig, method: Method, seed: u64, mut rngs: RunRngs) -> Result<Self, TrainError> {
+    pub fn new(
+        config: RunConfig,
+        method: Method,
+        seed: u64,
+        mut rngs: RunRngs,
+    ) -> Result<Self, TrainError> {
         let spec = env_spec(&config);
         let eval_env = spec.build()?;
         let layout = Layout::of_env(&eval_env)?;
@@ -185,7 +189,7 @@ impl Trainer {
             };
             Ok(Lane {
                 dec_states: dec_zero_states(&dec),
-                cen_state: cen.as_ref().map(|c| c.policy.zero_state()).unwrap_or_default(),
+                cen_state: cen.as_ref().map(|c| c.policy.zero_state()),
                 actions: vec![0; layout.n_agents()],
                 discarded: vec![0; layout.n_agents()],
                 scratch: None,
@@ -226,13 +230,28 @@ impl Trainer {
             evals: Vec::new(),
             elapsed_before: 0.0,
             segment_start: None,
-            tape: Tape::new(),
         })
     }
 
     /// The run's configuration.
     pub fn config(&self) -> &RunConfig {
         &self.config
+    }
+
+    /// The method being trained.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// The run's seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The policy the paper evaluates for this method (spec 7.1): the decentralized nets, or the
+    /// centralized net for Cen-DDRQN. `dec` must be [`Self::dec_policies`].
+    pub fn greedy_policy<'a>(&'a self, dec: &'a [&'a QNet]) -> GreedyPolicy<'a> {
+        policy_of(self.method, dec, self.cen.as_ref())
     }
 
     /// Completed training episodes.
@@ -262,7 +281,10 @@ impl Trainer {
 
     /// Wall-clock seconds this run has trained, over all segments.
     pub fn wall_seconds(&self) -> f64 {
-        self.elapsed_before + self.segment_start.map_or(0.0, |t| t.elapsed().as_secs_f64())
+        self.elapsed_before
+            + self
+                .segment_start
+                .map_or(0.0, |t| t.elapsed().as_secs_f64())
     }
 
     /// Fold the running segment's time into the saved total (call before checkpointing).
@@ -278,15 +300,20 @@ impl Trainer {
 
     /// Run main-loop iterations until a training episode finishes or training is complete.
     pub fn advance(&mut self) -> Result<Advance, TrainError> {
-        self.segment_start.get_or_insert_with(std::time::Instant::now);
+        self.segment_start
+            .get_or_insert_with(std::time::Instant::now);
         loop {
             if self.is_finished() {
                 return Ok(Advance::Finished);
             }
             let finished = self.main_loop_iteration()?;
             if finished {
-                let due = self.episodes % self.config.checkpoint_freq as u64 == 0;
-                return Ok(Advance::Episode { checkpoint_due: due });
+                let due = self
+                    .episodes
+                    .is_multiple_of(self.config.checkpoint_freq as u64);
+                return Ok(Advance::Episode {
+                    checkpoint_due: due,
+                });
             }
         }
     }
@@ -304,12 +331,12 @@ impl Trainer {
         }
         if finished {
             self.episodes += 1;
-            if self.episodes % self.config.eval_freq as u64 == 0 {
+            if self.episodes.is_multiple_of(self.config.eval_freq as u64) {
                 self.evaluate()?;
             }
         }
-        let c = &self.config;
-        if self.step % c.train_freq as u64 == 0 && self.episodes >= c.start_train as u64 {
+        let c = self.config.clone();
+        if self.step.is_multiple_of(c.train_freq as u64) && self.episodes >= c.start_train as u64 {
             let e = self.episodes as f64;
             if c.dynamic_h {
                 self.h = HysteresisSchedule::new(c.init_h, c.end_h, c.h_stable_at as f64)
@@ -328,7 +355,10 @@ impl Trainer {
                 c.eps_end + (1.0 - c.eps_end) * (-((e / 8.0).floor()) / 2000.0).exp()
             };
         }
-        if self.step % self.config.target_update_freq as u64 == 0 {
+        if self
+            .step
+            .is_multiple_of(self.config.target_update_freq as u64)
+        {
             for n in self.dec.iter_mut().chain(self.cen.as_mut()) {
                 n.sync_target();
             }
@@ -341,27 +371,70 @@ impl Trainer {
     /// that lane's buffer and the env resets. Returns whether the episode finished.
     fn step_lane(&mut self, cen_lane: bool) -> Result<bool, TrainError> {
         let lane = if cen_lane {
-            self.cen_lane.as_mut().expect("Our-2 has a centralized lane")
+            self.cen_lane
+                .as_mut()
+                .expect("Our-2 has a centralized lane")
         } else {
             &mut self.lane
         };
-        let scratch = lane.scratch.get_or_insert_with(|| ActScratch::new(&lane.env));
+        let scratch = lane
+            .scratch
+            .get_or_insert_with(|| ActScratch::new(&lane.env));
         let dec_nets: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
         let carry = self.config.h_explore;
         match lane.exploration {
             Exploration::Decentralized => {
-                let explore = Explore { rng: &mut self.rngs.explore, epsilon: self.epsilon, carry_state: carry };
-                select_dec(&lane.env, &dec_nets, &mut lane.dec_states, Some(explore), scratch, &mut lane.actions);
+                let explore = Explore {
+                    rng: &mut self.rngs.explore,
+                    epsilon: self.epsilon,
+                    carry_state: carry,
+                };
+                select_dec(
+                    &lane.env,
+                    &dec_nets,
+                    &mut lane.dec_states,
+                    Some(explore),
+                    &mut lane.actions,
+                );
             }
             Exploration::Centralized => {
                 if !dec_nets.is_empty() {
                     // Q12: Our-1 still runs (and discards) the decentralized selection.
-                    let explore = Explore { rng: &mut self.rngs.explore, epsilon: self.epsilon, carry_state: carry };
-                    select_dec(&lane.env, &dec_nets, &mut lane.dec_states, Some(explore), scratch, &mut lane.discarded);
+                    let explore = Explore {
+                        rng: &mut self.rngs.explore,
+                        epsilon: self.epsilon,
+                        carry_state: carry,
+                    };
+                    select_dec(
+                        &lane.env,
+                        &dec_nets,
+                        &mut lane.dec_states,
+                        Some(explore),
+                        &mut lane.discarded,
+                    );
                 }
-                let cen = &self.cen.as_ref().expect("centralized exploration needs the centralized net").policy;
-                let explore = Explore { rng: &mut self.rngs.explore, epsilon: self.epsilon, carry_state: carry };
-                select_cen(&lane.env, cen, &mut lane.cen_state, Some(explore), scratch, &mut lane.actions);
+                let cen = &self
+                    .cen
+                    .as_ref()
+                    .expect("centralized exploration needs the centralized net")
+                    .policy;
+                let explore = Explore {
+                    rng: &mut self.rngs.explore,
+                    epsilon: self.epsilon,
+                    carry_state: carry,
+                };
+                let state = lane
+                    .cen_state
+                    .as_mut()
+                    .expect("a centralized net has a state");
+                select_cen(
+                    &lane.env,
+                    cen,
+                    state,
+                    Some(explore),
+                    scratch,
+                    &mut lane.actions,
+                );
             }
             Exploration::Parallel => unreachable!("Our-2 is split into two lanes at construction"),
         }
@@ -377,7 +450,9 @@ impl Trainer {
         for s in lane.dec_states.iter_mut() {
             s.reset();
         }
-        lane.cen_state.reset();
+        if let Some(s) = lane.cen_state.as_mut() {
+            s.reset();
+        }
         Ok(!cen_lane)
     }
 
@@ -390,7 +465,10 @@ impl Trainer {
             h: self.h as f32,
             early_return_skips_all: c.early_return_skips_all,
         };
-        let dec_batch = self.lane.buffer.sample(c.batch_size, &mut self.rngs.replay)?;
+        let dec_batch = self
+            .lane
+            .buffer
+            .sample(c.batch_size, &mut self.rngs.replay)?;
         let cen_batch = match &self.cen_lane {
             Some(l) => Some(l.buffer.sample(c.batch_size, &mut self.rngs.replay)?),
             None => None,
@@ -402,13 +480,17 @@ impl Trainer {
             self.cen.as_mut(),
             &dec_batch,
             cen_batch.as_ref().unwrap_or(&dec_batch),
-            &mut self.tape,
         )?;
         self.updates += 1;
         if !loss.total.is_finite() {
             return Err(self.non_finite("loss"));
         }
-        if self.dec.iter().chain(self.cen.as_ref()).any(|n| !n.policy.is_finite()) {
+        if self
+            .dec
+            .iter()
+            .chain(self.cen.as_ref())
+            .any(|n| !n.is_finite())
+        {
             return Err(self.non_finite("parameter"));
         }
         if loss.steps > 0 {
@@ -431,10 +513,7 @@ impl Trainer {
     fn evaluate(&mut self) -> Result<(), TrainError> {
         let c = &self.config;
         let dec: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
-        let policy = match self.method {
-            Method::CenDdrqn => GreedyPolicy::Cen(&self.cen.as_ref().expect("Cen-DDRQN has a centralized net").policy),
-            _ => GreedyPolicy::Dec(&dec),
-        };
+        let policy = policy_of(self.method, &dec, self.cen.as_ref());
         let deterministic = c.env_name == EnvName::BoxPushing || c.tb_m_noisy == 0.0;
         let eval_return = evaluate(
             &mut self.eval_env,
@@ -458,6 +537,16 @@ impl Trainer {
             wall_seconds: self.wall_seconds(),
         });
         Ok(())
+    }
+}
+
+/// The evaluated policy of `method` (spec 7.1): Cen-DDRQN acts centrally, all others by agent.
+fn policy_of<'a>(method: Method, dec: &'a [&'a QNet], cen: Option<&'a Nets>) -> GreedyPolicy<'a> {
+    match method {
+        Method::CenDdrqn => {
+            GreedyPolicy::Cen(&cen.expect("Cen-DDRQN has a centralized net").policy)
+        }
+        _ => GreedyPolicy::Dec(dec),
     }
 }
 

@@ -54,7 +54,11 @@ impl EnvSpec {
 }
 
 /// Any built domain. Each method is one `match`, so the trainer pays no dynamic dispatch.
-#[derive(Debug, Clone)]
+///
+/// The variants differ in size (Warehouse is larger); a run holds one `AnyEnv`, so boxing would
+/// only add a pointer chase to every step of the hot loop.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub enum AnyEnv {
     BoxPushing(BoxPushing),
     Warehouse(Warehouse),

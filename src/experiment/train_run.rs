@@ -101,7 +101,12 @@ fn save_metrics(dir: &Path, trainer: &Trainer) -> Result<(), RunError> {
 
 /// Train one run to completion in `dir`, resuming from its checkpoint if there is one.
 /// With `force`, an existing run in `dir` is discarded first.
-pub fn train_run(spec: &RunSpec, dir: &Path, progress: &Progress, force: bool) -> Result<(), RunError> {
+pub fn train_run(
+    spec: &RunSpec,
+    dir: &Path,
+    progress: &Progress,
+    force: bool,
+) -> Result<(), RunError> {
     if force && dir.exists() {
         std::fs::remove_dir_all(dir).map_err(|e| io(dir, e))?;
     }
@@ -118,7 +123,9 @@ pub fn train_run(spec: &RunSpec, dir: &Path, progress: &Progress, force: bool) -
         let text = std::fs::read_to_string(&config_path).map_err(|e| io(&config_path, e))?;
         let existing: Result<RunManifest, _> = toml::from_str(&text);
         if existing.ok().as_ref() != Some(&manifest) {
-            return Err(RunError::ConfigMismatch { dir: dir.to_path_buf() });
+            return Err(RunError::ConfigMismatch {
+                dir: dir.to_path_buf(),
+            });
         }
     } else {
         let text = toml::to_string(&manifest).map_err(|e| io(&config_path, e))?;
@@ -128,18 +135,25 @@ pub fn train_run(spec: &RunSpec, dir: &Path, progress: &Progress, force: bool) -
     let mut trainer = if checkpoint.exists() {
         load_checkpoint(&checkpoint)?
     } else {
-        Trainer::new(spec.config.clone(), spec.method, spec.seed, run_rngs(spec.seed))?
+        Trainer::new(
+            spec.config.clone(),
+            spec.method,
+            spec.seed,
+            run_rngs(spec.seed),
+        )?
     };
-    loop {
-        match trainer.advance()? {
-            Advance::Episode { checkpoint_due } => {
-                progress.update(trainer.episodes(), format!("eps {:.3} return {:.2}", trainer.epsilon(), trainer.evals().last().map_or(f64::NAN, |e| e.eval_return)));
-                if checkpoint_due {
-                    save_metrics(dir, &trainer)?;
-                    save_checkpoint(&checkpoint, &mut trainer)?;
-                }
-            }
-            Advance::Finished => break,
+    while let Advance::Episode { checkpoint_due } = trainer.advance()? {
+        progress.update(
+            trainer.episodes(),
+            format!(
+                "eps {:.3} return {:.2}",
+                trainer.epsilon(),
+                trainer.evals().last().map_or(f64::NAN, |e| e.eval_return)
+            ),
+        );
+        if checkpoint_due {
+            save_metrics(dir, &trainer)?;
+            save_checkpoint(&checkpoint, &mut trainer)?;
         }
     }
     save_metrics(dir, &trainer)?;

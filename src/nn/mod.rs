@@ -1,1 +1,26 @@
-//! Layers, the recurrent Q-net and Adam (filled in by issue 3).
+//! Layers, the reference's recurrent Q-net, Adam, and weight files, on top of `autograd`.
+//!
+//! - [`QNet`]: fc1 -> fc2 -> LSTM -> fc3 -> fc4 with leaky ReLU (spec `algorithms.md` 2.1),
+//!   run on a tape over a batch of sequences (training), without a tape (targets), or one step
+//!   at a time with an [`LstmState`] (acting).
+//! - [`Adam`]: PyTorch's Adam (spec 2.4); [`Updater::td_step`]: one full TD gradient step.
+//! - `safetensors_io`: weight files with PyTorch's state_dict names.
+
+mod adam;
+pub mod demo;
+pub mod init;
+mod linear;
+pub mod loss;
+mod lstm;
+mod params;
+mod qnet;
+pub mod safetensors_io;
+mod update;
+
+pub use adam::{Adam, AdamConfig};
+pub use linear::LinearVars;
+pub use lstm::LstmState;
+pub use params::{LinearParams, LstmParams, Params};
+pub use qnet::{flatten_padded, QNet, QNetConfig, QNetParams, QNetVars, TENSOR_NAMES};
+pub use safetensors_io::WeightsError;
+pub use update::{TdBatch, Updater};

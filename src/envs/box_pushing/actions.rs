@@ -13,7 +13,7 @@ pub const N_ACTIONS: usize = 8;
 pub const PUSH: usize = 4;
 
 /// A robot's macro-action. Indices 0..3 navigate to waypoint W0..W3 (spec 5.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum MacroAction {
     /// Move to waypoint `k` (0..=3), the cell below small box 0 / small box 1 / the big box's
     /// left / right half.

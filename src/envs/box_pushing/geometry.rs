@@ -6,7 +6,7 @@
 
 /// A grid cell `(col, row)`. Signed, because the Q2 "teleport" joint push may lift a robot above
 /// the top row (spec Q2), and a front cell may lie outside the grid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Cell {
     pub col: i32,
     pub row: i32,
@@ -46,7 +46,7 @@ impl Cell {
 
 /// A robot heading, in the reference's direction order (spec 1): 0 north, 1 east, 2 south,
 /// 3 west. The index also orders the planner's tie-break (spec 5.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[repr(u8)]
 pub enum Heading {
     North = 0,

@@ -7,7 +7,7 @@ use super::geometry::{Cell, Heading};
 /// These are the reference's formulas for ylen >= 8 (spec 2). They are written with N for both
 /// axes: the reference computes several x positions from ylen (Q9), which only matters on
 /// non-square grids, and those are not supported.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Layout {
     /// Grid side N (even, >= 8).
     pub n: i32,

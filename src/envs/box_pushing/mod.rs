@@ -40,7 +40,7 @@ pub const MAX_GRID: usize = 1 << 20;
 
 /// Delivery counters that persist across resets, as the reference keeps them (quirk Q14).
 /// Diagnostics only; they never affect the dynamics.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct DeliveryStats {
     /// Steps in which exactly one small box entered the goal row.
     pub single_small_box: u64,
@@ -55,7 +55,7 @@ pub struct DeliveryStats {
 /// unused by the paper, is not provided).
 ///
 /// Constructed in the reset state, so `step` may be called at once.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BoxPushing {
     layout: Layout,
     horizon: usize,

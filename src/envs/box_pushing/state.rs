@@ -4,7 +4,7 @@ use super::actions::MacroAction;
 use super::geometry::{Cell, Heading};
 
 /// One robot's physical and controller state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Robot {
     pub cell: Cell,
     pub heading: Heading,
@@ -33,7 +33,7 @@ impl Robot {
 
 /// The three boxes. Small boxes occupy one cell; the big box occupies its left cell and the cell to
 /// the east of it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Boxes {
     pub small: [Cell; 2],
     pub big_left: Cell,

@@ -5,7 +5,7 @@ use super::params::N_TOOLS;
 use super::turtlebot::{TbAction, Turtlebot};
 
 /// Fetch macro-actions (spec section 3). Index 0 Wait, 1..=2 Pass to Turtlebot 0/1, 3..=5 Search.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum FetchAction {
     /// Wait-M: one step.
     Wait,
@@ -37,7 +37,7 @@ impl FetchAction {
 }
 
 /// Durations and limits of the Fetch's actions, copied from the parameters once.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct FetchDynamics {
     /// Pass duration (4).
     pub pass_steps: f64,
@@ -58,7 +58,7 @@ impl FetchDynamics {
 }
 
 /// State of `AgentFetch_v4` (spec section 4).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Fetch {
     /// Current macro-action; None before the first step.
     pub cur: Option<FetchAction>,

@@ -2,7 +2,7 @@
 //! through `n_objs + 1` steps of fixed duration and needs tool k to leave work step k.
 
 /// State of `AgentHuman` (spec section 4).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Human {
     /// Current work step, 0..=n_objs.
     pub step_k: usize,

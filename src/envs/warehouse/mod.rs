@@ -56,7 +56,7 @@ const FETCH_ACTION_NAMES: [&str; 6] = [
 
 /// The Warehouse Tool Delivery environment. Build with [`Warehouse::new`] or
 /// [`Warehouse::paper`]; it starts reset.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Warehouse {
     params: WarehouseParams,
     tb_dyn: TbDynamics,

@@ -9,7 +9,7 @@ use super::pyround::round2;
 use crate::envs::EnvRng;
 
 /// Turtlebot macro-actions (spec section 3); the index is also the target waypoint's code.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TbAction {
     /// Go-to-WS: drive to the workshop waypoint (code 0) and offer the basket.
     GoWorkshop = 0,
@@ -24,7 +24,7 @@ impl TbAction {
 }
 
 /// Settings shared by both Turtlebots, copied from the parameters once.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct TbDynamics {
     /// Distance per primitive step (m), 0.6.
     pub speed: f64,
@@ -38,7 +38,7 @@ pub struct TbDynamics {
 }
 
 /// State of `AgentTurtlebot_v4` (spec section 4).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Turtlebot {
     /// Position (x, y) in m.
     pub pos: [f64; 2],

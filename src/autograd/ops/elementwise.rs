@@ -1,0 +1,240 @@
+//! Elementwise ops on same-shaped arrays: add, sub, mul, scale, sigmoid, tanh, leaky ReLU, square.
+
+use ndarray::{Array2, Zip};
+
+use super::{put, Op};
+use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace};
+use crate::autograd::tape::{GradCx, Tape, Var};
+
+impl Tape {
+    /// A copy of `x`'s value in a recycled buffer.
+    fn copy_of(&mut self, x: Var) -> Array2<f32> {
+        let (r, c) = self.shape(x);
+        let mut y = self.pool().array(r, c);
+        y.assign(&self.value(x));
+        y
+    }
+
+    /// y = f(a, b) elementwise; panics if the shapes differ.
+    fn binary(&mut self, a: Var, b: Var, what: &str, f: impl Fn(f32, f32) -> f32) -> Array2<f32> {
+        let shape = self.shape(a);
+        assert_eq!(shape, self.shape(b), "{what}: shapes differ");
+        let mut y = self.pool().array(shape.0, shape.1);
+        Zip::from(&mut y)
+            .and(&self.value(a))
+            .and(&self.value(b))
+            .for_each(|y, &a, &b| *y = f(a, b));
+        y
+    }
+
+    /// y = a + b (same shapes; see [`Tape::add_bias`] for broadcasting a row).
+    pub fn add(&mut self, a: Var, b: Var) -> Var {
+        let y = self.binary(a, b, "add", |a, b| a + b);
+        self.push_op(y, Op::Add { a, b }, &[a, b])
+    }
+
+    /// y = a - b (same shapes).
+    pub fn sub(&mut self, a: Var, b: Var) -> Var {
+        let y = self.binary(a, b, "sub", |a, b| a - b);
+        self.push_op(y, Op::Sub { a, b }, &[a, b])
+    }
+
+    /// y = a * b elementwise (same shapes).
+    pub fn mul(&mut self, a: Var, b: Var) -> Var {
+        let y = self.binary(a, b, "mul", |a, b| a * b);
+        self.push_op(y, Op::Mul { a, b }, &[a, b])
+    }
+
+    /// y = c * x for a constant c.
+    pub fn scale(&mut self, x: Var, c: f32) -> Var {
+        let mut y = self.copy_of(x);
+        y.mapv_inplace(|v| c * v);
+        self.push_op(y, Op::Scale { x, c }, &[x])
+    }
+
+    /// y = 1 / (1 + e^-x). Backward reuses the output: dy/dx = y (1 - y).
+    pub fn sigmoid(&mut self, x: Var) -> Var {
+        let mut y = self.copy_of(x);
+        sigmoid_inplace(y.as_slice_mut().expect("tape arrays are contiguous"));
+        self.push_op(y, Op::Sigmoid { x }, &[x])
+    }
+
+    /// y = tanh(x). Backward reuses the output: dy/dx = 1 - y^2.
+    pub fn tanh(&mut self, x: Var) -> Var {
+        let mut y = self.copy_of(x);
+        tanh_inplace(y.as_slice_mut().expect("tape arrays are contiguous"));
+        self.push_op(y, Op::Tanh { x }, &[x])
+    }
+
+    /// y = x for x > 0, slope * x otherwise. PyTorch's layers use slope 0.01; the hysteretic TD
+    /// transform max(h d, d) of spec `algorithms.md` 5 is exactly this op with slope h (h <= 1).
+    pub fn leaky_relu(&mut self, x: Var, slope: f32) -> Var {
+        let mut y = self.copy_of(x);
+        y.mapv_inplace(|v| if v > 0.0 { v } else { slope * v });
+        self.push_op(y, Op::LeakyRelu { x, slope }, &[x])
+    }
+
+    /// y = x^2 elementwise.
+    pub fn square(&mut self, x: Var) -> Var {
+        let mut y = self.copy_of(x);
+        y.mapv_inplace(|v| v * v);
+        self.push_op(y, Op::Square { x }, &[x])
+    }
+}
+
+// d(a + b) = da + db
+pub(super) fn add_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    for v in [a, b] {
+        if let Some((d, mode)) = cx.slot(v) {
+            put!(mode, d, g; |g| g);
+        }
+    }
+}
+
+// d(a - b) = da - db
+pub(super) fn sub_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(a) {
+        put!(mode, d, g; |g| g);
+    }
+    if let Some((d, mode)) = cx.slot(b) {
+        put!(mode, d, g; |g| -g);
+    }
+}
+
+// d(a * b) = b da + a db (a fan-out mul(x, x) gets both terms: 2 x dx)
+pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    let (va, vb) = (cx.value(a), cx.value(b));
+    if let Some((d, mode)) = cx.slot(a) {
+        put!(mode, d, g, vb; |g, b| g * b);
+    }
+    if let Some((d, mode)) = cx.slot(b) {
+        put!(mode, d, g, va; |g, a| g * a);
+    }
+}
+
+// d(c x) = c dx
+pub(super) fn scale_backward(x: Var, c: f32, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g; |g| c * g);
+    }
+}
+
+// dy/dx = y (1 - y)
+pub(super) fn sigmoid_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g, y; |g, y| g * y * (1.0 - y));
+    }
+}
+
+// dy/dx = 1 - y^2
+pub(super) fn tanh_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g, y; |g, y| g * (1.0 - y * y));
+    }
+}
+
+// dy/dx = 1 for x > 0, slope otherwise
+pub(super) fn leaky_relu_backward(x: Var, slope: f32, g: &Array2<f32>, cx: &mut GradCx) {
+    let vx = cx.value(x);
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g, vx; |g, x| if x > 0.0 { g } else { slope * g });
+    }
+}
+
+// dy/dx = 2 x
+pub(super) fn square_backward(x: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    let vx = cx.value(x);
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g, vx; |g, x| 2.0 * x * g);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::grad_check::{grad_check, Inputs};
+
+    #[test]
+    fn add_matches_finite_differences() {
+        grad_check(|t, v| t.add(v[0], v[1]), &[(3, 4), (3, 4)], Inputs::Any);
+    }
+
+    #[test]
+    fn add_fan_out_doubles_the_gradient() {
+        grad_check(|t, v| t.add(v[0], v[0]), &[(2, 5)], Inputs::Any);
+    }
+
+    #[test]
+    fn sub_matches_finite_differences() {
+        grad_check(|t, v| t.sub(v[0], v[1]), &[(4, 3), (4, 3)], Inputs::Any);
+    }
+
+    #[test]
+    fn mul_matches_finite_differences() {
+        grad_check(|t, v| t.mul(v[0], v[1]), &[(3, 5), (3, 5)], Inputs::Any);
+    }
+
+    #[test]
+    fn mul_fan_out_matches_finite_differences() {
+        // y = x * x: dy/dx = 2 x, both operand slots feed the same gradient.
+        grad_check(|t, v| t.mul(v[0], v[0]), &[(3, 3)], Inputs::Any);
+    }
+
+    #[test]
+    fn scale_matches_finite_differences() {
+        grad_check(|t, v| t.scale(v[0], -2.5), &[(2, 3)], Inputs::Any);
+    }
+
+    #[test]
+    fn sigmoid_matches_finite_differences() {
+        grad_check(|t, v| t.sigmoid(v[0]), &[(3, 4)], Inputs::Any);
+    }
+
+    #[test]
+    fn tanh_matches_finite_differences() {
+        grad_check(|t, v| t.tanh(v[0]), &[(3, 4)], Inputs::Any);
+    }
+
+    #[test]
+    fn tanh_fan_out_matches_finite_differences() {
+        grad_check(
+            |t, v| {
+                let y = t.tanh(v[0]);
+                t.mul(y, v[0])
+            },
+            &[(4, 2)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn leaky_relu_matches_finite_differences() {
+        grad_check(
+            |t, v| t.leaky_relu(v[0], 0.01),
+            &[(4, 5)],
+            Inputs::AwayFromZero,
+        );
+        grad_check(
+            |t, v| t.leaky_relu(v[0], 0.3),
+            &[(4, 5)],
+            Inputs::AwayFromZero,
+        );
+    }
+
+    #[test]
+    fn square_matches_finite_differences() {
+        grad_check(|t, v| t.square(v[0]), &[(3, 2)], Inputs::Any);
+    }
+
+    #[test]
+    fn leaky_relu_with_slope_h_is_the_hysteretic_transform() {
+        // spec 5: max(h d, d) for h <= 1
+        let mut t = crate::autograd::Tape::new();
+        let d = t.constant(ndarray::arr2(&[[-2.0f32, 0.5, 0.0, 3.0]]).view());
+        let y = t.leaky_relu(d, 0.2);
+        let want: Vec<f32> = [-2.0f32, 0.5, 0.0, 3.0]
+            .iter()
+            .map(|&d| (0.2 * d).max(d))
+            .collect();
+        assert_eq!(t.value(y).iter().copied().collect::<Vec<_>>(), want);
+    }
+}

@@ -1,0 +1,156 @@
+//! The differentiable operations. Each file defines its ops' forward (as `Tape` methods) next to
+//! their backward; this module only names them and dispatches the reverse pass.
+
+mod elementwise;
+mod lstm;
+mod matmul;
+mod reduce;
+mod shape;
+
+pub use lstm::LstmVars;
+
+use ndarray::Array2;
+
+use super::kernels::dense::Activation;
+use super::tape::{GradCx, Var};
+
+/// What produced a node, with what its backward needs besides the forward values.
+#[derive(Debug)]
+pub(crate) enum Op {
+    /// Parameter, constant, or an op's cache: nothing to propagate.
+    Leaf,
+    MatMul {
+        a: Var,
+        b: Var,
+    },
+    MatMulNt {
+        a: Var,
+        b: Var,
+    },
+    AddBias {
+        x: Var,
+        bias: Var,
+    },
+    Linear {
+        x: Var,
+        w: Var,
+        b: Var,
+        act: Activation,
+    },
+    Add {
+        a: Var,
+        b: Var,
+    },
+    Sub {
+        a: Var,
+        b: Var,
+    },
+    Mul {
+        a: Var,
+        b: Var,
+    },
+    Scale {
+        x: Var,
+        c: f32,
+    },
+    Sigmoid {
+        x: Var,
+    },
+    Tanh {
+        x: Var,
+    },
+    LeakyRelu {
+        x: Var,
+        slope: f32,
+    },
+    Square {
+        x: Var,
+    },
+    ConcatCols {
+        parts: Vec<Var>,
+    },
+    ConcatRows {
+        parts: Vec<Var>,
+    },
+    SliceCols {
+        x: Var,
+        start: usize,
+    },
+    GatherCols {
+        x: Var,
+        index: Vec<usize>,
+    },
+    GatherRows {
+        x: Var,
+        index: Vec<usize>,
+    },
+    Sum {
+        x: Var,
+    },
+    Mean {
+        x: Var,
+    },
+    MaskedMean {
+        x: Var,
+        mask: Var,
+        count: f32,
+    },
+    Mse {
+        x: Var,
+        target: Var,
+    },
+    Lstm(Box<lstm::LstmNode>),
+}
+
+impl Op {
+    /// Add this node's contribution to its inputs' gradients, given the node's value `y` and
+    /// the gradient `g` flowing into it.
+    pub(crate) fn backward(&self, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
+        match self {
+            Op::Leaf => {}
+            Op::MatMul { a, b } => matmul::matmul_backward(*a, *b, g, cx),
+            Op::MatMulNt { a, b } => matmul::matmul_nt_backward(*a, *b, g, cx),
+            Op::AddBias { x, bias } => matmul::add_bias_backward(*x, *bias, g, cx),
+            Op::Linear { x, w, b, act } => matmul::linear_backward(*x, *w, *b, *act, y, g, cx),
+            Op::Add { a, b } => elementwise::add_backward(*a, *b, g, cx),
+            Op::Sub { a, b } => elementwise::sub_backward(*a, *b, g, cx),
+            Op::Mul { a, b } => elementwise::mul_backward(*a, *b, g, cx),
+            Op::Scale { x, c } => elementwise::scale_backward(*x, *c, g, cx),
+            Op::Sigmoid { x } => elementwise::sigmoid_backward(*x, y, g, cx),
+            Op::Tanh { x } => elementwise::tanh_backward(*x, y, g, cx),
+            Op::LeakyRelu { x, slope } => elementwise::leaky_relu_backward(*x, *slope, g, cx),
+            Op::Square { x } => elementwise::square_backward(*x, g, cx),
+            Op::ConcatCols { parts } => shape::concat_cols_backward(parts, g, cx),
+            Op::ConcatRows { parts } => shape::concat_rows_backward(parts, g, cx),
+            Op::SliceCols { x, start } => shape::slice_cols_backward(*x, *start, g, cx),
+            Op::GatherCols { x, index } => shape::gather_cols_backward(*x, index, g, cx),
+            Op::GatherRows { x, index } => shape::gather_rows_backward(*x, index, g, cx),
+            Op::Sum { x } => reduce::sum_backward(*x, g, cx),
+            Op::Mean { x } => reduce::mean_backward(*x, g, cx),
+            Op::MaskedMean { x, mask, count } => {
+                reduce::masked_mean_backward(*x, *mask, *count, g, cx)
+            }
+            Op::Mse { x, target } => reduce::mse_backward(*x, *target, g, cx),
+            Op::Lstm(node) => node.backward(g, cx),
+        }
+    }
+}
+
+/// `dst = expr` on the first gradient contribution, `dst += expr` afterwards, elementwise over
+/// `dst` zipped with the sources.
+macro_rules! put {
+    ($mode:expr, $dst:expr, $($src:expr),+ ; |$($p:ident),+| $e:expr) => {{
+        match $mode {
+            $crate::autograd::kernels::gemm::Mode::Overwrite => ndarray::Zip::from($dst)
+                $(.and($src))+
+                .for_each(|d, $(&$p),+| *d = $e),
+            $crate::autograd::kernels::gemm::Mode::Accumulate => ndarray::Zip::from($dst)
+                $(.and($src))+
+                .for_each(|d, $(&$p),+| *d += $e),
+        }
+    }};
+}
+pub(crate) use put;
+
+#[cfg(test)]
+pub(crate) mod grad_check;

@@ -1,0 +1,3 @@
+//! `macdec bench ...`: timing of the hot paths (`nets`: one Q-net training update).
+
+pub mod nets;

@@ -1,0 +1,328 @@
+//! Q-net parameters as safetensors files with the reference's PyTorch state_dict names and shapes
+//! (`fc1.weight` [M, in], ..., `lstm.weight_ih_l0` [4H, H], ...), so
+//! `net.load_state_dict(safetensors.torch.load_file(path))` accepts them.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use safetensors::tensor::{Dtype, SafeTensors, TensorView};
+
+use super::qnet::{QNet, QNetConfig, QNetParams, TENSOR_NAMES};
+
+/// Why a weights file could not be written or read. Every message names the file, and the
+/// tensor when one is at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum WeightsError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: not a valid safetensors file: {reason}")]
+    Format { path: PathBuf, reason: String },
+    #[error("{path}: tensor `{name}` is missing (expected shape {expected:?})")]
+    Missing {
+        path: PathBuf,
+        name: &'static str,
+        expected: Vec<usize>,
+    },
+    #[error("{path}: tensor `{name}` has shape {found:?}, expected {expected:?}")]
+    Shape {
+        path: PathBuf,
+        name: String,
+        found: Vec<usize>,
+        expected: Vec<usize>,
+    },
+    #[error("{path}: tensor `{name}` has dtype {found}, expected F32")]
+    Dtype {
+        path: PathBuf,
+        name: String,
+        found: String,
+    },
+    #[error("{path}: unexpected tensor `{name}`; a Q-net has exactly {expected}")]
+    Unexpected {
+        path: PathBuf,
+        name: String,
+        expected: String,
+    },
+}
+
+/// The file's bytes for `params` (PyTorch's `{"format": "pt"}` metadata included).
+pub fn to_safetensors_bytes(params: &QNetParams) -> Vec<u8> {
+    let data: Vec<(&str, Vec<usize>, Vec<u8>)> = params
+        .named()
+        .into_iter()
+        .map(|(name, a)| {
+            let bytes = a.iter().flat_map(|v| v.to_le_bytes()).collect();
+            (name, a.shape().to_vec(), bytes)
+        })
+        .collect();
+    let views = data.iter().map(|(name, shape, bytes)| {
+        let view = TensorView::new(Dtype::F32, shape.clone(), bytes)
+            .expect("shape and byte length agree by construction");
+        (*name, view)
+    });
+    let meta = Some(HashMap::from([("format".to_string(), "pt".to_string())]));
+    safetensors::serialize(views, &meta).expect("serializing in-memory f32 tensors cannot fail")
+}
+
+/// Parse a file's bytes into parameters of size `cfg`. `origin` only labels errors.
+/// Every expected tensor must be present, F32 and of the expected shape, and no other tensor
+/// may be present (like PyTorch's strict `load_state_dict`).
+pub fn from_safetensors_bytes(
+    bytes: &[u8],
+    cfg: QNetConfig,
+    origin: &Path,
+) -> Result<QNetParams, WeightsError> {
+    let path = origin.to_path_buf();
+    let st = SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Format {
+        path: path.clone(),
+        reason: e.to_string(),
+    })?;
+    let mut names: Vec<String> = st.names().into_iter().cloned().collect();
+    names.sort();
+    for name in &names {
+        if !TENSOR_NAMES.contains(&name.as_str()) {
+            return Err(WeightsError::Unexpected {
+                path,
+                name: name.clone(),
+                expected: TENSOR_NAMES.join(", "),
+            });
+        }
+    }
+    let mut params = QNetParams::zeros(cfg);
+    let shapes = cfg.tensor_shapes();
+    let mut slots = {
+        use super::params::Params;
+        params.slices_mut()
+    };
+    for ((name, expected), slot) in TENSOR_NAMES.iter().zip(shapes).zip(slots.iter_mut()) {
+        let view = st.tensor(name).map_err(|_| WeightsError::Missing {
+            path: path.clone(),
+            name,
+            expected: expected.clone(),
+        })?;
+        if view.dtype() != Dtype::F32 {
+            return Err(WeightsError::Dtype {
+                path,
+                name: name.to_string(),
+                found: format!("{:?}", view.dtype()),
+            });
+        }
+        if view.shape() != expected.as_slice() {
+            return Err(WeightsError::Shape {
+                path,
+                name: name.to_string(),
+                found: view.shape().to_vec(),
+                expected,
+            });
+        }
+        for (d, b) in slot.iter_mut().zip(view.data().chunks_exact(4)) {
+            *d = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        }
+    }
+    drop(slots);
+    Ok(params)
+}
+
+/// The layer sizes a weights file describes (read from fc1, the LSTM and fc4), so a policy can
+/// be loaded without knowing its sizes; the full check happens in [`from_safetensors_bytes`].
+pub fn config_of_safetensors(bytes: &[u8], origin: &Path) -> Result<QNetConfig, WeightsError> {
+    let path = origin.to_path_buf();
+    let st = SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Format {
+        path: path.clone(),
+        reason: e.to_string(),
+    })?;
+    let shape = |name: &'static str| -> Result<Vec<usize>, WeightsError> {
+        let v = st.tensor(name).map_err(|_| WeightsError::Missing {
+            path: path.clone(),
+            name,
+            expected: vec![],
+        })?;
+        if v.shape().len() != 2 {
+            return Err(WeightsError::Shape {
+                path: path.clone(),
+                name: name.to_string(),
+                found: v.shape().to_vec(),
+                expected: vec![0, 0],
+            });
+        }
+        Ok(v.shape().to_vec())
+    };
+    let fc1 = shape("fc1.weight")?;
+    let hh = shape("lstm.weight_hh_l0")?;
+    let fc4 = shape("fc4.weight")?;
+    Ok(QNetConfig {
+        input: fc1[1],
+        mlp: fc1[0],
+        hidden: hh[1],
+        output: fc4[0],
+    })
+}
+
+impl QNet {
+    /// Write the parameters to `path` (via a temporary file and a rename, so a crash never
+    /// leaves a half-written file under the final name).
+    pub fn save_safetensors(&self, path: &Path) -> Result<(), WeightsError> {
+        let io = |source| WeightsError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut tmp = path.as_os_str().to_owned();
+        tmp.push(".tmp");
+        std::fs::write(&tmp, to_safetensors_bytes(&self.params)).map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
+    }
+
+    /// Read a net of size `cfg` from `path` (see [`from_safetensors_bytes`] for the checks).
+    pub fn load_safetensors(path: &Path, cfg: QNetConfig) -> Result<QNet, WeightsError> {
+        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(QNet {
+            params: from_safetensors_bytes(&bytes, cfg, path)?,
+        })
+    }
+
+    /// Read a net from `path`, taking its sizes from the file.
+    pub fn load_safetensors_any_size(path: &Path) -> Result<QNet, WeightsError> {
+        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let cfg = config_of_safetensors(&bytes, path)?;
+        Ok(QNet {
+            params: from_safetensors_bytes(&bytes, cfg, path)?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    const CFG: QNetConfig = QNetConfig {
+        input: 5,
+        mlp: 6,
+        hidden: 4,
+        output: 3,
+    };
+
+    fn net() -> QNet {
+        QNet::new(CFG, &mut ChaCha8Rng::seed_from_u64(3))
+    }
+
+    /// Re-serialize `params`' tensors with one of them renamed, reshaped or dropped.
+    fn tampered(edit: impl Fn(&str, Vec<usize>) -> Option<(String, Vec<usize>)>) -> Vec<u8> {
+        let params = net().params;
+        let data: Vec<(String, Vec<usize>, Vec<u8>)> = params
+            .named()
+            .into_iter()
+            .filter_map(|(name, a)| {
+                let (name, shape) = edit(name, a.shape().to_vec())?;
+                let n: usize = shape.iter().product();
+                let bytes = a
+                    .iter()
+                    .cycle()
+                    .take(n)
+                    .flat_map(|v| v.to_le_bytes())
+                    .collect();
+                Some((name, shape, bytes))
+            })
+            .collect();
+        let views = data.iter().map(|(n, s, b)| {
+            (
+                n.clone(),
+                TensorView::new(Dtype::F32, s.clone(), b).unwrap(),
+            )
+        });
+        safetensors::serialize(views, &None).unwrap()
+    }
+
+    #[test]
+    fn save_then_load_gives_identical_parameters() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("q.safetensors");
+        let n = net();
+        n.save_safetensors(&path).unwrap();
+        let back = QNet::load_safetensors(&path, CFG).unwrap();
+        assert_eq!(back, n);
+        assert_eq!(QNet::load_safetensors_any_size(&path).unwrap(), n);
+    }
+
+    #[test]
+    fn file_uses_pytorch_names_and_shapes() {
+        let bytes = to_safetensors_bytes(&net().params);
+        let st = SafeTensors::deserialize(&bytes).unwrap();
+        let shape = |n: &str| st.tensor(n).unwrap().shape().to_vec();
+        assert_eq!(shape("fc1.weight"), vec![6, 5]);
+        assert_eq!(shape("fc2.weight"), vec![4, 6]);
+        assert_eq!(shape("lstm.weight_ih_l0"), vec![16, 4]);
+        assert_eq!(shape("lstm.weight_hh_l0"), vec![16, 4]);
+        assert_eq!(shape("lstm.bias_ih_l0"), vec![16]);
+        assert_eq!(shape("lstm.bias_hh_l0"), vec![16]);
+        assert_eq!(shape("fc3.weight"), vec![6, 4]);
+        assert_eq!(shape("fc4.weight"), vec![3, 6]);
+        assert_eq!(shape("fc4.bias"), vec![3]);
+        assert_eq!(st.names().len(), 12);
+    }
+
+    #[test]
+    fn missing_tensor_is_an_error_naming_it() {
+        let bytes = tampered(|n, s| (n != "lstm.bias_hh_l0").then(|| (n.to_string(), s)));
+        let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                WeightsError::Missing {
+                    name: "lstm.bias_hh_l0",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("lstm.bias_hh_l0"));
+    }
+
+    #[test]
+    fn misnamed_tensor_is_an_error_naming_it() {
+        let bytes = tampered(|n, s| {
+            Some((
+                if n == "fc3.bias" {
+                    "fc3.b".to_string()
+                } else {
+                    n.to_string()
+                },
+                s,
+            ))
+        });
+        let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
+        assert!(err.to_string().contains("`fc3.b`"), "{err}");
+    }
+
+    #[test]
+    fn misshaped_tensor_is_an_error_naming_it_and_both_shapes() {
+        let bytes = tampered(|n, s| {
+            Some((
+                n.to_string(),
+                if n == "fc2.weight" { vec![6, 4] } else { s },
+            ))
+        });
+        let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains("fc2.weight") && msg.contains("[6, 4]") && msg.contains("[4, 6]"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn garbage_is_a_format_error() {
+        let err = from_safetensors_bytes(b"not a file", CFG, Path::new("x")).unwrap_err();
+        assert!(matches!(err, WeightsError::Format { .. }));
+    }
+}
