@@ -72,6 +72,16 @@ enum Command {
     },
     /// Write a Slurm job-array script (one task per run) to stdout.
     Slurm(SlurmArgs),
+    /// Export a trained run's decentralized Q-nets for robots: one safetensors file per agent and
+    /// manifest.json (domain, layout, architecture, run, SHA-256 of each file).
+    Export {
+        /// A run directory: <results>/<experiment>/<method>/seed-<k>.
+        #[arg(long)]
+        run: PathBuf,
+        /// The policy directory to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Serve one agent of an exported policy to a robot: JSON lines on stdin/stdout, or over TCP
     /// with --listen (one hidden state per connection). See README "Exporting and running a policy".
     Robot(RobotArgs),
@@ -218,6 +228,7 @@ fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Train(args) => train(args),
         Command::Replay { actions, verbose } => replay(&actions, verbose),
+        Command::Export { run, out } => export(&run, &out),
         Command::Robot(args) => robot(args),
         Command::Deploy(args) => deploy(args),
         Command::Slurm(args) => slurm(args),
@@ -470,9 +481,23 @@ fn policy_factory(
             Box::new(MockPolicy::new(obs, n, salt)) as Box<dyn AgentPolicy>
         }));
     }
-    // LEAD: build the QNet from `verified.weights` (safetensors bytes, checked against the
-    // manifest's architecture) and return a factory cloning it with a zero LSTM state.
-    bail!("running exported Q-nets is not wired in yet (the nets land with issue 3); use the test-only --mock")
+    let net = macdec::deploy::qnet_policy::load_net(manifest, verified)?;
+    Ok(macdec::deploy::qnet_policy::qnet_factory(net))
+}
+
+fn export(run: &Path, out: &Path) -> Result<()> {
+    let manifest = macdec::deploy::export::export_run(run, out)
+        .with_context(|| format!("exporting {} to {}", run.display(), out.display()))?;
+    eprintln!(
+        "exported {} agent(s) of {} ({} seed {}, {} episodes trained) to {}",
+        manifest.agents.len(),
+        manifest.env.name(),
+        manifest.run.method,
+        manifest.run.seed,
+        manifest.run.episodes_trained,
+        out.display()
+    );
+    Ok(())
 }
 
 fn robot(args: RobotArgs) -> Result<()> {

@@ -229,3 +229,127 @@ fn deployed_robot_processes_equal_in_process_greedy_execution() {
     assert_eq!(deployed, in_process);
     assert!(deployed.iter().all(|t| !t.trajectory.is_empty()));
 }
+
+/// A tiny Box Pushing experiment: a few seconds of training.
+const TINY: &str = r#"
+name = "tiny"
+methods = ["our1", "cen-ddrqn"]
+seeds = "3..4"
+
+[params]
+env_name = "BP_MA"
+grid_dim = 8
+env_terminate_step = 40
+total_epi = 80
+eps_l_d_steps = 40
+batch_size = 16
+replay_buffer_size = 2000
+eval_freq = 20
+checkpoint_freq = 40
+"#;
+
+#[test]
+fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluation() {
+    use macdec::algos::evaluate::{greedy_episode, GreedyPolicy};
+    use macdec::envs::MacroEnv;
+    use macdec::experiment::train_run::{load_checkpoint, CHECKPOINT};
+
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let results = dir.path().join("results");
+    let out = Command::new(BIN)
+        .args(["train", "--quiet", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&results)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    // Cen-DDRQN has no decentralized nets: refused with the reason.
+    let out = Command::new(BIN)
+        .args(["export", "--run"])
+        .arg(results.join("tiny/cen-ddrqn/seed-3"))
+        .arg("--out")
+        .arg(dir.path().join("cen-policy"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no decentralized Q-nets"), "{err}");
+
+    let run = results.join("tiny/our1/seed-3");
+    let policy = dir.path().join("policy");
+    let out = Command::new(BIN)
+        .args(["export", "--run"])
+        .arg(&run)
+        .arg("--out")
+        .arg(&policy)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (manifest, _) = macdec::deploy::manifest::load_all(&policy).unwrap();
+    assert_eq!(
+        (manifest.run.method.as_str(), manifest.run.seed),
+        ("our1", 3)
+    );
+    assert_eq!(manifest.run.episodes_trained, 80);
+    assert_eq!(manifest.agents.len(), 2);
+
+    let episodes = 2;
+    let out = Command::new(BIN)
+        .args([
+            "deploy",
+            "--trajectories",
+            "--episodes",
+            &episodes.to_string(),
+            "--policy",
+        ])
+        .arg(&policy)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let deployed: Vec<EpisodeTrace> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(deployed.len(), episodes);
+
+    // In-process greedy evaluation of the checkpoint's nets, same seed (the run's), same stream.
+    let trainer = load_checkpoint(&run.join(CHECKPOINT)).unwrap();
+    let nets = trainer.dec_policies();
+    let mut env = manifest.env.build().unwrap();
+    let mut rng = stream(3, Role::EvalEnv);
+    for trace in &deployed {
+        let mut steps = Vec::new();
+        let ret = greedy_episode(
+            &mut env,
+            GreedyPolicy::Dec(&nets),
+            manifest.discount,
+            &mut rng,
+            |e, _, r| steps.push((e.executed().to_vec(), r)),
+        )
+        .unwrap();
+        assert_eq!(trace.discounted_return, ret);
+        let got: Vec<(Vec<usize>, f64)> = trace
+            .trajectory
+            .iter()
+            .map(|s| (s.executed.clone(), s.reward))
+            .collect();
+        assert_eq!(got, steps);
+    }
+}

@@ -9,7 +9,8 @@
 //! {"format": "macdec-policy", "format_version": 1,
 //!  "env": {"env": "box-pushing", "grid": 10, "horizon": 100}, "discount": 0.98,
 //!  "architecture": {"kind": "ddrqn", "mlp_layer_size": 32, "rnn_h_size": 32, "leaky_relu_slope": 0.01},
-//!  "run": {"method": "our1", "seed": 3, "config": {...}},
+//!  "run": {"experiment": "fig4a", "method": "our1", "variant": "", "seed": 3,
+//!          "episodes_trained": 15000, "config": {...}},
 //!  "agents": [{"index": 0, "weights": "agent-0.safetensors", "sha256": "9f86...",
 //!              "obs_size": 5, "obs_names": [...], "n_actions": 8, "action_names": [...]}, ...]}
 //! ```
@@ -48,13 +49,19 @@ pub struct Manifest {
     pub agents: Vec<AgentEntry>,
 }
 
-/// Where an exported policy came from: the method, the run's seed and its resolved config (kept
-/// as the run directory stored it, so this layer does not depend on the config types).
+/// Where an exported policy came from: the run's experiment, method, variant and seed, how far it
+/// trained, and its resolved config (kept as JSON, so loading a policy does not depend on the
+/// config types of the version that trained it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunInfo {
+    pub experiment: String,
     pub method: String,
+    pub variant: String,
     pub seed: u64,
+    /// Training episodes completed when the checkpoint was taken.
+    pub episodes_trained: u64,
+    /// The run's `RunConfig` (every hyperparameter).
     pub config: serde_json::Value,
 }
 
@@ -145,6 +152,8 @@ pub enum ManifestError {
     },
     #[error("agent {agent} is out of range: the policy has agents 0..{n_agents}")]
     AgentOutOfRange { agent: usize, n_agents: usize },
+    #[error("weights do not load into the Q-net: {0}")]
+    Net(String),
     #[error("expected one weight file per agent ({expected}), got {got}")]
     WeightsCount { expected: usize, got: usize },
 }
@@ -445,8 +454,11 @@ mod tests {
 
     fn run_info() -> RunInfo {
         RunInfo {
+            experiment: "test".into(),
             method: "our1".into(),
+            variant: String::new(),
             seed: 7,
+            episodes_trained: 100,
             config: serde_json::json!({"discount": 0.98, "dec_mlp_layer_size": 32}),
         }
     }

@@ -86,8 +86,11 @@ pub fn mock_architecture() -> Architecture {
 
 fn mock_run() -> RunInfo {
     RunInfo {
+        experiment: "mock".into(),
         method: "mock".into(),
+        variant: String::new(),
         seed: 0,
+        episodes_trained: 0,
         config: serde_json::json!({"note": "placeholder weights for the mock policy"}),
     }
 }

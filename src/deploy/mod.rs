@@ -4,17 +4,20 @@
 //! decentralized deployment: one process runs the domain and talks to one robot per agent, each
 //! seeing only its own macro-observations ([`driver`], [`link`], [`processes`]).
 //!
-//! Nothing here knows a learner: a policy is anything implementing [`AgentPolicy`] (the real
-//! recurrent Q-net, or [`mock::MockPolicy`] in tests and behind the CLI's hidden `--mock` flag).
+//! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
+//! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
+//! CLI's hidden `--mock` flag). Only [`export`] reads a run's checkpoint.
 
 pub mod architecture;
 pub mod driver;
+pub mod export;
 pub mod line_reader;
 pub mod link;
 pub mod manifest;
 pub mod mock;
 pub mod processes;
 pub mod protocol;
+pub mod qnet_policy;
 pub mod robot;
 pub mod server;
 
