@@ -258,8 +258,16 @@ fn train(args: TrainArgs) -> Result<()> {
     if !args.no_plot {
         match macdec::plot::plot_results(&args.out, &args.plots) {
             Ok(report) => {
-                for p in report.plots.iter().filter(|p| p.experiment == experiment.name) {
-                    eprintln!("learning curves: {} and {}", p.png.display(), p.svg.display());
+                for p in report
+                    .plots
+                    .iter()
+                    .filter(|p| p.experiment == experiment.name)
+                {
+                    eprintln!(
+                        "learning curves: {} and {}",
+                        p.png.display(),
+                        p.svg.display()
+                    );
                 }
             }
             Err(e) => eprintln!("note: no figure drawn: {e}"),
