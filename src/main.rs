@@ -132,6 +132,12 @@ struct TrainArgs {
     /// No progress bars; one line per finished run.
     #[arg(long)]
     quiet: bool,
+    /// Where the learning-curve figures go after training.
+    #[arg(long, default_value = "plots")]
+    plots: PathBuf,
+    /// Do not draw figures after training.
+    #[arg(long)]
+    no_plot: bool,
     /// Run only the run with this index in the experiment's run list (Slurm array tasks).
     #[arg(long)]
     run_index: Option<usize>,
@@ -320,6 +326,24 @@ fn train(args: TrainArgs) -> Result<()> {
         eprintln!("{skipped} run(s) already finished, skipped (use --force to recompute)");
     }
     macdec::experiment::report::print_curves(&args.out, &runs)?;
+    if !args.no_plot {
+        match macdec::plot::plot_results(&args.out, &args.plots) {
+            Ok(report) => {
+                for p in report
+                    .plots
+                    .iter()
+                    .filter(|p| p.experiment == experiment.name)
+                {
+                    eprintln!(
+                        "learning curves: {} and {}",
+                        p.png.display(),
+                        p.svg.display()
+                    );
+                }
+            }
+            Err(e) => eprintln!("note: no figure drawn: {e}"),
+        }
+    }
     if failed > 0 {
         bail!("{failed} of {} run(s) failed", runs.len());
     }

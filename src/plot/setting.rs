@@ -28,7 +28,12 @@ pub struct EnvSetting {
 impl EnvSetting {
     /// Read the setting from a run's `config.toml` text; `Err` says which key is missing or bad.
     pub fn from_config_toml(text: &str) -> Result<Self, String> {
-        let table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
+        // A run directory's config.toml holds the run's identity and its resolved config under
+        // `[config]` (experiment::train_run::RunManifest); a bare RunConfig is accepted too.
+        if let Some(toml::Value::Table(inner)) = table.remove("config") {
+            table = inner;
+        }
         let env_name: EnvName = table
             .get("env_name")
             .ok_or("no `env_name`")?
@@ -89,6 +94,20 @@ mod tests {
     fn setting_of(env: EnvName, grid: usize) -> EnvSetting {
         let text = toml::to_string(&paper_defaults(env, grid, Method::Our1)).unwrap();
         EnvSetting::from_config_toml(&text).unwrap()
+    }
+
+    #[test]
+    fn a_run_manifest_is_read_through_its_config_table() {
+        let manifest = crate::experiment::train_run::RunManifest {
+            experiment: "e".into(),
+            method: Method::Our1,
+            variant: String::new(),
+            seed: 3,
+            config: paper_defaults(EnvName::BoxPushing, 30, Method::Our1),
+        };
+        let s = EnvSetting::from_config_toml(&toml::to_string(&manifest).unwrap()).unwrap();
+        assert_eq!((s.grid_dim, s.horizon), (30, 200));
+        assert_eq!(s.optimal_return(), Some(BP30_OPTIMAL));
     }
 
     #[test]
