@@ -259,7 +259,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
     std::fs::write(&config, TINY).unwrap();
     let results = dir.path().join("results");
     let out = Command::new(BIN)
-        .args(["train", "--quiet", "--config"])
+        .args(["train", "--quiet", "--no-plot", "--config"])
         .arg(&config)
         .arg("--out")
         .arg(&results)
