@@ -31,6 +31,9 @@ enum Command {
         /// Timed iterations per configuration.
         #[arg(long, default_value_t = 200)]
         iters: usize,
+        /// Only the configuration with this name (e.g. torch-wtd).
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -57,9 +60,10 @@ fn main() -> Result<()> {
             demo::run(&cfg, |step, loss| println!("step {step:>6}  loss {loss:.5}"))?;
             println!("done in {:.1} s", t0.elapsed().as_secs_f64());
         }
-        Command::Bench { what: BenchWhat::Nets, iters } => {
+        Command::Bench { what: BenchWhat::Nets, iters, only } => {
             let mut results = Vec::new();
-            for shape in &nets::SHAPES {
+            let chosen = nets::SHAPES.iter().filter(|s| only.as_deref().is_none_or(|o| o == s.name));
+            for shape in chosen {
                 results.push(nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)));
             }
             print!("{}", nets::format_table(&results));

@@ -67,19 +67,32 @@ pub fn tanh_approx(x: f32) -> f32 {
     }
 }
 
-/// Compile `$body` twice: once for AVX2 (chosen at run time when the CPU has it) and once for the
-/// baseline target. The body must not use `mul_add`, so both copies give identical bits.
+/// Compile `$body` three times: for AVX-512 and for AVX2 (chosen at run time when the CPU has
+/// them) and for the baseline target. The body must not use `mul_add`, so every copy gives the
+/// same bits (no instruction set fuses a multiply and an add unless asked to).
 macro_rules! simd_dispatch {
-    ($(#[$doc:meta])* pub fn $name:ident($($arg:ident: $ty:ty),*) $body:block) => {
+    ($(#[$doc:meta])* pub fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $body:block) => {
         $(#[$doc])*
+        #[allow(clippy::too_many_arguments)]
         pub fn $name($($arg: $ty),*) {
             #[inline(always)]
+            #[allow(clippy::too_many_arguments)]
             fn imp($($arg: $ty),*) $body
             #[cfg(target_arch = "x86_64")]
             {
+                #[target_feature(enable = "avx512f")]
+                #[allow(clippy::too_many_arguments)]
+                unsafe fn avx512($($arg: $ty),*) {
+                    imp($($arg),*)
+                }
                 #[target_feature(enable = "avx2")]
+                #[allow(clippy::too_many_arguments)]
                 unsafe fn avx2($($arg: $ty),*) {
                     imp($($arg),*)
+                }
+                if $crate::autograd::kernels::activations::has_avx512() {
+                    // SAFETY: the CPU supports AVX-512F (checked just above).
+                    return unsafe { avx512($($arg),*) };
                 }
                 if std::arch::is_x86_feature_detected!("avx2") {
                     // SAFETY: the CPU supports AVX2 (checked just above).
@@ -89,6 +102,14 @@ macro_rules! simd_dispatch {
             imp($($arg),*)
         }
     };
+}
+pub(crate) use simd_dispatch;
+
+/// Whether the CPU has AVX-512F (checked once).
+#[cfg(target_arch = "x86_64")]
+pub fn has_avx512() -> bool {
+    static HAS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *HAS.get_or_init(|| std::arch::is_x86_feature_detected!("avx512f"))
 }
 
 simd_dispatch! {

@@ -5,7 +5,6 @@
 
 use ndarray::{s, Array2};
 
-use super::matmul::column_sums_into;
 use super::Op;
 use crate::autograd::kernels::gemm::{gemm, Mode};
 use crate::autograd::kernels::lstm::{
@@ -92,6 +91,7 @@ impl LstmNode {
         let rows = lstm_backward_scratch_rows(p);
         let mut dh_rec = cx.pool.array(rows, h);
         let mut dc = cx.pool.array(rows, h);
+        let mut db = cx.pool.array(1, 4 * h);
         lstm_backward(
             g.view(),
             w_hh.view(),
@@ -102,6 +102,7 @@ impl LstmNode {
             &mut dgates,
             &mut dh_rec,
             &mut dc,
+            db.as_slice_mut().expect("pool arrays are contiguous"),
         );
 
         // Weight gradients: one product over all steps, dW = dG^T [x | h_prev].
@@ -125,7 +126,7 @@ impl LstmNode {
         }
         for v in [self.w.b_ih, self.w.b_hh] {
             if let Some((d, mode)) = cx.slot(v) {
-                column_sums_into(dgates.view(), d, mode);
+                super::put!(mode, d, &db; |g| g);
             }
         }
         // Input gradient: dx = dG W_ih in packed order, scattered back to flat order.
@@ -143,7 +144,7 @@ impl LstmNode {
             }
             cx.pool.give_array(dxp);
         }
-        for a in [dgates, dh_rec, dc] {
+        for a in [dgates, dh_rec, dc, db] {
             cx.pool.give_array(a);
         }
     }
