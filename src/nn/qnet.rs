@@ -266,12 +266,16 @@ impl QNet {
         packing: &SeqPacking,
     ) -> Var {
         self.check_input(x, packing);
-        let x = tape.constant(x);
-        let a1 = vars.fc1.forward(tape, x, LEAKY);
+        // The whole net runs in packed order (each LSTM step then touches contiguous rows);
+        // only the input and the Q-values are reordered.
+        let xp = gather_rows(x, packing.packed_to_flat(), tape.pool());
+        let xp = tape.constant_owned(xp);
+        let a1 = vars.fc1.forward(tape, xp, LEAKY);
         let a2 = vars.fc2.forward(tape, a1, LEAKY);
-        let h = tape.lstm(a2, vars.lstm, packing);
+        let h = tape.lstm_packed(a2, vars.lstm, packing);
         let a3 = vars.fc3.forward(tape, h, LEAKY);
-        vars.fc4.forward(tape, a3, Activation::Identity)
+        let q = vars.fc4.forward(tape, a3, Activation::Identity);
+        tape.gather_rows(q, packing.flat_to_packed())
     }
 
     /// [`QNet::forward`] for a padded batch x: [B, T, in] whose row b is valid for its first
@@ -284,9 +288,9 @@ impl QNet {
         lengths: &[usize],
     ) -> Var {
         let packing = SeqPacking::new(lengths);
-        let flat = flatten_padded(x, lengths, tape_pool(tape));
+        let flat = flatten_padded(x, lengths, tape.pool());
         let q = self.forward(tape, vars, flat.view(), &packing);
-        tape_pool(tape).give_array(flat);
+        tape.pool().give_array(flat);
         q
     }
 
@@ -303,13 +307,14 @@ impl QNet {
         let cfg = self.config();
         let p = &self.params;
         let k = packing.total();
+        let xp = gather_rows(x, packing.packed_to_flat(), pool);
         let mut a1 = pool.array(k, cfg.mlp);
-        linear_forward(x, p.fc1.weight.view(), flat(&p.fc1.bias), LEAKY, a1.view_mut());
+        linear_forward(xp.view(), p.fc1.weight.view(), flat(&p.fc1.bias), LEAKY, a1.view_mut());
         let mut a2 = pool.array(k, cfg.hidden);
         linear_forward(a1.view(), p.fc2.weight.view(), flat(&p.fc2.bias), LEAKY, a2.view_mut());
-        let [s_xh, s_g, s_c, s_tc] = LstmCache::shapes(k, cfg.hidden, cfg.hidden);
+        let [s_hp, s_g, s_c, s_tc] = LstmCache::shapes(k, cfg.hidden);
         let mut cache = LstmCache {
-            xh: pool.array(s_xh.0, s_xh.1),
+            h_prev: pool.array(s_hp.0, s_hp.1),
             gates: pool.array(s_g.0, s_g.1),
             c: pool.array(s_c.0, s_c.1),
             tanh_c: pool.array(s_tc.0, s_tc.1),
@@ -323,10 +328,11 @@ impl QNet {
         };
         lstm_forward(a2.view(), &w, packing, &mut cache, &mut h);
         linear_forward(h.view(), p.fc3.weight.view(), flat(&p.fc3.bias), LEAKY, a1.view_mut());
-        let mut q = pool.array(k, cfg.output);
+        let mut qp = pool.array(k, cfg.output);
         let fc4 = &p.fc4;
-        linear_forward(a1.view(), fc4.weight.view(), flat(&fc4.bias), Activation::Identity, q.view_mut());
-        for a in [a1, a2, h, cache.xh, cache.gates, cache.c, cache.tanh_c] {
+        linear_forward(a1.view(), fc4.weight.view(), flat(&fc4.bias), Activation::Identity, qp.view_mut());
+        let q = gather_rows(qp.view(), packing.flat_to_packed(), pool);
+        for a in [xp, a1, a2, h, qp, cache.h_prev, cache.gates, cache.c, cache.tanh_c] {
             pool.give_array(a);
         }
         q
@@ -378,8 +384,13 @@ impl QNet {
     }
 }
 
-fn tape_pool(tape: &mut Tape) -> &mut Pool {
-    tape.pool()
+/// out[k] = x[index[k]] (rows), in a buffer from `pool`.
+fn gather_rows(x: ArrayView2<f32>, index: &[usize], pool: &mut Pool) -> Array2<f32> {
+    let mut out = pool.array(index.len(), x.ncols());
+    for (mut row, &i) in out.rows_mut().into_iter().zip(index) {
+        row.assign(&x.row(i));
+    }
+    out
 }
 
 /// The valid rows of a padded [B, T, in] batch, flattened in (sequence, time) order.
