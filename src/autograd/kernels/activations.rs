@@ -103,6 +103,7 @@ macro_rules! simd_dispatch {
         }
     };
 }
+#[allow(unused_imports)]
 pub(crate) use simd_dispatch;
 
 /// Whether the CPU has AVX-512F (checked once).

@@ -4,6 +4,7 @@
 use ndarray::{ArrayView2, ArrayViewMut2};
 use serde::{Deserialize, Serialize};
 
+use super::activations::simd_dispatch;
 use super::gemm::{gemm, Mode};
 
 /// The nonlinearity fused after a linear layer.
@@ -61,14 +62,51 @@ pub fn linear_forward(
 ) {
     assert_eq!(b.len(), w.nrows(), "linear: bias length");
     gemm(x, w.t(), out.view_mut(), Mode::Overwrite);
-    for mut row in out.rows_mut() {
-        let row = row.as_slice_mut().expect("linear output rows are contiguous");
-        match act {
-            Activation::Identity => row.iter_mut().zip(b).for_each(|(y, &b)| *y += b),
-            Activation::LeakyRelu(s) => row.iter_mut().zip(b).for_each(|(y, &b)| {
-                let z = *y + b;
-                *y = if z > 0.0 { z } else { s * z };
-            }),
+    let slope = match act {
+        Activation::Identity => 1.0,
+        Activation::LeakyRelu(s) => s,
+    };
+    let out = out.as_slice_mut().expect("linear output must be contiguous");
+    bias_act_rows(out, b, slope);
+}
+
+simd_dispatch! {
+    /// Each row of `rows` (rows of b.len() values): z = row + b, then z for z > 0, slope * z
+    /// otherwise (slope 1 is the identity).
+    pub fn bias_act_rows(rows: &mut [f32], b: &[f32], slope: f32) {
+        for row in rows.chunks_exact_mut(b.len()) {
+            for (y, &bv) in row.iter_mut().zip(b) {
+                let z = *y + bv;
+                *y = if z > 0.0 { z } else { slope * z };
+            }
+        }
+    }
+}
+
+simd_dispatch! {
+    /// The backward of [`bias_act_rows`] from its output y (slope >= 0, so y > 0 exactly when
+    /// z > 0): dz = g for y > 0, slope * g otherwise; adds the column sums of dz (the bias
+    /// gradient) to `sums` (one per column). All slices are rows of sums.len() values.
+    pub fn act_backward_rows(g: &[f32], y: &[f32], slope: f32, dz: &mut [f32], sums: &mut [f32]) {
+        let n = sums.len();
+        for ((gr, yr), dr) in g.chunks_exact(n).zip(y.chunks_exact(n)).zip(dz.chunks_exact_mut(n)) {
+            for j in 0..n {
+                let d = if yr[j] > 0.0 { gr[j] } else { slope * gr[j] };
+                dr[j] = d;
+                sums[j] += d;
+            }
+        }
+    }
+}
+
+simd_dispatch! {
+    /// Adds the column sums of `g` (rows of sums.len() values) to `sums`.
+    pub fn add_column_sums(g: &[f32], sums: &mut [f32]) {
+        let n = sums.len();
+        for gr in g.chunks_exact(n) {
+            for j in 0..n {
+                sums[j] += gr[j];
+            }
         }
     }
 }
