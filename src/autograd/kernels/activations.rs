@@ -29,14 +29,10 @@ const TANH_Q: [f32; 4] = [1.0, 0.464_193_588_550_694_08, 0.024_504_106_408_776_7
 /// coefficients to f32) and relative error below 1e-6. NaN stays NaN.
 #[inline(always)]
 pub fn tanh_approx(x: f32) -> f32 {
-    // Comparisons (not f32::min/max) so a NaN input propagates instead of being clamped.
-    let x = if x > TANH_CLAMP {
-        TANH_CLAMP
-    } else if x < -TANH_CLAMP {
-        -TANH_CLAMP
-    } else {
-        x
-    };
+    // Two one-sided selects, each a single min/max instruction once vectorized; a NaN input
+    // fails both comparisons and propagates (f32::min/max would clamp it, and cost more).
+    let x = if x > TANH_CLAMP { TANH_CLAMP } else { x };
+    let x = if x < -TANH_CLAMP { -TANH_CLAMP } else { x };
     // Estrin's scheme: shallower dependency chains than Horner's, so more of them overlap.
     let (c, d) = (TANH_P, TANH_Q);
     let z = x * x;
@@ -46,9 +42,8 @@ pub fn tanh_approx(x: f32) -> f32 {
     let q = (d[3] * z + d[2]) * z2 + (d[1] * z + d[0]);
     let t = x * p / q;
     // Rounding can overshoot saturation by an ulp or two; tanh never leaves [-1, 1].
-    if t > 1.0 {
-        1.0
-    } else if t < -1.0 {
+    let t = if t > 1.0 { 1.0 } else { t };
+    if t < -1.0 {
         -1.0
     } else {
         t
