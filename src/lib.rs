@@ -7,5 +7,5 @@
 
 pub mod autograd;
 pub mod bench;
-pub mod nn;
 pub mod envs;
+pub mod nn;

@@ -7,7 +7,11 @@ use macdec::bench::nets;
 use macdec::nn::demo;
 
 #[derive(Parser)]
-#[command(name = "macdec", version, about = "Macro-action multi-agent deep RL (MacDec-MADDRQN, ICRA 2020)")]
+#[command(
+    name = "macdec",
+    version,
+    about = "Macro-action multi-agent deep RL (MacDec-MADDRQN, ICRA 2020)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -47,7 +51,11 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Demo { steps, seed } => {
-            let cfg = demo::DemoConfig { steps, seed, ..demo::DemoConfig::default() };
+            let cfg = demo::DemoConfig {
+                steps,
+                seed,
+                ..demo::DemoConfig::default()
+            };
             println!(
                 "delayed recall with an LSTM Q-net: {} steps, batch {}, seed {} \
                  (a net without memory cannot go below {:.4})",
@@ -57,12 +65,20 @@ fn main() -> Result<()> {
                 demo::MEMORYLESS_LOSS
             );
             let t0 = std::time::Instant::now();
-            demo::run(&cfg, |step, loss| println!("step {step:>6}  loss {loss:.5}"))?;
+            demo::run(&cfg, |step, loss| {
+                println!("step {step:>6}  loss {loss:.5}")
+            })?;
             println!("done in {:.1} s", t0.elapsed().as_secs_f64());
         }
-        Command::Bench { what: BenchWhat::Nets, iters, only } => {
+        Command::Bench {
+            what: BenchWhat::Nets,
+            iters,
+            only,
+        } => {
             let mut results = Vec::new();
-            let chosen = nets::SHAPES.iter().filter(|s| only.as_deref().is_none_or(|o| o == s.name));
+            let chosen = nets::SHAPES
+                .iter()
+                .filter(|s| only.as_deref().is_none_or(|o| o == s.name));
             for shape in chosen {
                 results.push(nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)));
             }

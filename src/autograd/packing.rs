@@ -121,7 +121,10 @@ mod tests {
         let p = SeqPacking::new(&[2, 0, 3, 3]);
         assert_eq!(p.total(), 8);
         assert_eq!(p.n_steps(), 3);
-        assert_eq!((0..3).map(|t| p.batch_size(t)).collect::<Vec<_>>(), vec![3, 3, 2]);
+        assert_eq!(
+            (0..3).map(|t| p.batch_size(t)).collect::<Vec<_>>(),
+            vec![3, 3, 2]
+        );
         // flat starts: seq0 0, seq1 2, seq2 2, seq3 5
         // t=0: seqs 2, 3, 0 -> flat 2, 5, 0; t=1: 3, 6, 1; t=2: 4, 7
         assert_eq!(p.packed_to_flat(), &[2, 5, 0, 3, 6, 1, 4, 7]);

@@ -112,7 +112,11 @@ impl Tape {
     /// first. Panics if `loss` is not [1, 1].
     pub fn backward(&mut self, loss: Var) {
         let shape = self.shape(loss);
-        assert_eq!(shape, (1, 1), "backward() needs a scalar loss, got shape {shape:?}");
+        assert_eq!(
+            shape,
+            (1, 1),
+            "backward() needs a scalar loss, got shape {shape:?}"
+        );
         let one = ndarray::arr2(&[[1.0f32]]);
         self.backward_with(loss, one.view());
     }
@@ -121,7 +125,11 @@ impl Tape {
     /// vector-Jacobian product). Panics if `seed`'s shape differs from the output's.
     pub fn backward_with(&mut self, output: Var, seed: ArrayView2<f32>) {
         let out = self.index(output);
-        assert_eq!(seed.dim(), self.values[out].dim(), "backward_with: seed shape");
+        assert_eq!(
+            seed.dim(),
+            self.values[out].dim(),
+            "backward_with: seed shape"
+        );
         for g in self.grads.iter_mut() {
             if let Some(g) = g.take() {
                 self.pool.give_array(g);

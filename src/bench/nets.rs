@@ -27,10 +27,21 @@ pub struct NetShape {
     pub pytorch_ms: Option<f64>,
 }
 
-const fn shape(name: &'static str, cfg: [usize; 4], batch: usize, seq: usize, pytorch_ms: Option<f64>) -> NetShape {
+const fn shape(
+    name: &'static str,
+    cfg: [usize; 4],
+    batch: usize,
+    seq: usize,
+    pytorch_ms: Option<f64>,
+) -> NetShape {
     NetShape {
         name,
-        cfg: QNetConfig { input: cfg[0], mlp: cfg[1], hidden: cfg[2], output: cfg[3] },
+        cfg: QNetConfig {
+            input: cfg[0],
+            mlp: cfg[1],
+            hidden: cfg[2],
+            output: cfg[3],
+        },
         batch,
         seq,
         pytorch_ms,
@@ -71,13 +82,25 @@ impl NetBench {
 /// Flops of the matrix products in one update (forward, backward without the input's
 /// gradient, as executed: the recurrent products skip each sequence's first step).
 pub fn update_flops(cfg: QNetConfig, packing: &SeqPacking) -> f64 {
-    let QNetConfig { input, mlp: m, hidden: h, output } = cfg;
+    let QNetConfig {
+        input,
+        mlp: m,
+        hidden: h,
+        output,
+    } = cfg;
     let k = packing.total() as f64;
     let rec = (packing.total() - packing.batch_size(0)) as f64;
     let mm = |rows: f64, a: usize, b: usize| 2.0 * rows * a as f64 * b as f64;
-    let forward = mm(k, input, m) + mm(k, m, h) + mm(k, h, 4 * h) + mm(rec, h, 4 * h) + mm(k, h, m) + mm(k, m, output);
-    let weight_grads = mm(k, input, m) + mm(k, m, h) + mm(k, 2 * h, 4 * h) + mm(k, h, m) + mm(k, m, output);
-    let input_grads = mm(k, m, h) + mm(k, h, 4 * h) + mm(rec, 4 * h, h) + mm(k, h, m) + mm(k, m, output);
+    let forward = mm(k, input, m)
+        + mm(k, m, h)
+        + mm(k, h, 4 * h)
+        + mm(rec, h, 4 * h)
+        + mm(k, h, m)
+        + mm(k, m, output);
+    let weight_grads =
+        mm(k, input, m) + mm(k, m, h) + mm(k, 2 * h, 4 * h) + mm(k, h, m) + mm(k, m, output);
+    let input_grads =
+        mm(k, m, h) + mm(k, h, 4 * h) + mm(rec, 4 * h, h) + mm(k, h, m) + mm(k, m, output);
     forward + weight_grads + input_grads
 }
 
@@ -141,7 +164,10 @@ fn thread_cpu_ns() -> Option<u64> {
         fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
     }
     const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
-    let mut ts = Timespec { tv_sec: 0, tv_nsec: 0 };
+    let mut ts = Timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
     // SAFETY: `ts` is a valid, writable timespec (two 64-bit fields on 64-bit Linux).
     let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
     (rc == 0).then(|| ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64)
@@ -156,7 +182,16 @@ fn thread_cpu_ns() -> Option<u64> {
 pub fn format_table(results: &[NetBench]) -> String {
     let mut s = format!(
         "{:<12} {:>12} {:>7} {:>9} {:>7} {:>7} {:>7} {:>6} {:>7} {:>8}\n",
-        "shape", "in/M/H/out", "batch", "median_ms", "p10_ms", "p90_ms", "cpu_ms", "GFLOP", "GFLOP/s", "torch_ms"
+        "shape",
+        "in/M/H/out",
+        "batch",
+        "median_ms",
+        "p10_ms",
+        "p90_ms",
+        "cpu_ms",
+        "GFLOP",
+        "GFLOP/s",
+        "torch_ms"
     );
     for r in results {
         let c = r.shape.cfg;
@@ -168,10 +203,13 @@ pub fn format_table(results: &[NetBench]) -> String {
             r.median_ms,
             r.p10_ms,
             r.p90_ms,
-            r.cpu_median_ms.map_or("-".to_string(), |t| format!("{t:.3}")),
+            r.cpu_median_ms
+                .map_or("-".to_string(), |t| format!("{t:.3}")),
             r.flops / 1e9,
             r.gflops(),
-            r.shape.pytorch_ms.map_or("-".to_string(), |t| format!("{t:.2}")),
+            r.shape
+                .pytorch_ms
+                .map_or("-".to_string(), |t| format!("{t:.2}")),
         );
     }
     s
@@ -184,7 +222,12 @@ mod tests {
     #[test]
     fn flop_count_of_a_known_shape() {
         // 1 sequence of 2 steps, in 1, M 1, H 1, out 1: K = 2, one recurrent row.
-        let cfg = QNetConfig { input: 1, mlp: 1, hidden: 1, output: 1 };
+        let cfg = QNetConfig {
+            input: 1,
+            mlp: 1,
+            hidden: 1,
+            output: 1,
+        };
         let p = SeqPacking::new(&[2]);
         // forward: 2*2*(1 + 1 + 4 + 1 + 1) + 2*1*4 = 32 + 8; weight grads: 2*2*(1 + 1 + 8 + 1 + 1)
         // = 48; input grads: 2*2*(1 + 4 + 1 + 1) + 2*1*4 = 28 + 8

@@ -95,6 +95,10 @@ pub trait MacroEnv {
             out[at..at + o.len()].copy_from_slice(o);
             at += o.len();
         }
-        assert_eq!(at, out.len(), "joint observation buffer has the wrong length");
+        assert_eq!(
+            at,
+            out.len(),
+            "joint observation buffer has the wrong length"
+        );
     }
 }

@@ -20,7 +20,12 @@ pub struct AdamConfig {
 impl AdamConfig {
     /// PyTorch's defaults with learning rate `lr`.
     pub fn with_lr(lr: f64) -> Self {
-        AdamConfig { lr, beta1: 0.9, beta2: 0.999, eps: 1e-8 }
+        AdamConfig {
+            lr,
+            beta1: 0.9,
+            beta2: 0.999,
+            eps: 1e-8,
+        }
     }
 }
 
@@ -66,14 +71,27 @@ impl Adam {
         let bias_correction2 = 1.0 - c.beta2.powi(t);
         let step_size = (c.lr / bias_correction1) as f32;
         let bc2_sqrt = bias_correction2.sqrt() as f32;
-        let (w1, b2, w2, eps) = ((1.0 - c.beta1) as f32, c.beta2 as f32, (1.0 - c.beta2) as f32, c.eps as f32);
+        let (w1, b2, w2, eps) = (
+            (1.0 - c.beta1) as f32,
+            c.beta2 as f32,
+            (1.0 - c.beta2) as f32,
+            c.eps as f32,
+        );
         let ps = params.slices_mut();
         let gs = grads.slices();
         assert_eq!(ps.len(), self.m.len(), "adam: different number of tensors");
-        assert_eq!(gs.len(), self.m.len(), "adam: different number of gradient tensors");
+        assert_eq!(
+            gs.len(),
+            self.m.len(),
+            "adam: different number of gradient tensors"
+        );
         for (((p, g), m), v) in ps.into_iter().zip(gs).zip(&mut self.m).zip(&mut self.v) {
             assert_eq!(p.len(), m.len(), "adam: tensor size changed");
-            assert_eq!(g.len(), m.len(), "adam: gradient size differs from the parameter's");
+            assert_eq!(
+                g.len(),
+                m.len(),
+                "adam: gradient size differs from the parameter's"
+            );
             adam_update(p, g, m, v, [w1, b2, w2, bc2_sqrt, eps, step_size]);
         }
     }

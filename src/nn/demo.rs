@@ -61,13 +61,22 @@ pub type LossCurve = Vec<(usize, f32)>;
 /// Train the Q-net on delayed recall, calling `report(step, mean_loss)` every `report_every`
 /// steps; returns every reported point.
 pub fn run(cfg: &DemoConfig, mut report: impl FnMut(usize, f32)) -> Result<LossCurve, DemoError> {
-    for (name, v) in [("steps", cfg.steps), ("batch", cfg.batch), ("report_every", cfg.report_every)] {
+    for (name, v) in [
+        ("steps", cfg.steps),
+        ("batch", cfg.batch),
+        ("report_every", cfg.report_every),
+    ] {
         if v == 0 {
             return Err(DemoError::NotPositive { name });
         }
     }
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let net_cfg = QNetConfig { input: SYMBOLS + 1, mlp: 32, hidden: 32, output: SYMBOLS };
+    let net_cfg = QNetConfig {
+        input: SYMBOLS + 1,
+        mlp: 32,
+        hidden: 32,
+        output: SYMBOLS,
+    };
     let mut net = QNet::new(net_cfg, &mut rng);
     let mut adam = Adam::new(AdamConfig::with_lr(cfg.lr), &net.params);
     let mut updater = Updater::new(&net);
@@ -98,7 +107,11 @@ fn recall_batch(n: usize, rng: &mut ChaCha8Rng) -> TdBatch {
     for &len in &lengths {
         let first = rng.gen_range(0..SYMBOLS);
         for t in 0..len {
-            let symbol = if t == 0 { first } else { rng.gen_range(0..SYMBOLS) };
+            let symbol = if t == 0 {
+                first
+            } else {
+                rng.gen_range(0..SYMBOLS)
+            };
             x[[row, symbol]] = 1.0;
             x[[row, SYMBOLS]] = if t == 0 { 1.0 } else { 0.0 };
             let a = rng.gen_range(0..SYMBOLS);
@@ -107,7 +120,12 @@ fn recall_batch(n: usize, rng: &mut ChaCha8Rng) -> TdBatch {
             row += 1;
         }
     }
-    TdBatch { x, packing, actions, targets }
+    TdBatch {
+        x,
+        packing,
+        actions,
+        targets,
+    }
 }
 
 #[cfg(test)]
@@ -116,7 +134,11 @@ mod tests {
 
     #[test]
     fn the_lstm_learns_to_recall_beyond_what_a_memoryless_net_can() {
-        let cfg = DemoConfig { steps: 600, report_every: 100, ..DemoConfig::default() };
+        let cfg = DemoConfig {
+            steps: 600,
+            report_every: 100,
+            ..DemoConfig::default()
+        };
         let curve = run(&cfg, |_, _| {}).unwrap();
         let (first, last) = (curve[0].1, curve[curve.len() - 1].1);
         assert!(last < 0.5 * MEMORYLESS_LOSS, "loss {first} -> {last}");
@@ -125,7 +147,13 @@ mod tests {
 
     #[test]
     fn zero_steps_is_refused() {
-        let cfg = DemoConfig { steps: 0, ..DemoConfig::default() };
-        assert_eq!(run(&cfg, |_, _| {}), Err(DemoError::NotPositive { name: "steps" }));
+        let cfg = DemoConfig {
+            steps: 0,
+            ..DemoConfig::default()
+        };
+        assert_eq!(
+            run(&cfg, |_, _| {}),
+            Err(DemoError::NotPositive { name: "steps" })
+        );
     }
 }

@@ -10,7 +10,12 @@ pub const LEAKY_RELU_GAIN: f64 = 1.414_142_856_997_835_4;
 
 /// Xavier-uniform [fan_out, fan_in]: U(-b, b), b = gain * sqrt(6 / (fan_in + fan_out)), drawn
 /// in row-major order.
-pub fn xavier_uniform(fan_out: usize, fan_in: usize, gain: f64, rng: &mut ChaCha8Rng) -> Array2<f32> {
+pub fn xavier_uniform(
+    fan_out: usize,
+    fan_in: usize,
+    gain: f64,
+    rng: &mut ChaCha8Rng,
+) -> Array2<f32> {
     let bound = gain * (6.0 / (fan_in + fan_out) as f64).sqrt();
     uniform2(fan_out, fan_in, bound as f32, rng)
 }

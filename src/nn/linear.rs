@@ -71,7 +71,11 @@ impl LinearVars {
 pub(crate) fn copy_grad(tape: &Tape, v: Var, dst: &mut [f32]) {
     match tape.grad(v) {
         Some(g) => {
-            assert_eq!(g.len(), dst.len(), "gradient size differs from the parameter's");
+            assert_eq!(
+                g.len(),
+                dst.len(),
+                "gradient size differs from the parameter's"
+            );
             for (d, &g) in dst.iter_mut().zip(g.iter()) {
                 *d = g;
             }

@@ -18,7 +18,11 @@ pub fn hysteretic_td_loss(
     let q_taken = tape.gather_cols(q, actions);
     let y = tape.constant(y.insert_axis(Axis(1)));
     let delta = tape.sub(y, q_taken);
-    let delta = if h == 1.0 { delta } else { tape.leaky_relu(delta, h) };
+    let delta = if h == 1.0 {
+        delta
+    } else {
+        tape.leaky_relu(delta, h)
+    };
     let sq = tape.square(delta);
     tape.mean(sq)
 }
@@ -37,6 +41,9 @@ mod tests {
         assert_eq!(t.scalar(loss), 0.625);
         t.backward(loss);
         // dL/dQ[k, a_k] = -2 h d'_k / K = [-2 * 0.5 * -1 / 2, -2 * 0.5 * -0.5 / 2] = [0.5, 0.25]
-        assert_eq!(t.grad(q).unwrap(), ndarray::arr2(&[[0.0f32, 0.5], [0.25, 0.0]]));
+        assert_eq!(
+            t.grad(q).unwrap(),
+            ndarray::arr2(&[[0.0f32, 0.5], [0.25, 0.0]])
+        );
     }
 }

@@ -39,7 +39,11 @@ impl LstmParams {
     pub fn step(&self, x: &[f32], state: &mut LstmState) {
         let h = self.hidden();
         assert_eq!(x.len(), self.weight_ih.ncols(), "lstm step: input length");
-        assert_eq!(state.h.len(), h, "lstm step: state was made for another hidden size");
+        assert_eq!(
+            state.h.len(),
+            h,
+            "lstm step: state was made for another hidden size"
+        );
         state.gates.resize(4 * h, 0.0);
         let (w_ih, w_hh) = (flat(&self.weight_ih), flat(&self.weight_hh));
         let (b_ih, b_hh) = (flat(&self.bias_ih), flat(&self.bias_hh));
@@ -152,7 +156,11 @@ mod tests {
         for a in [&p.weight_ih, &p.weight_hh] {
             assert!(a.iter().all(|v| v.abs() <= k));
         }
-        assert!(p.bias_ih.iter().chain(p.bias_hh.iter()).all(|v| v.abs() <= k));
+        assert!(p
+            .bias_ih
+            .iter()
+            .chain(p.bias_hh.iter())
+            .all(|v| v.abs() <= k));
         assert!(p.weight_hh.iter().any(|v| v.abs() > 0.9 * k));
     }
 }

@@ -59,10 +59,12 @@ impl LstmParams {
 
 /// Flat, contiguous view of an owned array (ours are always in standard layout).
 pub(crate) fn flat<D: ndarray::Dimension>(a: &ndarray::Array<f32, D>) -> &[f32] {
-    a.as_slice_memory_order().expect("owned parameter arrays are contiguous")
+    a.as_slice_memory_order()
+        .expect("owned parameter arrays are contiguous")
 }
 
 /// Mutable flat view (see [`flat`]).
 pub(crate) fn flat_mut<D: ndarray::Dimension>(a: &mut ndarray::Array<f32, D>) -> &mut [f32] {
-    a.as_slice_memory_order_mut().expect("owned parameter arrays are contiguous")
+    a.as_slice_memory_order_mut()
+        .expect("owned parameter arrays are contiguous")
 }

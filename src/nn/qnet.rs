@@ -51,7 +51,12 @@ pub const TENSOR_NAMES: [&str; 12] = [
 impl QNetConfig {
     /// The shape of each tensor of [`TENSOR_NAMES`], in the same order.
     pub fn tensor_shapes(&self) -> [Vec<usize>; 12] {
-        let QNetConfig { input, mlp, hidden, output } = *self;
+        let QNetConfig {
+            input,
+            mlp,
+            hidden,
+            output,
+        } = *self;
         [
             vec![mlp, input],
             vec![mlp],
@@ -70,7 +75,10 @@ impl QNetConfig {
 
     /// Number of trainable scalars.
     pub fn n_params(&self) -> usize {
-        self.tensor_shapes().iter().map(|s| s.iter().product::<usize>()).sum()
+        self.tensor_shapes()
+            .iter()
+            .map(|s| s.iter().product::<usize>())
+            .sum()
     }
 }
 
@@ -106,7 +114,13 @@ impl QNetParams {
         let lstm = LstmParams::pytorch_default(cfg.hidden, cfg.hidden, rng);
         let fc3 = LinearParams::xavier(cfg.hidden, cfg.mlp, LEAKY_RELU_GAIN, rng);
         let fc4 = LinearParams::xavier(cfg.mlp, cfg.output, 1.0, rng);
-        QNetParams { fc1, fc2, lstm, fc3, fc4 }
+        QNetParams {
+            fc1,
+            fc2,
+            lstm,
+            fc3,
+            fc4,
+        }
     }
 
     /// The sizes these tensors have.
@@ -140,12 +154,19 @@ impl QNetParams {
 
     /// The tensor called `name` (state_dict naming), if there is one.
     pub fn get(&self, name: &str) -> Option<ArrayViewD<'_, f32>> {
-        self.named().into_iter().find(|(n, _)| *n == name).map(|(_, a)| a)
+        self.named()
+            .into_iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, a)| a)
     }
 
     /// Overwrite with `other`'s values (same config) without allocating: the hard target copy.
     pub fn copy_from(&mut self, other: &QNetParams) {
-        assert_eq!(self.config(), other.config(), "copy_from: different net sizes");
+        assert_eq!(
+            self.config(),
+            other.config(),
+            "copy_from: different net sizes"
+        );
         for (d, s) in self.slices_mut().into_iter().zip(other.slices()) {
             d.copy_from_slice(s);
         }
@@ -229,7 +250,9 @@ impl QNetVars {
 impl QNet {
     /// A freshly initialized net (spec 2.2), drawn from `rng`.
     pub fn new(cfg: QNetConfig, rng: &mut ChaCha8Rng) -> Self {
-        QNet { params: QNetParams::init(cfg, rng) }
+        QNet {
+            params: QNetParams::init(cfg, rng),
+        }
     }
 
     /// Its layer sizes.
@@ -309,9 +332,21 @@ impl QNet {
         let k = packing.total();
         let xp = gather_rows(x, packing.packed_to_flat(), pool);
         let mut a1 = pool.array(k, cfg.mlp);
-        linear_forward(xp.view(), p.fc1.weight.view(), flat(&p.fc1.bias), LEAKY, a1.view_mut());
+        linear_forward(
+            xp.view(),
+            p.fc1.weight.view(),
+            flat(&p.fc1.bias),
+            LEAKY,
+            a1.view_mut(),
+        );
         let mut a2 = pool.array(k, cfg.hidden);
-        linear_forward(a1.view(), p.fc2.weight.view(), flat(&p.fc2.bias), LEAKY, a2.view_mut());
+        linear_forward(
+            a1.view(),
+            p.fc2.weight.view(),
+            flat(&p.fc2.bias),
+            LEAKY,
+            a2.view_mut(),
+        );
         let [s_hp, s_g, s_c, s_tc] = LstmCache::shapes(k, cfg.hidden);
         let mut cache = LstmCache {
             h_prev: pool.array(s_hp.0, s_hp.1),
@@ -327,12 +362,34 @@ impl QNet {
             b_hh: flat(&p.lstm.bias_hh),
         };
         lstm_forward(a2.view(), &w, packing, &mut cache, &mut h);
-        linear_forward(h.view(), p.fc3.weight.view(), flat(&p.fc3.bias), LEAKY, a1.view_mut());
+        linear_forward(
+            h.view(),
+            p.fc3.weight.view(),
+            flat(&p.fc3.bias),
+            LEAKY,
+            a1.view_mut(),
+        );
         let mut qp = pool.array(k, cfg.output);
         let fc4 = &p.fc4;
-        linear_forward(a1.view(), fc4.weight.view(), flat(&fc4.bias), Activation::Identity, qp.view_mut());
+        linear_forward(
+            a1.view(),
+            fc4.weight.view(),
+            flat(&fc4.bias),
+            Activation::Identity,
+            qp.view_mut(),
+        );
         let q = gather_rows(qp.view(), packing.flat_to_packed(), pool);
-        for a in [xp, a1, a2, h, qp, cache.h_prev, cache.gates, cache.c, cache.tanh_c] {
+        for a in [
+            xp,
+            a1,
+            a2,
+            h,
+            qp,
+            cache.h_prev,
+            cache.gates,
+            cache.c,
+            cache.tanh_c,
+        ] {
             pool.give_array(a);
         }
         q
@@ -355,7 +412,13 @@ impl QNet {
     /// `state`'s scratch. Panics if x or the state do not match the net's sizes.
     pub fn act_step<'s>(&self, x: &[f32], state: &'s mut LstmState) -> &'s [f32] {
         let cfg = self.config();
-        assert_eq!(x.len(), cfg.input, "act_step: input has {} values, the net {}", x.len(), cfg.input);
+        assert_eq!(
+            x.len(),
+            cfg.input,
+            "act_step: input has {} values, the net {}",
+            x.len(),
+            cfg.input
+        );
         let p = &self.params;
         let mut sc = std::mem::take(&mut state.scratch);
         sc[0].resize(cfg.mlp, 0.0);
@@ -379,8 +442,18 @@ impl QNet {
 
     fn check_input(&self, x: ArrayView2<f32>, packing: &SeqPacking) {
         let cfg = self.config();
-        assert_eq!(x.ncols(), cfg.input, "q-net input has {} features, the net {}", x.ncols(), cfg.input);
-        assert_eq!(x.nrows(), packing.total(), "q-net input rows differ from the packing's total");
+        assert_eq!(
+            x.ncols(),
+            cfg.input,
+            "q-net input has {} features, the net {}",
+            x.ncols(),
+            cfg.input
+        );
+        assert_eq!(
+            x.nrows(),
+            packing.total(),
+            "q-net input rows differ from the packing's total"
+        );
     }
 }
 
@@ -402,8 +475,12 @@ pub fn flatten_padded(x: ArrayView3<f32>, lengths: &[usize], pool: &mut Pool) ->
     let mut out = pool.array(k, input);
     let mut at = 0;
     for (s, &len) in lengths.iter().enumerate() {
-        assert!(len <= t, "sequence {s} has length {len} > padded length {t}");
-        out.slice_mut(s![at..at + len, ..]).assign(&x.slice(s![s, ..len, ..]));
+        assert!(
+            len <= t,
+            "sequence {s} has length {len} > padded length {t}"
+        );
+        out.slice_mut(s![at..at + len, ..])
+            .assign(&x.slice(s![s, ..len, ..]));
         at += len;
     }
     out
@@ -416,13 +493,19 @@ mod tests {
     use ndarray::{Array1, Array3};
     use rand::{Rng, SeedableRng};
 
-    const CFG: QNetConfig = QNetConfig { input: 5, mlp: 7, hidden: 4, output: 3 };
+    const CFG: QNetConfig = QNetConfig {
+        input: 5,
+        mlp: 7,
+        hidden: 4,
+        output: 3,
+    };
 
     fn setup(lengths: &[usize], seed: u64) -> (QNet, Array2<f32>, SeqPacking) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let net = QNet::new(CFG, &mut rng);
         let packing = SeqPacking::new(lengths);
-        let x = Array2::from_shape_simple_fn((packing.total(), CFG.input), || rng.gen_range(-1.0..1.0));
+        let x =
+            Array2::from_shape_simple_fn((packing.total(), CFG.input), || rng.gen_range(-1.0..1.0));
         (net, x, packing)
     }
 
@@ -431,19 +514,44 @@ mod tests {
         let (net, _, _) = setup(&[1], 0);
         let p = &net.params;
         for l in [&p.fc1, &p.fc2, &p.fc3, &p.fc4] {
-            assert!(l.bias.iter().all(|&b| b == 0.0), "Linear biases start at zero");
+            assert!(
+                l.bias.iter().all(|&b| b == 0.0),
+                "Linear biases start at zero"
+            );
         }
-        let bound = |l: &LinearParams, gain: f64| (gain * (6.0 / (l.input() + l.output()) as f64).sqrt()) as f32;
-        assert!(p.fc1.weight.iter().all(|w| w.abs() <= bound(&p.fc1, LEAKY_RELU_GAIN)));
+        let bound = |l: &LinearParams, gain: f64| {
+            (gain * (6.0 / (l.input() + l.output()) as f64).sqrt()) as f32
+        };
+        assert!(p
+            .fc1
+            .weight
+            .iter()
+            .all(|w| w.abs() <= bound(&p.fc1, LEAKY_RELU_GAIN)));
         assert!(p.fc4.weight.iter().all(|w| w.abs() <= bound(&p.fc4, 1.0)));
         // fc4's gain-1 bound is below fc1's leaky gain bound scaled to fc4's fans: some fc4
         // weight would exceed it if the leaky gain were used by mistake (checked on a big net).
-        let big = QNet::new(QNetConfig { input: 8, mlp: 64, hidden: 64, output: 64 }, &mut ChaCha8Rng::seed_from_u64(1));
+        let big = QNet::new(
+            QNetConfig {
+                input: 8,
+                mlp: 64,
+                hidden: 64,
+                output: 64,
+            },
+            &mut ChaCha8Rng::seed_from_u64(1),
+        );
         let b1 = bound(&big.params.fc4, 1.0);
-        let max4 = big.params.fc4.weight.iter().fold(0.0f32, |m, w| m.max(w.abs()));
+        let max4 = big
+            .params
+            .fc4
+            .weight
+            .iter()
+            .fold(0.0f32, |m, w| m.max(w.abs()));
         assert!(max4 <= b1 && max4 > 0.95 * b1);
         assert_eq!(net.config(), CFG);
-        assert_eq!(CFG.n_params(), net.params.slices().iter().map(|s| s.len()).sum::<usize>());
+        assert_eq!(
+            CFG.n_params(),
+            net.params.slices().iter().map(|s| s.len()).sum::<usize>()
+        );
     }
 
     #[test]
@@ -480,7 +588,9 @@ mod tests {
         let mut padded = Array3::from_elem((3, 4, CFG.input), f32::NAN);
         for (s, &len) in lengths.iter().enumerate() {
             for t in 0..len {
-                padded.slice_mut(s![s, t, ..]).assign(&x.row(packing.flat_row(s, t)));
+                padded
+                    .slice_mut(s![s, t, ..])
+                    .assign(&x.row(packing.flat_row(s, t)));
             }
         }
         let flat_q = net.forward_nograd(x.view(), &packing);
@@ -513,8 +623,7 @@ mod tests {
         let mut grads = QNetParams::zeros(CFG);
         loss_of(&net, Some(&mut grads));
         let step = 1e-2f32;
-        let n_tensors = net.params.slices().len();
-        for t in 0..n_tensors {
+        for (t, name) in TENSOR_NAMES.iter().enumerate() {
             let len = net.params.slices()[t].len();
             for e in [0, len / 2, len - 1] {
                 let mut plus = net.clone();
@@ -525,8 +634,7 @@ mod tests {
                 let analytic = grads.slices()[t][e] as f64;
                 assert!(
                     (numeric - analytic).abs() <= 2e-3 + 2e-2 * numeric.abs().max(analytic.abs()),
-                    "{} element {e}: analytic {analytic}, numeric {numeric}",
-                    TENSOR_NAMES[t]
+                    "{name} element {e}: analytic {analytic}, numeric {numeric}"
                 );
             }
         }
@@ -544,7 +652,10 @@ mod tests {
     #[test]
     fn params_are_reachable_by_state_dict_name() {
         let (net, _, _) = setup(&[1], 9);
-        assert_eq!(net.params.get("lstm.weight_hh_l0").unwrap().shape(), &[16, 4]);
+        assert_eq!(
+            net.params.get("lstm.weight_hh_l0").unwrap().shape(),
+            &[16, 4]
+        );
         assert_eq!(net.params.get("fc4.bias").unwrap().shape(), &[3]);
         assert!(net.params.get("fc5.bias").is_none());
     }

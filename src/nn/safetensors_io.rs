@@ -165,7 +165,10 @@ impl QNet {
     /// Write the parameters to `path` (via a temporary file and a rename, so a crash never
     /// leaves a half-written file under the final name).
     pub fn save_safetensors(&self, path: &Path) -> Result<(), WeightsError> {
-        let io = |source| WeightsError::Io { path: path.to_path_buf(), source };
+        let io = |source| WeightsError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
         let mut tmp = path.as_os_str().to_owned();
         tmp.push(".tmp");
         std::fs::write(&tmp, to_safetensors_bytes(&self.params)).map_err(io)?;
@@ -178,7 +181,9 @@ impl QNet {
             path: path.to_path_buf(),
             source,
         })?;
-        Ok(QNet { params: from_safetensors_bytes(&bytes, cfg, path)? })
+        Ok(QNet {
+            params: from_safetensors_bytes(&bytes, cfg, path)?,
+        })
     }
 
     /// Read a net from `path`, taking its sizes from the file.
@@ -188,7 +193,9 @@ impl QNet {
             source,
         })?;
         let cfg = config_of_safetensors(&bytes, path)?;
-        Ok(QNet { params: from_safetensors_bytes(&bytes, cfg, path)? })
+        Ok(QNet {
+            params: from_safetensors_bytes(&bytes, cfg, path)?,
+        })
     }
 }
 
@@ -198,7 +205,12 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
-    const CFG: QNetConfig = QNetConfig { input: 5, mlp: 6, hidden: 4, output: 3 };
+    const CFG: QNetConfig = QNetConfig {
+        input: 5,
+        mlp: 6,
+        hidden: 4,
+        output: 3,
+    };
 
     fn net() -> QNet {
         QNet::new(CFG, &mut ChaCha8Rng::seed_from_u64(3))
@@ -213,11 +225,21 @@ mod tests {
             .filter_map(|(name, a)| {
                 let (name, shape) = edit(name, a.shape().to_vec())?;
                 let n: usize = shape.iter().product();
-                let bytes = a.iter().cycle().take(n).flat_map(|v| v.to_le_bytes()).collect();
+                let bytes = a
+                    .iter()
+                    .cycle()
+                    .take(n)
+                    .flat_map(|v| v.to_le_bytes())
+                    .collect();
                 Some((name, shape, bytes))
             })
             .collect();
-        let views = data.iter().map(|(n, s, b)| (n.clone(), TensorView::new(Dtype::F32, s.clone(), b).unwrap()));
+        let views = data.iter().map(|(n, s, b)| {
+            (
+                n.clone(),
+                TensorView::new(Dtype::F32, s.clone(), b).unwrap(),
+            )
+        });
         safetensors::serialize(views, &None).unwrap()
     }
 
@@ -253,14 +275,30 @@ mod tests {
     fn missing_tensor_is_an_error_naming_it() {
         let bytes = tampered(|n, s| (n != "lstm.bias_hh_l0").then(|| (n.to_string(), s)));
         let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
-        assert!(matches!(err, WeightsError::Missing { name: "lstm.bias_hh_l0", .. }), "{err}");
+        assert!(
+            matches!(
+                err,
+                WeightsError::Missing {
+                    name: "lstm.bias_hh_l0",
+                    ..
+                }
+            ),
+            "{err}"
+        );
         assert!(err.to_string().contains("lstm.bias_hh_l0"));
     }
 
     #[test]
     fn misnamed_tensor_is_an_error_naming_it() {
         let bytes = tampered(|n, s| {
-            Some((if n == "fc3.bias" { "fc3.b".to_string() } else { n.to_string() }, s))
+            Some((
+                if n == "fc3.bias" {
+                    "fc3.b".to_string()
+                } else {
+                    n.to_string()
+                },
+                s,
+            ))
         });
         let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
         assert!(err.to_string().contains("`fc3.b`"), "{err}");
@@ -269,11 +307,17 @@ mod tests {
     #[test]
     fn misshaped_tensor_is_an_error_naming_it_and_both_shapes() {
         let bytes = tampered(|n, s| {
-            Some((n.to_string(), if n == "fc2.weight" { vec![6, 4] } else { s }))
+            Some((
+                n.to_string(),
+                if n == "fc2.weight" { vec![6, 4] } else { s },
+            ))
         });
         let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
         let msg = err.to_string();
-        assert!(msg.contains("fc2.weight") && msg.contains("[6, 4]") && msg.contains("[4, 6]"), "{msg}");
+        assert!(
+            msg.contains("fc2.weight") && msg.contains("[6, 4]") && msg.contains("[4, 6]"),
+            "{msg}"
+        );
     }
 
     #[test]

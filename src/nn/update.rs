@@ -70,7 +70,12 @@ mod tests {
     }
 
     fn train(seed: u64, updates: usize) -> QNet {
-        let cfg = QNetConfig { input: 4, mlp: 8, hidden: 6, output: 3 };
+        let cfg = QNetConfig {
+            input: 4,
+            mlp: 8,
+            hidden: 6,
+            output: 3,
+        };
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut net = QNet::new(cfg, &mut rng);
         let mut adam = Adam::new(AdamConfig::with_lr(1e-2), &net.params);
@@ -84,7 +89,11 @@ mod tests {
 
     fn bits(net: &QNet) -> Vec<u32> {
         use crate::nn::Params;
-        net.params.slices().iter().flat_map(|s| s.iter().map(|v| v.to_bits())).collect()
+        net.params
+            .slices()
+            .iter()
+            .flat_map(|s| s.iter().map(|v| v.to_bits()))
+            .collect()
     }
 
     #[test]
@@ -99,12 +108,21 @@ mod tests {
         let one = in_pool(1);
         assert_eq!(one, in_pool(2));
         assert_eq!(one, bits(&train(17, 30)));
-        assert_ne!(one, bits(&train(18, 30)), "a different seed must give different parameters");
+        assert_ne!(
+            one,
+            bits(&train(18, 30)),
+            "a different seed must give different parameters"
+        );
     }
 
     #[test]
     fn loss_falls_on_a_fixed_batch() {
-        let cfg = QNetConfig { input: 4, mlp: 16, hidden: 8, output: 3 };
+        let cfg = QNetConfig {
+            input: 4,
+            mlp: 16,
+            hidden: 8,
+            output: 3,
+        };
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut net = QNet::new(cfg, &mut rng);
         let mut adam = Adam::new(AdamConfig::with_lr(1e-2), &net.params);
@@ -120,7 +138,12 @@ mod tests {
 
     #[test]
     fn no_memory_growth_across_100k_updates() {
-        let cfg = QNetConfig { input: 2, mlp: 3, hidden: 2, output: 2 };
+        let cfg = QNetConfig {
+            input: 2,
+            mlp: 3,
+            hidden: 2,
+            output: 2,
+        };
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let mut net = QNet::new(cfg, &mut rng);
         let mut adam = Adam::new(AdamConfig::with_lr(1e-3), &net.params);

@@ -66,7 +66,9 @@ pub fn linear_forward(
         Activation::Identity => 1.0,
         Activation::LeakyRelu(s) => s,
     };
-    let out = out.as_slice_mut().expect("linear output must be contiguous");
+    let out = out
+        .as_slice_mut()
+        .expect("linear output must be contiguous");
     bias_act_rows(out, b, slope);
 }
 

@@ -63,7 +63,11 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
 /// dst = src^T for src: [r, c], dst: [c, r] (e.g. a weight W [out, in] into W^T, the right
 /// operand of x W^T, once per pass instead of once per product).
 pub fn transpose_into(src: ArrayView2<f32>, dst: &mut Array2<f32>) {
-    assert_eq!(dst.dim(), (src.ncols(), src.nrows()), "transpose_into: shape");
+    assert_eq!(
+        dst.dim(),
+        (src.ncols(), src.nrows()),
+        "transpose_into: shape"
+    );
     dst.assign(&src.t());
 }
 
@@ -99,12 +103,29 @@ mod avx512 {
     /// # Safety
     /// The CPU supports AVX-512F; the views are valid with non-negative strides; b and c have
     /// unit column stride; c does not overlap a or b.
-    pub unsafe fn gemm_views(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, mode: Mode) {
+    pub unsafe fn gemm_views(
+        a: ArrayView2<f32>,
+        b: ArrayView2<f32>,
+        mut c: ArrayViewMut2<f32>,
+        mode: Mode,
+    ) {
         let (m, k, n) = (a.nrows(), a.ncols(), b.ncols());
         let (rsa, csa) = (a.strides()[0], a.strides()[1]);
         let rsb = b.strides()[0];
         let rsc = c.strides()[0];
-        gemm(m, n, k, a.as_ptr(), rsa, csa, b.as_ptr(), rsb, c.as_mut_ptr(), rsc, mode == Mode::Accumulate);
+        gemm(
+            m,
+            n,
+            k,
+            a.as_ptr(),
+            rsa,
+            csa,
+            b.as_ptr(),
+            rsb,
+            c.as_mut_ptr(),
+            rsc,
+            mode == Mode::Accumulate,
+        );
     }
 
     #[target_feature(enable = "avx512f")]
@@ -135,7 +156,18 @@ mod avx512 {
                     let cols = (n - j).min(NR);
                     let m0 = lane_mask(cols);
                     let m1 = lane_mask(cols.saturating_sub(16));
-                    let t = Tile { k: kc, a: ai, rsa, csa, b: bk.add(j), rsb, c: ci.add(j), rsc, m0, m1 };
+                    let t = Tile {
+                        k: kc,
+                        a: ai,
+                        rsa,
+                        csa,
+                        b: bk.add(j),
+                        rsb,
+                        c: ci.add(j),
+                        rsc,
+                        m0,
+                        m1,
+                    };
                     let acc = accumulate || k0 > 0;
                     match rows {
                         8 => t.run::<8>(acc),
@@ -222,9 +254,15 @@ mod tests {
         let mut c = Array2::from_elem((2, 2), f32::NAN);
         gemm(a.view(), b.view(), c.view_mut(), Mode::Overwrite);
         // [1 2 3; 4 5 6] · [1 0; 0 1; 1 1] = [4 5; 10 11]
-        assert_eq!(c, Array2::from_shape_vec((2, 2), vec![4., 5., 10., 11.]).unwrap());
+        assert_eq!(
+            c,
+            Array2::from_shape_vec((2, 2), vec![4., 5., 10., 11.]).unwrap()
+        );
         gemm(a.view(), b.view(), c.view_mut(), Mode::Accumulate);
-        assert_eq!(c, Array2::from_shape_vec((2, 2), vec![8., 10., 20., 22.]).unwrap());
+        assert_eq!(
+            c,
+            Array2::from_shape_vec((2, 2), vec![8., 10., 20., 22.]).unwrap()
+        );
     }
 
     #[test]
@@ -239,16 +277,28 @@ mod tests {
     /// Reference product in f64.
     fn naive(a: ArrayView2<f32>, b: ArrayView2<f32>) -> Array2<f64> {
         Array2::from_shape_fn((a.nrows(), b.ncols()), |(i, j)| {
-            (0..a.ncols()).map(|q| a[[i, q]] as f64 * b[[q, j]] as f64).sum()
+            (0..a.ncols())
+                .map(|q| a[[i, q]] as f64 * b[[q, j]] as f64)
+                .sum()
         })
     }
 
     #[test]
     fn every_tile_edge_and_stride_case_matches_a_naive_product() {
         // Sizes around the 8 x 32 tile and the 384 k-block; strided, transposed and sliced views.
-        for &(m, k, n) in &[(1, 1, 1), (7, 3, 33), (8, 5, 32), (9, 17, 16), (17, 400, 47), (3, 800, 65)] {
-            let a = Array2::from_shape_fn((m, k + 2), |(i, j)| ((i * 31 + j * 17) % 13) as f32 / 7.0 - 0.9);
-            let bt = Array2::from_shape_fn((n, k), |(i, j)| ((i * 7 + j * 3) % 11) as f32 / 5.0 - 1.0);
+        for &(m, k, n) in &[
+            (1, 1, 1),
+            (7, 3, 33),
+            (8, 5, 32),
+            (9, 17, 16),
+            (17, 400, 47),
+            (3, 800, 65),
+        ] {
+            let a = Array2::from_shape_fn((m, k + 2), |(i, j)| {
+                ((i * 31 + j * 17) % 13) as f32 / 7.0 - 0.9
+            });
+            let bt =
+                Array2::from_shape_fn((n, k), |(i, j)| ((i * 7 + j * 3) % 11) as f32 / 5.0 - 1.0);
             let av = a.slice(s![.., 1..k + 1]);
             for b in [bt.t(), bt.t().as_standard_layout().view().to_owned().view()] {
                 let want = naive(av, b);
@@ -257,7 +307,11 @@ mod tests {
                 gemm(av, b, c.view_mut(), Mode::Accumulate);
                 for ((i, j), &w) in want.indexed_iter() {
                     let got = c[[i, j]] as f64;
-                    assert!((got - 2.0 * w).abs() < 1e-4 * (1.0 + w.abs()), "{m}x{k}x{n} at {i},{j}: {got} vs {}", 2.0 * w);
+                    assert!(
+                        (got - 2.0 * w).abs() < 1e-4 * (1.0 + w.abs()),
+                        "{m}x{k}x{n} at {i},{j}: {got} vs {}",
+                        2.0 * w
+                    );
                 }
             }
             // transposed A
@@ -277,7 +331,12 @@ mod tests {
         let a = Array2::from_elem((3, 2), 1.0f32);
         let b = Array2::from_elem((2, 4), 1.0f32);
         let mut big = Array2::from_elem((3, 10), -1.0f32);
-        gemm(a.view(), b.view(), big.slice_mut(s![.., 3..7]), Mode::Overwrite);
+        gemm(
+            a.view(),
+            b.view(),
+            big.slice_mut(s![.., 3..7]),
+            Mode::Overwrite,
+        );
         for ((_, j), &v) in big.indexed_iter() {
             assert_eq!(v, if (3..7).contains(&j) { 2.0 } else { -1.0 });
         }

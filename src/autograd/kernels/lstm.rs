@@ -113,7 +113,12 @@ pub fn lstm_forward(
         let (n, o) = (packing.batch_size(t), packing.offset(t));
         // The step's gate pre-activations, computed just before use so they are still in
         // cache for the cell kernel (the biases are added there).
-        gemm(x.slice(s![o..o + n, ..]), w_ih_t.view(), cache.gates.slice_mut(s![o..o + n, ..]), Mode::Overwrite);
+        gemm(
+            x.slice(s![o..o + n, ..]),
+            w_ih_t.view(),
+            cache.gates.slice_mut(s![o..o + n, ..]),
+            Mode::Overwrite,
+        );
         if t > 0 {
             gemm(
                 cache.h_prev.slice(s![o..o + n, ..]),
@@ -122,8 +127,13 @@ pub fn lstm_forward(
                 Mode::Accumulate,
             );
         }
-        let gates = &mut cache.gates.as_slice_mut().expect("contiguous")[o * 4 * h..(o + n) * 4 * h];
-        let (c_before, c_now) = cache.c.as_slice_mut().expect("contiguous").split_at_mut(o * h);
+        let gates =
+            &mut cache.gates.as_slice_mut().expect("contiguous")[o * 4 * h..(o + n) * 4 * h];
+        let (c_before, c_now) = cache
+            .c
+            .as_slice_mut()
+            .expect("contiguous")
+            .split_at_mut(o * h);
         let c_prev: &[f32] = if t > 0 {
             let po = packing.offset(t - 1);
             &c_before[po * h..(po + n) * h]
@@ -200,8 +210,18 @@ fn forward_row<const L: usize>(
 ) {
     let mut q0 = q.start;
     while q0 + L <= q.end {
-        let z = [rd(gates, q0), rd(gates, h + q0), rd(gates, 2 * h + q0), rd(gates, 3 * h + q0)];
-        let b = [rd(bias, q0), rd(bias, h + q0), rd(bias, 2 * h + q0), rd(bias, 3 * h + q0)];
+        let z = [
+            rd(gates, q0),
+            rd(gates, h + q0),
+            rd(gates, 2 * h + q0),
+            rd(gates, 3 * h + q0),
+        ];
+        let b = [
+            rd(bias, q0),
+            rd(bias, h + q0),
+            rd(bias, 2 * h + q0),
+            rd(bias, 3 * h + q0),
+        ];
         let (g, cv, tc, hv) = cell_lanes::<L>(z, b, rd(c_prev, q0));
         for (blk, gv) in g.iter().enumerate() {
             wr(gates, blk * h + q0, gv);
@@ -273,7 +293,11 @@ pub fn lstm_backward(
 ) {
     let (k, h) = (packing.total(), w_hh.ncols());
     assert_eq!(dy.dim(), (k, h), "lstm backward: dy must be [K, H]");
-    assert_eq!(dgates.dim(), (k, 4 * h), "lstm backward: dgates must be [K, 4H]");
+    assert_eq!(
+        dgates.dim(),
+        (k, 4 * h),
+        "lstm backward: dgates must be [K, 4H]"
+    );
     let n0 = packing.batch_size(0);
     assert_eq!(dh_rec.dim(), (n0, h));
     assert_eq!(dc.dim(), (n0, h));
@@ -338,7 +362,9 @@ fn prefetch(data: &[f32]) {
     for line in data.chunks(16) {
         // SAFETY: prefetching reads nothing architecturally and the address is in bounds.
         unsafe {
-            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(line.as_ptr().cast());
+            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                line.as_ptr().cast(),
+            );
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -392,7 +418,12 @@ fn backward_row<const L: usize>(
         for l in 0..L {
             dh[l] = dyv[l] + dhr[l];
         }
-        let g = [rd(gates, q0), rd(gates, h + q0), rd(gates, 2 * h + q0), rd(gates, 3 * h + q0)];
+        let g = [
+            rd(gates, q0),
+            rd(gates, h + q0),
+            rd(gates, 2 * h + q0),
+            rd(gates, 3 * h + q0),
+        ];
         let (d, dcp) = cell_grad_lanes::<L>(dh, rd(dc, q0), g, rd(c_prev, q0), rd(tanh_c, q0));
         for (blk, dv) in d.iter().enumerate() {
             wr(dgates, blk * h + q0, dv);

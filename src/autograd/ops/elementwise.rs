@@ -208,8 +208,16 @@ mod tests {
 
     #[test]
     fn leaky_relu_matches_finite_differences() {
-        grad_check(|t, v| t.leaky_relu(v[0], 0.01), &[(4, 5)], Inputs::AwayFromZero);
-        grad_check(|t, v| t.leaky_relu(v[0], 0.3), &[(4, 5)], Inputs::AwayFromZero);
+        grad_check(
+            |t, v| t.leaky_relu(v[0], 0.01),
+            &[(4, 5)],
+            Inputs::AwayFromZero,
+        );
+        grad_check(
+            |t, v| t.leaky_relu(v[0], 0.3),
+            &[(4, 5)],
+            Inputs::AwayFromZero,
+        );
     }
 
     #[test]

@@ -29,7 +29,11 @@ pub(crate) enum Inputs {
 }
 
 /// Random arrays of the given shapes, reproducible from `seed`.
-pub(crate) fn random_inputs(shapes: &[(usize, usize)], kind: Inputs, seed: u64) -> Vec<Array2<f32>> {
+pub(crate) fn random_inputs(
+    shapes: &[(usize, usize)],
+    kind: Inputs,
+    seed: u64,
+) -> Vec<Array2<f32>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     shapes
         .iter()
@@ -72,14 +76,21 @@ pub(crate) fn check_gradients(
     let analytic: Vec<Array2<f32>> = vars
         .iter()
         .zip(&inputs)
-        .map(|(&v, a)| tape.grad(v).map_or_else(|| Array2::zeros(a.dim()), |g| g.to_owned()))
+        .map(|(&v, a)| {
+            tape.grad(v)
+                .map_or_else(|| Array2::zeros(a.dim()), |g| g.to_owned())
+        })
         .collect();
 
     let mut eval = |xs: &[Array2<f32>]| -> f64 {
         tape.reset();
         let vars: Vec<Var> = xs.iter().map(|a| tape.param(a.view())).collect();
         let y = build(&mut tape, &vars);
-        tape.value(y).iter().zip(seed.iter()).map(|(&y, &s)| y as f64 * s as f64).sum()
+        tape.value(y)
+            .iter()
+            .zip(seed.iter())
+            .map(|(&y, &s)| y as f64 * s as f64)
+            .sum()
     };
     let mut numeric = Vec::new();
     let mut xs = inputs.clone();

@@ -52,7 +52,12 @@ impl Tape {
     pub fn lstm_packed(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {
         let k = self.shape(x).0;
         let h = self.shape(w.w_hh).1;
-        assert_eq!(k, packing.total(), "lstm: x has {k} rows, the packing {}", packing.total());
+        assert_eq!(
+            k,
+            packing.total(),
+            "lstm: x has {k} rows, the packing {}",
+            packing.total()
+        );
         let [s_hp, s_g, s_c, s_tc] = LstmCache::shapes(k, h);
         let mut cache = LstmCache {
             h_prev: self.pool().array(s_hp.0, s_hp.1),
@@ -80,7 +85,11 @@ impl Tape {
             c: self.push_aux(cache.c),
             tanh_c: self.push_aux(cache.tanh_c),
         };
-        self.push_op(y, Op::Lstm(Box::new(node)), &[x, w.w_ih, w.w_hh, w.b_ih, w.b_hh])
+        self.push_op(
+            y,
+            Op::Lstm(Box::new(node)),
+            &[x, w.w_ih, w.w_hh, w.b_ih, w.b_hh],
+        )
     }
 }
 
@@ -93,7 +102,11 @@ impl LstmNode {
         }
         let (x, h_prev) = (cx.value(self.x), cx.value(self.h_prev));
         let (w_ih, w_hh) = (cx.value(self.w.w_ih), cx.value(self.w.w_hh));
-        let (gates, c, tanh_c) = (cx.value(self.gates), cx.value(self.c), cx.value(self.tanh_c));
+        let (gates, c, tanh_c) = (
+            cx.value(self.gates),
+            cx.value(self.c),
+            cx.value(self.tanh_c),
+        );
         let input = x.ncols();
         let wants_w = cx.wants(self.w.w_ih) || cx.wants(self.w.w_hh);
 
@@ -122,9 +135,18 @@ impl LstmNode {
             |r, dg| {
                 let dg = dg.slice(s![r.clone(), ..]);
                 if wants_w {
-                    let mode = if first { Mode::Overwrite } else { Mode::Accumulate };
+                    let mode = if first {
+                        Mode::Overwrite
+                    } else {
+                        Mode::Accumulate
+                    };
                     gemm(dg.t(), x.slice(s![r.clone(), ..]), dw_ih.view_mut(), mode);
-                    gemm(dg.t(), h_prev.slice(s![r.clone(), ..]), dw_hh.view_mut(), mode);
+                    gemm(
+                        dg.t(),
+                        h_prev.slice(s![r.clone(), ..]),
+                        dw_hh.view_mut(),
+                        mode,
+                    );
                 }
                 first = false;
                 if let Some((d, mode)) = dx.as_mut() {
@@ -188,11 +210,22 @@ mod tests {
     }
 
     fn shapes(k: usize, input: usize, h: usize) -> [(usize, usize); 5] {
-        [(k, input), (4 * h, input), (4 * h, h), (1, 4 * h), (1, 4 * h)]
+        [
+            (k, input),
+            (4 * h, input),
+            (4 * h, h),
+            (1, 4 * h),
+            (1, 4 * h),
+        ]
     }
 
     fn vars(v: &[Var]) -> LstmVars {
-        LstmVars { w_ih: v[1], w_hh: v[2], b_ih: v[3], b_hh: v[4] }
+        LstmVars {
+            w_ih: v[1],
+            w_hh: v[2],
+            b_ih: v[3],
+            b_hh: v[4],
+        }
     }
 
     #[test]
@@ -211,7 +244,8 @@ mod tests {
                 unfused(&mut t, v[0], vars(&v), &packing)
             };
             t.backward_with(y, seed.view());
-            let grads: Vec<Array2<f32>> = v.iter().map(|&v| t.grad(v).unwrap().to_owned()).collect();
+            let grads: Vec<Array2<f32>> =
+                v.iter().map(|&v| t.grad(v).unwrap().to_owned()).collect();
             (t.value(y).to_owned(), grads)
         };
         let (y1, g1) = run(true);
@@ -226,7 +260,11 @@ mod tests {
     fn lstm_matches_finite_differences() {
         let packing = SeqPacking::new(&[2, 4, 1, 4]);
         let k = packing.total();
-        grad_check(move |t, v| t.lstm(v[0], vars(v), &packing), &shapes(k, 3, 2), Inputs::Any);
+        grad_check(
+            move |t, v| t.lstm(v[0], vars(v), &packing),
+            &shapes(k, 3, 2),
+            Inputs::Any,
+        );
     }
 
     #[test]
@@ -253,7 +291,12 @@ mod tests {
         grad_check(
             move |t, v| {
                 let w_hh = t.constant(w_hh.view());
-                let w = LstmVars { w_ih: v[1], w_hh, b_ih: v[2], b_hh: v[3] };
+                let w = LstmVars {
+                    w_ih: v[1],
+                    w_hh,
+                    b_ih: v[2],
+                    b_hh: v[3],
+                };
                 t.lstm(v[0], w, &packing)
             },
             &[(k, 3), (8, 3), (1, 8), (1, 8)],
@@ -271,7 +314,12 @@ mod tests {
             let mut t = Tape::new();
             let xv = t.constant(x.view());
             let v: Vec<Var> = ws.iter().map(|a| t.param(a.view())).collect();
-            let w = LstmVars { w_ih: v[0], w_hh: v[1], b_ih: v[2], b_hh: v[3] };
+            let w = LstmVars {
+                w_ih: v[0],
+                w_hh: v[1],
+                b_ih: v[2],
+                b_hh: v[3],
+            };
             let y = t.lstm(xv, w, &SeqPacking::new(lengths));
             t.value(y).to_owned()
         };

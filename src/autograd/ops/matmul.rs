@@ -25,7 +25,12 @@ impl Tape {
         let ((m, k), (n, k2)) = (self.shape(a), self.shape(w));
         assert_eq!(k, k2, "matmul_nt: [{m}, {k}] · [{n}, {k2}]^T");
         let mut y = self.pool().array(m, n);
-        gemm(self.value(a), self.value(w).t(), y.view_mut(), Mode::Overwrite);
+        gemm(
+            self.value(a),
+            self.value(w).t(),
+            y.view_mut(),
+            Mode::Overwrite,
+        );
         self.push_op(y, Op::MatMulNt { a, b: w }, &[a, w])
     }
 
@@ -170,12 +175,20 @@ mod tests {
 
     #[test]
     fn matmul_nt_matches_finite_differences() {
-        grad_check(|t, v| t.matmul_nt(v[0], v[1]), &[(5, 3), (2, 3)], Inputs::Any);
+        grad_check(
+            |t, v| t.matmul_nt(v[0], v[1]),
+            &[(5, 3), (2, 3)],
+            Inputs::Any,
+        );
     }
 
     #[test]
     fn add_bias_matches_finite_differences() {
-        grad_check(|t, v| t.add_bias(v[0], v[1]), &[(4, 3), (1, 3)], Inputs::Any);
+        grad_check(
+            |t, v| t.add_bias(v[0], v[1]),
+            &[(4, 3), (1, 3)],
+            Inputs::Any,
+        );
     }
 
     #[test]
@@ -218,7 +231,8 @@ mod tests {
                 t.leaky_relu(z, 0.01)
             };
             t.backward_with(y, seed.view());
-            let grads: Vec<Array2<f32>> = v.iter().map(|&v| t.grad(v).unwrap().to_owned()).collect();
+            let grads: Vec<Array2<f32>> =
+                v.iter().map(|&v| t.grad(v).unwrap().to_owned()).collect();
             (t.value(y).to_owned(), grads)
         };
         let (y1, g1) = run(true);

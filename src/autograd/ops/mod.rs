@@ -19,27 +19,86 @@ use super::tape::{GradCx, Var};
 pub(crate) enum Op {
     /// Parameter, constant, or an op's cache: nothing to propagate.
     Leaf,
-    MatMul { a: Var, b: Var },
-    MatMulNt { a: Var, b: Var },
-    AddBias { x: Var, bias: Var },
-    Linear { x: Var, w: Var, b: Var, act: Activation },
-    Add { a: Var, b: Var },
-    Sub { a: Var, b: Var },
-    Mul { a: Var, b: Var },
-    Scale { x: Var, c: f32 },
-    Sigmoid { x: Var },
-    Tanh { x: Var },
-    LeakyRelu { x: Var, slope: f32 },
-    Square { x: Var },
-    ConcatCols { parts: Vec<Var> },
-    ConcatRows { parts: Vec<Var> },
-    SliceCols { x: Var, start: usize },
-    GatherCols { x: Var, index: Vec<usize> },
-    GatherRows { x: Var, index: Vec<usize> },
-    Sum { x: Var },
-    Mean { x: Var },
-    MaskedMean { x: Var, mask: Var, count: f32 },
-    Mse { x: Var, target: Var },
+    MatMul {
+        a: Var,
+        b: Var,
+    },
+    MatMulNt {
+        a: Var,
+        b: Var,
+    },
+    AddBias {
+        x: Var,
+        bias: Var,
+    },
+    Linear {
+        x: Var,
+        w: Var,
+        b: Var,
+        act: Activation,
+    },
+    Add {
+        a: Var,
+        b: Var,
+    },
+    Sub {
+        a: Var,
+        b: Var,
+    },
+    Mul {
+        a: Var,
+        b: Var,
+    },
+    Scale {
+        x: Var,
+        c: f32,
+    },
+    Sigmoid {
+        x: Var,
+    },
+    Tanh {
+        x: Var,
+    },
+    LeakyRelu {
+        x: Var,
+        slope: f32,
+    },
+    Square {
+        x: Var,
+    },
+    ConcatCols {
+        parts: Vec<Var>,
+    },
+    ConcatRows {
+        parts: Vec<Var>,
+    },
+    SliceCols {
+        x: Var,
+        start: usize,
+    },
+    GatherCols {
+        x: Var,
+        index: Vec<usize>,
+    },
+    GatherRows {
+        x: Var,
+        index: Vec<usize>,
+    },
+    Sum {
+        x: Var,
+    },
+    Mean {
+        x: Var,
+    },
+    MaskedMean {
+        x: Var,
+        mask: Var,
+        count: f32,
+    },
+    Mse {
+        x: Var,
+        target: Var,
+    },
     Lstm(Box<lstm::LstmNode>),
 }
 

@@ -74,7 +74,13 @@ pub(super) fn mean_backward(x: Var, g: &Array2<f32>, cx: &mut GradCx) {
 }
 
 // dy/dx_i = mask_i / sum(mask)
-pub(super) fn masked_mean_backward(x: Var, mask: Var, count: f32, g: &Array2<f32>, cx: &mut GradCx) {
+pub(super) fn masked_mean_backward(
+    x: Var,
+    mask: Var,
+    count: f32,
+    g: &Array2<f32>,
+    cx: &mut GradCx,
+) {
     let scale = if count == 0.0 { 0.0 } else { g[[0, 0]] / count };
     let m = cx.value(mask);
     if let Some((d, mode)) = cx.slot(x) {
@@ -132,7 +138,11 @@ mod tests {
     #[test]
     fn masked_mean_matches_finite_differences() {
         let mask = Array2::from_shape_fn((4, 3), |(i, j)| ((i + j) % 2) as f32);
-        grad_check(move |t, v| t.masked_mean(v[0], mask.view()), &[(4, 3)], Inputs::Any);
+        grad_check(
+            move |t, v| t.masked_mean(v[0], mask.view()),
+            &[(4, 3)],
+            Inputs::Any,
+        );
     }
 
     #[test]
@@ -144,7 +154,10 @@ mod tests {
         assert_eq!(t.scalar(y), 2.0);
         t.backward(y);
         // dy/dx = mask / 2
-        assert_eq!(t.grad(x).unwrap(), ndarray::arr2(&[[0.5f32, 0.0], [0.5, 0.0]]));
+        assert_eq!(
+            t.grad(x).unwrap(),
+            ndarray::arr2(&[[0.5f32, 0.0], [0.5, 0.0]])
+        );
     }
 
     #[test]
@@ -160,7 +173,11 @@ mod tests {
     #[test]
     fn mse_matches_finite_differences() {
         let target = Array2::from_shape_fn((3, 2), |(i, j)| i as f32 - j as f32 * 0.5);
-        grad_check(move |t, v| t.mse(v[0], target.view()), &[(3, 2)], Inputs::Any);
+        grad_check(
+            move |t, v| t.mse(v[0], target.view()),
+            &[(3, 2)],
+            Inputs::Any,
+        );
     }
 
     #[test]

@@ -26,7 +26,13 @@ impl Tape {
             y.slice_mut(s![.., at..at + c]).assign(&self.value(p));
             at += c;
         }
-        self.push_op(y, Op::ConcatCols { parts: parts.to_vec() }, parts)
+        self.push_op(
+            y,
+            Op::ConcatCols {
+                parts: parts.to_vec(),
+            },
+            parts,
+        )
     }
 
     /// y = [a; b; ...] stacked along rows. Panics if the column counts differ or `parts` is empty.
@@ -46,13 +52,22 @@ impl Tape {
             y.slice_mut(s![at..at + r, ..]).assign(&self.value(p));
             at += r;
         }
-        self.push_op(y, Op::ConcatRows { parts: parts.to_vec() }, parts)
+        self.push_op(
+            y,
+            Op::ConcatRows {
+                parts: parts.to_vec(),
+            },
+            parts,
+        )
     }
 
     /// y = x[:, start..end]. Panics if the range is out of bounds.
     pub fn slice_cols(&mut self, x: Var, start: usize, end: usize) -> Var {
         let (rows, cols) = self.shape(x);
-        assert!(start <= end && end <= cols, "slice_cols: {start}..{end} of {cols} columns");
+        assert!(
+            start <= end && end <= cols,
+            "slice_cols: {start}..{end} of {cols} columns"
+        );
         let mut y = self.pool().array(rows, end - start);
         y.assign(&self.value(x).slice(s![.., start..end]));
         self.push_op(y, Op::SliceCols { x, start }, &[x])
@@ -70,7 +85,14 @@ impl Tape {
             assert!(a < cols, "gather_cols: index {a} out of range 0..{cols}");
             y[[k, 0]] = vx[[k, a]];
         }
-        self.push_op(y, Op::GatherCols { x, index: index.to_vec() }, &[x])
+        self.push_op(
+            y,
+            Op::GatherCols {
+                x,
+                index: index.to_vec(),
+            },
+            &[x],
+        )
     }
 
     /// y[k, :] = x[index[k], :]: select (or reorder, or repeat) rows. Panics on an index out of
@@ -83,7 +105,14 @@ impl Tape {
             assert!(r < rows, "gather_rows: row {r} out of range 0..{rows}");
             y.row_mut(k).assign(&vx.row(r));
         }
-        self.push_op(y, Op::GatherRows { x, index: index.to_vec() }, &[x])
+        self.push_op(
+            y,
+            Op::GatherRows {
+                x,
+                index: index.to_vec(),
+            },
+            &[x],
+        )
     }
 }
 
@@ -153,17 +182,29 @@ mod tests {
 
     #[test]
     fn concat_cols_matches_finite_differences() {
-        grad_check(|t, v| t.concat_cols(&[v[0], v[1]]), &[(3, 2), (3, 4)], Inputs::Any);
+        grad_check(
+            |t, v| t.concat_cols(&[v[0], v[1]]),
+            &[(3, 2), (3, 4)],
+            Inputs::Any,
+        );
     }
 
     #[test]
     fn concat_cols_fan_out_matches_finite_differences() {
-        grad_check(|t, v| t.concat_cols(&[v[0], v[1], v[0]]), &[(2, 2), (2, 1)], Inputs::Any);
+        grad_check(
+            |t, v| t.concat_cols(&[v[0], v[1], v[0]]),
+            &[(2, 2), (2, 1)],
+            Inputs::Any,
+        );
     }
 
     #[test]
     fn concat_rows_matches_finite_differences() {
-        grad_check(|t, v| t.concat_rows(&[v[0], v[1], v[0]]), &[(2, 3), (1, 3)], Inputs::Any);
+        grad_check(
+            |t, v| t.concat_rows(&[v[0], v[1], v[0]]),
+            &[(2, 3), (1, 3)],
+            Inputs::Any,
+        );
     }
 
     #[test]
@@ -186,7 +227,11 @@ mod tests {
 
     #[test]
     fn gather_cols_matches_finite_differences() {
-        grad_check(|t, v| t.gather_cols(v[0], &[2, 0, 2, 1]), &[(4, 3)], Inputs::Any);
+        grad_check(
+            |t, v| t.gather_cols(v[0], &[2, 0, 2, 1]),
+            &[(4, 3)],
+            Inputs::Any,
+        );
     }
 
     #[test]
@@ -199,6 +244,10 @@ mod tests {
 
     #[test]
     fn gather_rows_with_repeats_matches_finite_differences() {
-        grad_check(|t, v| t.gather_rows(v[0], &[2, 0, 2]), &[(3, 2)], Inputs::Any);
+        grad_check(
+            |t, v| t.gather_rows(v[0], &[2, 0, 2]),
+            &[(3, 2)],
+            Inputs::Any,
+        );
     }
 }
