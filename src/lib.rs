@@ -5,7 +5,12 @@
 //! `experiment` (config, runner) -> `algos` (trainer) -> `envs` + `nn` (on `autograd`), and the
 //! results feed `plot` and `deploy`. Lower layers never name higher ones.
 
+pub mod algos;
 pub mod autograd;
 pub mod bench;
+pub mod deploy;
 pub mod envs;
+pub mod experiment;
 pub mod nn;
+pub mod plot;
+pub mod render;

@@ -1,10 +1,17 @@
 //! The `macdec` command line: parse, call the library, report. No logic lives here.
 
-use anyhow::Result;
+use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
-
+use macdec::algos::method::Method;
 use macdec::bench::nets;
+use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
+use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
+use macdec::experiment::seeds::parse_seeds;
+use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
+use macdec::experiment::train_run::train_run;
 use macdec::nn::demo;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 #[derive(Parser)]
 #[command(
@@ -28,62 +35,575 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
-    /// Time a hot path.
+    /// Train methods on an experiment config, one run per (method, variant, seed), in parallel.
+    Train(TrainArgs),
+    /// Replay a macro-action log and print the trajectory as JSON lines.
+    Replay {
+        /// JSON file: {"env": "box-pushing", "grid": 10, "horizon": 100, "steps": [[a0, a1], ...]}
+        #[arg(long)]
+        actions: PathBuf,
+        /// Also print an ASCII picture of the state after every step (to stderr).
+        #[arg(long)]
+        verbose: bool,
+    },
+    /// Draw every experiment's learning curves (PNG + SVG) and summary tables from a results tree.
+    Plot {
+        /// Results root: <results>/<experiment>/<curve>/seed-<k>/metrics.csv.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        /// Where the figures and <experiment>_summary.csv files go.
+        #[arg(long, default_value = "plots")]
+        out: PathBuf,
+    },
+    /// Animate a trained run's greedy policy as a GIF.
+    Render {
+        /// A run directory: <results>/<experiment>/<method>/seed-<k>.
+        #[arg(long)]
+        run: PathBuf,
+        /// Episodes to show, one after another.
+        #[arg(long, default_value_t = 1)]
+        episodes: usize,
+        /// The GIF to write.
+        #[arg(long, default_value = "rollout.gif")]
+        out: PathBuf,
+        /// Milliseconds per primitive step.
+        #[arg(long, default_value_t = 150)]
+        frame_ms: u32,
+    },
+    /// Write a Slurm job-array script (one task per run) to stdout.
+    Slurm(SlurmArgs),
+    /// Export a trained run's decentralized Q-nets for robots: one safetensors file per agent and
+    /// manifest.json (domain, layout, architecture, run, SHA-256 of each file).
+    Export {
+        /// A run directory: <results>/<experiment>/<method>/seed-<k>.
+        #[arg(long)]
+        run: PathBuf,
+        /// The policy directory to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Serve one agent of an exported policy to a robot: JSON lines on stdin/stdout, or over TCP
+    /// with --listen (one hidden state per connection). See README "Exporting and running a policy".
+    Robot(RobotArgs),
+    /// Run the policy's domain here and one `macdec robot` process per agent over loopback TCP,
+    /// each robot seeing only its own observations; print one JSON line per episode.
+    Deploy(DeployArgs),
+    /// Measure speed.
     Bench {
-        /// What to time.
-        what: BenchWhat,
-        /// Timed iterations per configuration.
+        /// What to measure.
+        what: BenchTarget,
+        /// Timed iterations per configuration (nets).
         #[arg(long, default_value_t = 200)]
         iters: usize,
-        /// Only the configuration with this name (e.g. torch-wtd).
+        /// Only the configuration with this name (nets; e.g. torch-wtd).
         #[arg(long)]
         only: Option<String>,
     },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
-enum BenchWhat {
+enum BenchTarget {
+    /// Environment primitive steps per second with random macro-actions (single thread).
+    Envs,
     /// One Q-net training update (forward, backward, Adam) at the paper's shapes, 1 thread.
     Nets,
 }
 
+#[derive(clap::Args)]
+struct TrainArgs {
+    /// Experiment TOML (see experiments/); without it, a short built-in Box Pushing 10x10 run.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
+    #[arg(long, value_delimiter = ',')]
+    methods: Option<Vec<String>>,
+    /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
+    #[arg(long)]
+    seeds: Option<String>,
+    /// Runs in parallel (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Results root: runs go to <out>/<experiment>/<method>/seed-<k>/.
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+    /// Override a config key, e.g. total_epi=300 or dec-hddrqn.init_h=0.3 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Recompute runs that already finished (their directories are replaced).
+    #[arg(long)]
+    force: bool,
+    /// No progress bars; one line per finished run.
+    #[arg(long)]
+    quiet: bool,
+    /// Where the learning-curve figures go after training.
+    #[arg(long, default_value = "plots")]
+    plots: PathBuf,
+    /// Do not draw figures after training.
+    #[arg(long)]
+    no_plot: bool,
+    /// Run only the run with this index in the experiment's run list (Slurm array tasks).
+    #[arg(long)]
+    run_index: Option<usize>,
+}
+
+/// Which runs of an experiment, as `train` and `slurm` both select them.
+#[derive(clap::Args)]
+struct Selection {
+    /// Experiment TOML (see experiments/).
+    #[arg(long)]
+    config: PathBuf,
+    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
+    #[arg(long, value_delimiter = ',')]
+    methods: Option<Vec<String>>,
+    /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
+    #[arg(long)]
+    seeds: Option<String>,
+    /// Override a config key, e.g. total_epi=300 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(clap::Args)]
+struct SlurmArgs {
+    #[command(flatten)]
+    select: Selection,
+    /// Results root shared by the cluster's nodes.
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+    /// Wall-clock limit per array task.
+    #[arg(long, default_value = "12:00:00")]
+    time: String,
+    /// Memory per array task.
+    #[arg(long, default_value = "4G")]
+    mem: String,
+    /// Extra #SBATCH lines, e.g. --sbatch=--partition=cpu (repeatable).
+    #[arg(long = "sbatch", value_name = "LINE", allow_hyphen_values = true)]
+    sbatch: Vec<String>,
+}
+
+#[derive(clap::Args)]
+struct RobotArgs {
+    /// Exported policy directory (manifest.json and one safetensors file per agent).
+    #[arg(long)]
+    policy: PathBuf,
+    /// Which agent this robot is (0-based).
+    #[arg(long)]
+    agent: usize,
+    /// Serve TCP on this address (e.g. 127.0.0.1:7000; port 0 picks a free one) instead of
+    /// stdin/stdout. The first stdout line is {"listening": "ADDR"}.
+    #[arg(long)]
+    listen: Option<std::net::SocketAddr>,
+    /// With --listen: connections served at once (one more is refused with an error line).
+    #[arg(long, default_value_t = 16)]
+    max_connections: usize,
+    /// Longest request line in bytes; a longer one gets an error reply and is discarded.
+    #[arg(long, default_value_t = macdec::deploy::line_reader::MAX_LINE_BYTES)]
+    max_line_bytes: usize,
+    /// With --listen: close a connection idle for this many seconds (default: never).
+    #[arg(long)]
+    idle_timeout_secs: Option<u64>,
+    /// Run a deterministic stand-in policy instead of the weights (tests).
+    #[arg(long, hide = true)]
+    mock: bool,
+    /// Exit when stdin closes (set by `macdec deploy`, so robots never outlive it).
+    #[arg(long, hide = true)]
+    exit_on_stdin_close: bool,
+}
+
+#[derive(clap::Args)]
+struct DeployArgs {
+    /// Exported policy directory.
+    #[arg(long)]
+    policy: PathBuf,
+    /// Episodes to run.
+    #[arg(long, default_value_t = 1)]
+    episodes: usize,
+    /// Seed of the environment's random stream (default: the run's seed); the stream is the
+    /// evaluation env's stream of that seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Include every step (executed macro-actions, reward, finished flags) in the output.
+    #[arg(long)]
+    trajectories: bool,
+    /// Seconds to wait for a robot to start or to answer one message.
+    #[arg(long, default_value_t = 30)]
+    timeout_secs: u64,
+    /// Robots run the deterministic stand-in policy (tests).
+    #[arg(long, hide = true)]
+    mock: bool,
+}
+
 fn main() -> Result<()> {
-    let cli = Cli::parse();
-    match cli.command {
-        Command::Demo { steps, seed } => {
-            let cfg = demo::DemoConfig {
-                steps,
-                seed,
-                ..demo::DemoConfig::default()
-            };
-            println!(
-                "delayed recall with an LSTM Q-net: {} steps, batch {}, seed {} \
-                 (a net without memory cannot go below {:.4})",
-                cfg.steps,
-                cfg.batch,
-                cfg.seed,
-                demo::MEMORYLESS_LOSS
-            );
-            let t0 = std::time::Instant::now();
-            demo::run(&cfg, |step, loss| {
-                println!("step {step:>6}  loss {loss:.5}")
-            })?;
-            println!("done in {:.1} s", t0.elapsed().as_secs_f64());
-        }
-        Command::Bench {
-            what: BenchWhat::Nets,
-            iters,
-            only,
+    match Cli::parse().command {
+        Command::Train(args) => train(args),
+        Command::Replay { actions, verbose } => replay(&actions, verbose),
+        Command::Export { run, out } => export(&run, &out),
+        Command::Robot(args) => robot(args),
+        Command::Deploy(args) => deploy(args),
+        Command::Slurm(args) => slurm(args),
+        Command::Render {
+            run,
+            episodes,
+            out,
+            frame_ms,
         } => {
-            let mut results = Vec::new();
-            let chosen = nets::SHAPES
-                .iter()
-                .filter(|s| only.as_deref().is_none_or(|o| o == s.name));
-            for shape in chosen {
-                results.push(nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)));
+            let returns = macdec::experiment::rollout::render_run(&run, episodes, &out, frame_ms)
+                .with_context(|| format!("rendering {}", run.display()))?;
+            eprintln!(
+                "wrote {} ({} episode(s), team returns {returns:?})",
+                out.display(),
+                returns.len()
+            );
+            Ok(())
+        }
+        Command::Plot { results, out } => plot(&results, &out),
+        Command::Demo { steps, seed } => demo_run(steps, seed),
+        Command::Bench { what, iters, only } => match what {
+            BenchTarget::Envs => bench_envs(),
+            BenchTarget::Nets => {
+                let results: Vec<_> = nets::SHAPES
+                    .iter()
+                    .filter(|s| only.as_deref().is_none_or(|o| o == s.name))
+                    .map(|shape| nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)))
+                    .collect();
+                print!("{}", nets::format_table(&results));
+                Ok(())
             }
-            print!("{}", nets::format_table(&results));
+        },
+    }
+}
+
+fn train(args: TrainArgs) -> Result<()> {
+    let overrides = overrides(args.methods, args.seeds.as_deref(), args.set)?;
+    let experiment = match &args.config {
+        Some(path) => Experiment::load(path, &overrides)
+            .with_context(|| format!("loading {}", path.display()))?,
+        None => Experiment::parse(
+            DEFAULT_EXPERIMENT,
+            Path::new("<built-in default>"),
+            "quickstart_bp10",
+            &overrides,
+        )?,
+    };
+    let mut runs = experiment.runs()?;
+    if let Some(i) = args.run_index {
+        if i >= runs.len() {
+            bail!(
+                "--run-index {i}: the experiment has {} runs (0..{})",
+                runs.len(),
+                runs.len()
+            );
+        }
+        runs = vec![runs.swap_remove(i)];
+    }
+    let jobs = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let opts = RunnerOptions {
+        out: args.out.clone(),
+        jobs,
+        force: args.force,
+        quiet: args.quiet,
+    };
+    eprintln!(
+        "{}: {} run(s) ({} method(s) x {} seed(s)), {} at a time, results in {}",
+        experiment.name,
+        runs.len(),
+        experiment.methods.len(),
+        experiment.seeds.len(),
+        jobs,
+        args.out.join(&experiment.name).display()
+    );
+    let force = args.force;
+    let statuses = run_all(&runs, &opts, |spec, dir, progress| {
+        train_run(spec, dir, progress, force).map_err(|e| e.to_string())
+    });
+    let failed = statuses
+        .iter()
+        .filter(|s| matches!(s, RunStatus::Failed(_)))
+        .count();
+    let skipped = statuses
+        .iter()
+        .filter(|s| matches!(s, RunStatus::Skipped))
+        .count();
+    if skipped > 0 {
+        eprintln!("{skipped} run(s) already finished, skipped (use --force to recompute)");
+    }
+    macdec::experiment::report::print_curves(&args.out, &runs)?;
+    if !args.no_plot {
+        match macdec::plot::plot_results(&args.out, &args.plots) {
+            Ok(report) => {
+                for p in report
+                    .plots
+                    .iter()
+                    .filter(|p| p.experiment == experiment.name)
+                {
+                    eprintln!(
+                        "learning curves: {} and {}",
+                        p.png.display(),
+                        p.svg.display()
+                    );
+                }
+            }
+            Err(e) => eprintln!("note: no figure drawn: {e}"),
         }
     }
+    if failed > 0 {
+        bail!("{failed} of {} run(s) failed", runs.len());
+    }
+    Ok(())
+}
+
+fn overrides(
+    methods: Option<Vec<String>>,
+    seeds: Option<&str>,
+    set: Vec<String>,
+) -> Result<Overrides> {
+    let methods = methods
+        .map(|names| {
+            names
+                .iter()
+                .map(|n| n.parse::<Method>())
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .transpose()?;
+    let seeds = seeds.map(parse_seeds).transpose()?;
+    Ok(Overrides {
+        methods,
+        seeds,
+        set,
+    })
+}
+
+fn slurm(args: SlurmArgs) -> Result<()> {
+    let sel = args.select;
+    let mut train_args = Vec::new();
+    if let Some(m) = &sel.methods {
+        train_args.extend(["--methods".to_string(), shell_quote(&m.join(","))]);
+    }
+    if let Some(s) = &sel.seeds {
+        train_args.extend(["--seeds".to_string(), shell_quote(s)]);
+    }
+    for item in &sel.set {
+        train_args.extend(["--set".to_string(), shell_quote(item)]);
+    }
+    let o = overrides(sel.methods, sel.seeds.as_deref(), sel.set)?;
+    let experiment = Experiment::load(&sel.config, &o)
+        .with_context(|| format!("loading {}", sel.config.display()))?;
+    let labels: Vec<String> = experiment
+        .runs()?
+        .iter()
+        .map(|r| format!("{}/seed-{}", r.curve_name(), r.seed))
+        .collect();
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let config = absolute(&sel.config);
+    let out = absolute(&args.out);
+    let binary = std::env::current_exe().context("locating the macdec binary")?;
+    let script = job_script(
+        &experiment.name,
+        &labels,
+        &SlurmOptions {
+            config: &config,
+            out: &out,
+            binary: &binary,
+            train_args,
+            time: &args.time,
+            mem: &args.mem,
+            extra_sbatch: args.sbatch,
+        },
+    );
+    print!("{script}");
+    Ok(())
+}
+
+fn demo_run(steps: usize, seed: u64) -> Result<()> {
+    let cfg = demo::DemoConfig {
+        steps,
+        seed,
+        ..demo::DemoConfig::default()
+    };
+    println!(
+        "delayed recall with an LSTM Q-net: {} steps, batch {}, seed {} \
+         (a net without memory cannot go below {:.4})",
+        cfg.steps,
+        cfg.batch,
+        cfg.seed,
+        demo::MEMORYLESS_LOSS
+    );
+    let t0 = std::time::Instant::now();
+    demo::run(&cfg, |step, loss| {
+        println!("step {step:>6}  loss {loss:.5}")
+    })?;
+    println!("done in {:.1} s", t0.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn plot(results: &Path, out: &Path) -> Result<()> {
+    let report = macdec::plot::plot_results(results, out)
+        .with_context(|| format!("plotting {} into {}", results.display(), out.display()))?;
+    for note in &report.notes {
+        eprintln!("{note}");
+    }
+    for p in &report.plots {
+        eprintln!(
+            "wrote {}, {}, {}",
+            p.png.display(),
+            p.svg.display(),
+            p.summary_csv.display()
+        );
+    }
+    print!("{}", report.markdown());
+    Ok(())
+}
+
+fn replay(path: &Path, verbose: bool) -> Result<()> {
+    use macdec::envs::replay::{parse_replay, run_replay};
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading replay file {}", path.display()))?;
+    let file = parse_replay(&text).with_context(|| format!("parsing {}", path.display()))?;
+    let replay =
+        run_replay(&file, verbose).with_context(|| format!("replaying {}", path.display()))?;
+    let mut out = std::io::stdout().lock();
+    for frame in &replay.frames {
+        serde_json::to_writer(&mut out, &frame.line)?;
+        writeln!(out)?;
+        if let Some(picture) = &frame.picture {
+            out.flush()?;
+            eprintln!("{picture}");
+        }
+    }
+    if replay.unused_steps > 0 {
+        eprintln!(
+            "note: the episode ended with {} rows of `steps` unused",
+            replay.unused_steps
+        );
+    }
+    Ok(())
+}
+
+fn bench_envs() -> Result<()> {
+    const MIN_STEPS: u64 = 20_000_000;
+    println!("environment primitive steps/s, random macro-actions, single thread, >= {MIN_STEPS} steps each");
+    for (name, spec) in macdec::envs::bench::bench_suite() {
+        let r = macdec::envs::bench::bench_env(name, spec, MIN_STEPS)
+            .with_context(|| format!("benchmarking {name}"))?;
+        println!(
+            "{:<34} {:>12.0} steps/s  ({} steps, {} episodes, {:.2} s)",
+            r.name, r.steps_per_second, r.steps, r.episodes, r.seconds
+        );
+    }
+    Ok(())
+}
+
+/// Fresh policies (zero hidden state) for agent `agent`'s robot, one per connection.
+fn policy_factory(
+    manifest: &macdec::deploy::Manifest,
+    verified: &macdec::deploy::VerifiedAgent,
+    mock: bool,
+) -> Result<macdec::deploy::server::PolicyFactory> {
+    use macdec::deploy::{mock::MockPolicy, AgentPolicy};
+    let entry = &manifest.agents[verified.index];
+    if mock {
+        let (obs, n, salt) = (entry.obs_size, entry.n_actions, entry.index as u64);
+        return Ok(std::sync::Arc::new(move || {
+            Box::new(MockPolicy::new(obs, n, salt)) as Box<dyn AgentPolicy>
+        }));
+    }
+    let net = macdec::deploy::qnet_policy::load_net(manifest, verified)?;
+    Ok(macdec::deploy::qnet_policy::qnet_factory(net))
+}
+
+fn export(run: &Path, out: &Path) -> Result<()> {
+    let manifest = macdec::deploy::export::export_run(run, out)
+        .with_context(|| format!("exporting {} to {}", run.display(), out.display()))?;
+    eprintln!(
+        "exported {} agent(s) of {} ({} seed {}, {} episodes trained) to {}",
+        manifest.agents.len(),
+        manifest.env.name(),
+        manifest.run.method,
+        manifest.run.seed,
+        manifest.run.episodes_trained,
+        out.display()
+    );
+    Ok(())
+}
+
+fn robot(args: RobotArgs) -> Result<()> {
+    use macdec::deploy::{manifest::load_agent, processes, RobotSpec};
+    let (manifest, verified) = load_agent(&args.policy, args.agent)
+        .with_context(|| format!("loading agent {} of {}", args.agent, args.policy.display()))?;
+    let spec = std::sync::Arc::new(RobotSpec::new(&manifest, args.agent)?);
+    let factory = policy_factory(&manifest, &verified, args.mock)?;
+    if args.exit_on_stdin_close && args.listen.is_some() {
+        processes::exit_when_stdin_closes();
+    }
+    match args.listen {
+        None => {
+            macdec::deploy::serve_stdio(factory(), spec, args.max_line_bytes)?;
+        }
+        Some(addr) => {
+            let listener = std::net::TcpListener::bind(addr)
+                .with_context(|| format!("listening on {addr}"))?;
+            let bound = listener.local_addr()?;
+            {
+                let mut out = std::io::stdout().lock();
+                writeln!(out, "{}", processes::announcement(bound))?;
+                out.flush()?;
+            }
+            eprintln!(
+                "robot for agent {} of {} listening on {bound}",
+                args.agent,
+                args.policy.display()
+            );
+            let limits = macdec::deploy::Limits {
+                max_line_bytes: args.max_line_bytes,
+                max_connections: args.max_connections,
+                idle_timeout: args.idle_timeout_secs.map(std::time::Duration::from_secs),
+                ..Default::default()
+            };
+            macdec::deploy::serve_tcp(listener, factory, spec, limits)?;
+        }
+    }
+    Ok(())
+}
+
+fn deploy(args: DeployArgs) -> Result<()> {
+    use macdec::deploy::{manifest::load_all, processes::deploy_with_processes};
+    use macdec::experiment::seeds::{stream, Role};
+    let (manifest, _) = load_all(&args.policy)
+        .with_context(|| format!("loading policy {}", args.policy.display()))?;
+    let seed = args.seed.unwrap_or(manifest.run.seed);
+    let mut rng = stream(seed, Role::EvalEnv);
+    let exe = std::env::current_exe().context("locating the macdec executable")?;
+    let extra: Vec<String> = if args.mock {
+        vec!["--mock".into()]
+    } else {
+        vec![]
+    };
+    let traces = deploy_with_processes(
+        &exe,
+        &args.policy,
+        &manifest,
+        &extra,
+        args.episodes,
+        &mut rng,
+        std::time::Duration::from_secs(args.timeout_secs),
+    )
+    .with_context(|| format!("deploying {}", args.policy.display()))?;
+    let mut out = std::io::stdout().lock();
+    for mut trace in traces.iter().cloned() {
+        if !args.trajectories {
+            trace.trajectory.clear();
+        }
+        serde_json::to_writer(&mut out, &trace)?;
+        writeln!(out)?;
+    }
+    let mean = traces.iter().map(|t| t.discounted_return).sum::<f64>() / traces.len().max(1) as f64;
+    eprintln!(
+        "{} episode(s) of {} with {} robot process(es), seed {seed}: mean discounted return {mean:.4}",
+        traces.len(),
+        manifest.env.name(),
+        manifest.agents.len()
+    );
     Ok(())
 }

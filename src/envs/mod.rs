@@ -10,6 +10,14 @@
 
 use rand_chacha::ChaCha8Rng;
 
+pub mod bench;
+pub mod box_pushing;
+pub mod replay;
+pub mod spec;
+pub mod warehouse;
+
+pub use spec::{AnyEnv, EnvSpec};
+
 /// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the
 /// caller, so a checkpoint can save it and a run derives it from its seed (spec `algorithms.md` 8).
 pub type EnvRng = ChaCha8Rng;

@@ -1,0 +1,223 @@
+//! How the deployment driver reaches one robot: [`RobotLink`] is the transport-free contract
+//! (reset; observe and maybe get a macro-action), [`JsonLink`] speaks the protocol over any byte
+//! stream (a TCP connection to a robot process or thread), and [`LocalLink`] calls a policy
+//! directly (in-process greedy execution, the reference the protocol path must equal).
+
+use crate::deploy::line_reader::{LineEvent, LineReader};
+use crate::deploy::manifest::Manifest;
+use crate::deploy::protocol::{Ack, Reply, Request};
+use crate::deploy::{greedy_action, AgentPolicy};
+use std::io::{BufRead, BufReader, Write};
+use std::net::{SocketAddr, TcpStream};
+use std::time::Duration;
+
+/// Longest reply line a client accepts (the `info` reply carries the whole manifest).
+pub const MAX_REPLY_BYTES: usize = 16 * 1024 * 1024;
+
+/// One robot as the driver sees it.
+pub trait RobotLink {
+    /// A new episode: the robot zeroes its hidden state.
+    fn reset(&mut self) -> Result<(), LinkError>;
+    /// The agent's current macro-observation. `Some(action)` exactly when `macro_action_done`
+    /// (a new macro-action is due), `None` otherwise.
+    fn observe(&mut self, obs: &[f32], macro_action_done: bool)
+        -> Result<Option<usize>, LinkError>;
+}
+
+impl<L: RobotLink + ?Sized> RobotLink for Box<L> {
+    fn reset(&mut self) -> Result<(), LinkError> {
+        (**self).reset()
+    }
+    fn observe(
+        &mut self,
+        obs: &[f32],
+        macro_action_done: bool,
+    ) -> Result<Option<usize>, LinkError> {
+        (**self).observe(obs, macro_action_done)
+    }
+}
+
+/// Why talking to a robot failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LinkError {
+    #[error("connection to the robot failed: {0}")]
+    Io(String),
+    #[error("the robot closed the connection")]
+    Closed,
+    #[error("the robot sent a reply longer than {MAX_REPLY_BYTES} bytes")]
+    ReplyTooLong,
+    #[error("the robot sent an unreadable reply ({reason}): {line}")]
+    BadReply { line: String, reason: String },
+    #[error("the robot refused the request: {0}")]
+    Refused(String),
+    #[error("expected {expected} from the robot, got: {got}")]
+    Unexpected { expected: &'static str, got: String },
+    #[error("the robot chose macro-action {action}, out of range 0..{n_actions}")]
+    ActionOutOfRange { action: usize, n_actions: usize },
+    #[error("the robot serves agent {got}, expected agent {expected}")]
+    WrongAgent { expected: usize, got: usize },
+    #[error("the robot runs a different policy (its manifest differs from ours)")]
+    WrongPolicy,
+}
+
+/// The protocol over a byte stream: one request line out, one reply line back.
+pub struct JsonLink<R, W> {
+    reader: LineReader<R>,
+    writer: W,
+    n_actions: usize,
+}
+
+impl JsonLink<BufReader<TcpStream>, TcpStream> {
+    /// Connect to the robot serving agent `agent` of `manifest` at `addr` and check, with an
+    /// `info` request, that it runs that agent of that policy. Replies slower than `timeout`
+    /// fail the link (a hung robot must not hang the deployment).
+    pub fn connect(
+        addr: SocketAddr,
+        agent: usize,
+        manifest: &Manifest,
+        timeout: Duration,
+    ) -> Result<Self, LinkError> {
+        let io = |e: std::io::Error| LinkError::Io(format!("{addr}: {e}"));
+        let stream = TcpStream::connect_timeout(&addr, timeout).map_err(io)?;
+        stream.set_nodelay(true).map_err(io)?;
+        stream.set_read_timeout(Some(timeout)).map_err(io)?;
+        stream.set_write_timeout(Some(timeout)).map_err(io)?;
+        let reader = BufReader::new(stream.try_clone().map_err(io)?);
+        JsonLink::open(reader, stream, agent, manifest)
+    }
+}
+
+impl<R: BufRead, W: Write> JsonLink<R, W> {
+    /// Wrap a stream to a robot and check that it serves agent `agent` of `manifest`.
+    pub fn open(
+        reader: R,
+        writer: W,
+        agent: usize,
+        manifest: &Manifest,
+    ) -> Result<Self, LinkError> {
+        let mut link = JsonLink {
+            reader: LineReader::new(reader, MAX_REPLY_BYTES),
+            writer,
+            n_actions: 0,
+        };
+        match link.request(&Request::Info)? {
+            Reply::Info {
+                agent: got,
+                manifest: theirs,
+            } => {
+                if got != agent {
+                    return Err(LinkError::WrongAgent {
+                        expected: agent,
+                        got,
+                    });
+                }
+                if *theirs != *manifest {
+                    return Err(LinkError::WrongPolicy);
+                }
+            }
+            other => return Err(unexpected("the info reply", &other)),
+        }
+        link.n_actions = manifest.agents[agent].n_actions;
+        Ok(link)
+    }
+
+    /// Send one request and read its reply. An `{"error": ...}` reply becomes
+    /// [`LinkError::Refused`].
+    pub fn request(&mut self, request: &Request) -> Result<Reply, LinkError> {
+        let line = request.to_line() + "\n";
+        self.writer
+            .write_all(line.as_bytes())
+            .and_then(|()| self.writer.flush())
+            .map_err(|e| LinkError::Io(e.to_string()))?;
+        let reply = match self.reader.next_line() {
+            Ok(LineEvent::Line(bytes)) => bytes,
+            Ok(LineEvent::TooLong) => return Err(LinkError::ReplyTooLong),
+            Ok(LineEvent::Eof { .. }) => return Err(LinkError::Closed),
+            Err(e) => return Err(LinkError::Io(e.to_string())),
+        };
+        match serde_json::from_slice::<Reply>(&reply) {
+            Ok(Reply::Error { error }) => Err(LinkError::Refused(error)),
+            Ok(r) => Ok(r),
+            Err(e) => Err(LinkError::BadReply {
+                line: String::from_utf8_lossy(&reply).chars().take(200).collect(),
+                reason: e.to_string(),
+            }),
+        }
+    }
+}
+
+fn unexpected(expected: &'static str, got: &Reply) -> LinkError {
+    LinkError::Unexpected {
+        expected,
+        got: got.to_line().chars().take(200).collect(),
+    }
+}
+
+impl<R: BufRead, W: Write> RobotLink for JsonLink<R, W> {
+    fn reset(&mut self) -> Result<(), LinkError> {
+        match self.request(&Request::Reset)? {
+            Reply::Ack { ok: Ack::Reset } => Ok(()),
+            other => Err(unexpected("{\"ok\": \"reset\"}", &other)),
+        }
+    }
+
+    fn observe(
+        &mut self,
+        obs: &[f32],
+        macro_action_done: bool,
+    ) -> Result<Option<usize>, LinkError> {
+        let reply = self.request(&Request::Observe {
+            obs: obs.to_vec(),
+            macro_action_done,
+        })?;
+        match (macro_action_done, reply) {
+            (true, Reply::Decision { action, .. }) if action < self.n_actions => Ok(Some(action)),
+            (true, Reply::Decision { action, .. }) => Err(LinkError::ActionOutOfRange {
+                action,
+                n_actions: self.n_actions,
+            }),
+            (false, Reply::Ack { ok: Ack::Continue }) => Ok(None),
+            (true, other) => Err(unexpected("a decision", &other)),
+            (false, other) => Err(unexpected("{\"ok\": \"continue\"}", &other)),
+        }
+    }
+}
+
+/// A policy called in-process: greedy decentralized execution without any transport.
+pub struct LocalLink<P> {
+    policy: P,
+    q: Vec<f32>,
+}
+
+impl<P: AgentPolicy> LocalLink<P> {
+    pub fn new(policy: P) -> Self {
+        let q = vec![0.0; policy.n_actions()];
+        LocalLink { policy, q }
+    }
+}
+
+impl<P: AgentPolicy> RobotLink for LocalLink<P> {
+    fn reset(&mut self) -> Result<(), LinkError> {
+        self.policy.reset();
+        Ok(())
+    }
+
+    fn observe(
+        &mut self,
+        obs: &[f32],
+        macro_action_done: bool,
+    ) -> Result<Option<usize>, LinkError> {
+        if obs.len() != self.policy.obs_len() {
+            return Err(LinkError::Refused(format!(
+                "obs has {} values, the policy expects {}",
+                obs.len(),
+                self.policy.obs_len()
+            )));
+        }
+        if !macro_action_done {
+            return Ok(None);
+        }
+        self.policy.q_values(obs, &mut self.q);
+        Ok(Some(greedy_action(&self.q)))
+    }
+}

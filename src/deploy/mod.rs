@@ -1,0 +1,85 @@
+//! Running trained decentralized policies on robots (issue 7): the exported policy directory
+//! ([`manifest`], [`architecture`]), the JSON-lines robot protocol ([`protocol`]), the robot stub
+//! that serves one agent's policy over stdin/stdout or TCP ([`robot`], [`server`]), and
+//! decentralized deployment: one process runs the domain and talks to one robot per agent, each
+//! seeing only its own macro-observations ([`driver`], [`link`], [`processes`]).
+//!
+//! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
+//! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
+//! CLI's hidden `--mock` flag). Only [`export`] reads a run's checkpoint.
+
+pub mod architecture;
+pub mod driver;
+pub mod export;
+pub mod line_reader;
+pub mod link;
+pub mod manifest;
+pub mod mock;
+pub mod processes;
+pub mod protocol;
+pub mod qnet_policy;
+pub mod robot;
+pub mod server;
+
+pub use driver::{run_episode, run_episodes, EpisodeTrace, StepRecord};
+pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
+pub use manifest::{Manifest, ManifestError, VerifiedAgent};
+pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};
+pub use server::{serve_tcp, spawn_server, Limits, RobotServer};
+
+/// One agent's decentralized policy with its recurrent state, as a robot runs it: the agent's own
+/// macro-observation in, one Q-value per macro-action out (spec `algorithms.md` 4.2, greedy).
+///
+/// The hidden state lives inside the value, so a robot keeps it across messages and each TCP
+/// connection gets its own (a fresh value from a factory).
+pub trait AgentPolicy: Send {
+    /// Length of the observation the policy reads.
+    fn obs_len(&self) -> usize;
+    /// Number of macro-actions (length of the Q-vector).
+    fn n_actions(&self) -> usize;
+    /// Zero the hidden state, as at the start of an episode.
+    fn reset(&mut self);
+    /// Q-values of every macro-action for `obs` (length [`Self::obs_len`]) written into `q`
+    /// (length [`Self::n_actions`]); advances the hidden state by one macro-step. Callers check
+    /// both lengths first; an implementation may panic on wrong lengths.
+    fn q_values(&mut self, obs: &[f32], q: &mut [f32]);
+}
+
+impl<P: AgentPolicy + ?Sized> AgentPolicy for Box<P> {
+    fn obs_len(&self) -> usize {
+        (**self).obs_len()
+    }
+    fn n_actions(&self) -> usize {
+        (**self).n_actions()
+    }
+    fn reset(&mut self) {
+        (**self).reset()
+    }
+    fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
+        (**self).q_values(obs, q)
+    }
+}
+
+/// Index of the first maximal Q-value: the greedy macro-action, with ties going to the lowest
+/// index exactly as in training and evaluation (quirk Q14). Callers reject non-finite Q first.
+pub fn greedy_action(q: &[f32]) -> usize {
+    let mut best = 0;
+    for (i, &v) in q.iter().enumerate().skip(1) {
+        if v > q[best] {
+            best = i;
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn greedy_action_takes_the_first_of_equal_maxima() {
+        assert_eq!(greedy_action(&[1.0, 3.0, 3.0, -1.0]), 1);
+        assert_eq!(greedy_action(&[-2.0, -3.0]), 0);
+        assert_eq!(greedy_action(&[0.0, 0.5, 0.25, 0.5001]), 3);
+    }
+}

@@ -1,0 +1,660 @@
+//! The robot stub over TCP (`macdec robot --listen ADDR`): one thread and one [`Session`] (own
+//! hidden state) per connection, a bounded number of connections, bounded lines. A client that
+//! misbehaves or vanishes affects only its own connection.
+
+use crate::deploy::line_reader::MAX_LINE_BYTES;
+use crate::deploy::protocol::Reply;
+use crate::deploy::robot::{serve_stream, RobotError, RobotSpec, Session};
+use crate::deploy::AgentPolicy;
+use std::io::{BufReader, Write};
+use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// Makes a fresh policy (zero hidden state) for each new connection, e.g. a clone of the loaded
+/// net.
+pub type PolicyFactory = Arc<dyn Fn() -> Box<dyn AgentPolicy> + Send + Sync>;
+
+/// Resource bounds of a robot server.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    /// Longest request line in bytes before its newline ([`MAX_LINE_BYTES`] = 64 KiB).
+    pub max_line_bytes: usize,
+    /// Connections served at once; one more gets an error reply and is closed (default 16).
+    pub max_connections: usize,
+    /// Close a connection that sends nothing for this long (default: never; a robot may idle).
+    pub idle_timeout: Option<Duration>,
+    /// Close a connection whose client stops reading replies for this long (default 10 s).
+    pub write_timeout: Option<Duration>,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_line_bytes: MAX_LINE_BYTES,
+            max_connections: 16,
+            idle_timeout: None,
+            write_timeout: Some(Duration::from_secs(10)),
+        }
+    }
+}
+
+/// A running server (see [`spawn_server`]). Dropping it stops accepting; open connections finish
+/// on their own.
+pub struct RobotServer {
+    addr: SocketAddr,
+    stop: Arc<AtomicBool>,
+    active: Arc<AtomicUsize>,
+    accept: Option<JoinHandle<()>>,
+}
+
+impl RobotServer {
+    /// The address the server listens on (with the real port when bound to port 0).
+    pub fn local_addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// Connections being served right now.
+    pub fn active_connections(&self) -> usize {
+        self.active.load(Ordering::SeqCst)
+    }
+
+    /// Stop accepting and wait for the accept loop to end.
+    pub fn shutdown(mut self) {
+        self.stop_accepting();
+    }
+
+    fn stop_accepting(&mut self) {
+        if let Some(handle) = self.accept.take() {
+            self.stop.store(true, Ordering::SeqCst);
+            // Wake the blocking accept with a connection of our own.
+            let _ = TcpStream::connect_timeout(&self.addr, Duration::from_secs(1));
+            let _ = handle.join();
+        }
+    }
+}
+
+impl Drop for RobotServer {
+    fn drop(&mut self) {
+        self.stop_accepting();
+    }
+}
+
+/// Serve `listener` forever on this thread (`macdec robot --listen`). Fails only at start, when
+/// the factory's policy does not fit `spec`.
+pub fn serve_tcp(
+    listener: TcpListener,
+    factory: PolicyFactory,
+    spec: Arc<RobotSpec>,
+    limits: Limits,
+) -> Result<(), RobotError> {
+    spec.check_policy(factory().as_ref())?;
+    accept_loop(
+        listener,
+        factory,
+        spec,
+        limits,
+        Arc::new(AtomicBool::new(false)),
+        Arc::new(AtomicUsize::new(0)),
+    );
+    Ok(())
+}
+
+/// Serve `listener` on a background thread; the returned handle stops it (tests, in-process
+/// deployment).
+pub fn spawn_server(
+    listener: TcpListener,
+    factory: PolicyFactory,
+    spec: Arc<RobotSpec>,
+    limits: Limits,
+) -> Result<RobotServer, RobotError> {
+    spec.check_policy(factory().as_ref())?;
+    let addr = listener
+        .local_addr()
+        .expect("a bound TCP listener has a local address");
+    let stop = Arc::new(AtomicBool::new(false));
+    let active = Arc::new(AtomicUsize::new(0));
+    let (s, a) = (stop.clone(), active.clone());
+    let accept = std::thread::Builder::new()
+        .name(format!("robot-{}-accept", spec.agent))
+        .spawn(move || accept_loop(listener, factory, spec, limits, s, a))
+        .expect("spawning the accept thread (out of threads at start)");
+    Ok(RobotServer {
+        addr,
+        stop,
+        active,
+        accept: Some(accept),
+    })
+}
+
+/// Decrements the active-connection count when a connection's thread ends, however it ends.
+struct ActiveGuard(Arc<AtomicUsize>);
+
+impl Drop for ActiveGuard {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+fn accept_loop(
+    listener: TcpListener,
+    factory: PolicyFactory,
+    spec: Arc<RobotSpec>,
+    limits: Limits,
+    stop: Arc<AtomicBool>,
+    active: Arc<AtomicUsize>,
+) {
+    for conn in listener.incoming() {
+        if stop.load(Ordering::SeqCst) {
+            return;
+        }
+        let stream = match conn {
+            Ok(s) => s,
+            Err(e) => {
+                // Out of file descriptors or an aborted handshake: keep serving the others.
+                eprintln!("robot {}: accept failed: {e}", spec.agent);
+                std::thread::sleep(Duration::from_millis(20));
+                continue;
+            }
+        };
+        if active.load(Ordering::SeqCst) >= limits.max_connections {
+            refuse(
+                stream,
+                &format!(
+                    "too many connections: this robot serves at most {} at a time",
+                    limits.max_connections
+                ),
+            );
+            continue;
+        }
+        active.fetch_add(1, Ordering::SeqCst);
+        let guard = ActiveGuard(active.clone());
+        let (factory, spec) = (factory.clone(), spec.clone());
+        let spawned = std::thread::Builder::new()
+            .name(format!("robot-{}-conn", spec.agent))
+            .spawn(move || {
+                let _guard = guard;
+                serve_connection(stream, factory, spec, limits);
+            });
+        if let Err(e) = spawned {
+            // The closure (stream and guard) was dropped: the client sees a closed connection.
+            eprintln!("robot: cannot start a connection thread: {e}");
+        }
+    }
+}
+
+/// Best effort: tell the client why, then close.
+fn refuse(stream: TcpStream, why: &str) {
+    let _ = stream.set_write_timeout(Some(Duration::from_millis(200)));
+    let line = Reply::error(why).to_line() + "\n";
+    let _ = (&stream).write_all(line.as_bytes());
+    let _ = stream.shutdown(Shutdown::Both);
+}
+
+fn serve_connection(
+    stream: TcpStream,
+    factory: PolicyFactory,
+    spec: Arc<RobotSpec>,
+    limits: Limits,
+) {
+    // Replies are small and awaited one by one: send them at once (no Nagle delay).
+    let _ = stream.set_nodelay(true);
+    let _ = stream.set_read_timeout(limits.idle_timeout);
+    let _ = stream.set_write_timeout(limits.write_timeout);
+    let reader = match stream.try_clone() {
+        Ok(s) => BufReader::new(s),
+        Err(e) => return refuse(stream, &format!("robot cannot serve this connection: {e}")),
+    };
+    let mut session = match Session::new(factory(), spec) {
+        Ok(s) => s,
+        Err(e) => return refuse(stream, &e.to_string()),
+    };
+    let served = catch_unwind(AssertUnwindSafe(|| {
+        serve_stream(&mut session, reader, &stream, limits.max_line_bytes)
+    }));
+    if served.is_err() {
+        refuse(
+            stream,
+            "internal error: the policy panicked; connection closed",
+        );
+        return;
+    }
+    let _ = stream.shutdown(Shutdown::Both);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::deploy::greedy_action;
+    use crate::deploy::mock::{mock_manifest, MockPolicy};
+    use crate::deploy::protocol::{Ack, Request};
+    use crate::envs::EnvSpec;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::io::{BufRead, BufReader};
+    use std::time::Instant;
+
+    const OBS: usize = 5;
+    const ACTIONS: usize = 8;
+
+    fn start_with(limits: Limits, factory: PolicyFactory) -> RobotServer {
+        let manifest = mock_manifest(EnvSpec::BoxPushing {
+            grid: 10,
+            horizon: 100,
+        });
+        let spec = Arc::new(RobotSpec::new(&manifest, 0).unwrap());
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        spawn_server(listener, factory, spec, limits).unwrap()
+    }
+
+    fn start(limits: Limits) -> RobotServer {
+        start_with(
+            limits,
+            Arc::new(|| Box::new(MockPolicy::new(OBS, ACTIONS, 0)) as Box<dyn AgentPolicy>),
+        )
+    }
+
+    struct Client {
+        stream: TcpStream,
+        reader: BufReader<TcpStream>,
+    }
+
+    impl Client {
+        fn connect(server: &RobotServer) -> Client {
+            let stream = TcpStream::connect(server.local_addr()).unwrap();
+            stream.set_nodelay(true).unwrap();
+            stream
+                .set_read_timeout(Some(Duration::from_secs(20)))
+                .unwrap();
+            let reader = BufReader::new(stream.try_clone().unwrap());
+            Client { stream, reader }
+        }
+
+        fn send(&mut self, bytes: &[u8]) {
+            (&self.stream).write_all(bytes).unwrap();
+        }
+
+        /// The next reply line, or None when the server closed the connection.
+        fn next(&mut self) -> Option<Reply> {
+            let mut line = String::new();
+            let n = self.reader.read_line(&mut line).unwrap();
+            (n > 0).then(|| serde_json::from_str(&line).unwrap())
+        }
+
+        fn ask(&mut self, line: &str) -> Reply {
+            self.send(format!("{line}\n").as_bytes());
+            self.next().expect("a reply")
+        }
+    }
+
+    /// The reference: the mock policy called directly with the valid messages only.
+    struct Reference {
+        policy: MockPolicy,
+        q: Vec<f32>,
+    }
+
+    impl Reference {
+        fn new() -> Self {
+            Reference {
+                policy: MockPolicy::new(OBS, ACTIONS, 0),
+                q: vec![0.0; ACTIONS],
+            }
+        }
+        fn observe(&mut self, obs: &[f32]) -> Vec<f32> {
+            self.policy.q_values(obs, &mut self.q);
+            self.q.clone()
+        }
+    }
+
+    fn observe_line(obs: &[f32], done: bool) -> String {
+        Request::Observe {
+            obs: obs.to_vec(),
+            macro_action_done: done,
+        }
+        .to_line()
+    }
+
+    fn random_obs(rng: &mut ChaCha8Rng) -> Vec<f32> {
+        (0..OBS).map(|_| rng.gen_range(0..2) as f32).collect()
+    }
+
+    /// Check a decision against the reference fed the same observation.
+    fn check_decision(reply: Reply, obs: &[f32], reference: &mut Reference) {
+        let want = reference.observe(obs);
+        assert_eq!(
+            reply,
+            Reply::Decision {
+                action: greedy_action(&want),
+                name: crate::envs::box_pushing::BoxPushing::new(10, 100)
+                    .map(|e| e.action_names(0)[greedy_action(&want)].to_string())
+                    .unwrap(),
+                q: want,
+            }
+        );
+    }
+
+    use crate::envs::MacroEnv;
+
+    /// One fuzzed request line (never containing `\n`) and whether it must be refused.
+    fn fuzz_line(rng: &mut ChaCha8Rng) -> (Vec<u8>, bool) {
+        let valid = |rng: &mut ChaCha8Rng| -> String {
+            match rng.gen_range(0..4) {
+                0 => r#"{"type":"reset"}"#.to_string(),
+                1 => r#"{"type":"info"}"#.to_string(),
+                _ => observe_line(&random_obs(rng), rng.gen_bool(0.7)),
+            }
+        };
+        let mut line: Vec<u8>;
+        let mut must_fail = true;
+        match rng.gen_range(0..10) {
+            // Valid messages mutated byte-wise (flip, insert, delete, replace).
+            0..=2 => {
+                line = valid(rng).into_bytes();
+                for _ in 0..rng.gen_range(1..5) {
+                    let at = rng.gen_range(0..=line.len());
+                    match rng.gen_range(0..4) {
+                        0 if at < line.len() => line[at] ^= 1 << rng.gen_range(0..8),
+                        1 => line.insert(at, rng.gen()),
+                        2 if at < line.len() => {
+                            line.remove(at);
+                        }
+                        _ if at < line.len() => line[at] = rng.gen(),
+                        _ => {}
+                    }
+                }
+                must_fail = false; // a mutation may leave a valid message
+            }
+            // Random bytes, binary garbage included.
+            3 => {
+                line = (0..rng.gen_range(0..300)).map(|_| rng.gen()).collect();
+                must_fail = false;
+            }
+            // Non-finite or out-of-f32 numbers.
+            4 => {
+                let bad = [
+                    "NaN",
+                    "Infinity",
+                    "-Infinity",
+                    "1e39",
+                    "-4e38",
+                    "1e400",
+                    "nan",
+                ];
+                let mut vals: Vec<String> = (0..OBS).map(|i| (i % 2).to_string()).collect();
+                vals[rng.gen_range(0..OBS)] = bad[rng.gen_range(0..bad.len())].to_string();
+                line = format!(
+                    r#"{{"type":"observe","obs":[{}],"macro_action_done":true}}"#,
+                    vals.join(",")
+                )
+                .into_bytes();
+            }
+            // Wrong observation lengths.
+            5 => {
+                let mut n = rng.gen_range(0..12);
+                if n == OBS {
+                    n += 1;
+                }
+                line = observe_line(&vec![1.0; n], rng.gen_bool(0.5)).into_bytes();
+            }
+            // Unknown types and fields, wrong JSON types.
+            6 => {
+                let cases = [
+                    r#"{"type":"shutdown"}"#,
+                    r#"{"type":"observe","obs":[0,0,0,0,0],"macro_action_done":"yes"}"#,
+                    r#"{"type":"observe","obs":[0,0,0,0,0],"macro_action_done":true,"t":3}"#,
+                    r#"{"type":null}"#,
+                    r#"{"type":"observe","obs":{"a":1},"macro_action_done":true}"#,
+                    r#""observe""#,
+                    "[]",
+                    "{}",
+                ];
+                line = cases[rng.gen_range(0..cases.len())].as_bytes().to_vec();
+            }
+            // Valid messages.
+            _ => {
+                line = valid(rng).into_bytes();
+                must_fail = false;
+            }
+        }
+        for b in line.iter_mut() {
+            if *b == b'\n' {
+                *b = b' ';
+            }
+        }
+        (line, must_fail)
+    }
+
+    #[test]
+    fn fuzzed_input_gets_error_replies_and_never_disturbs_the_hidden_state() {
+        let server = start(Limits::default());
+        let mut client = Client::connect(&server);
+        let mut reference = Reference::new();
+        let mut rng = ChaCha8Rng::seed_from_u64(2020);
+        let (mut errors, mut decisions) = (0, 0);
+        for i in 0..1500 {
+            let (line, must_fail) = if i % 97 == 5 {
+                // An oversized line of garbage, 64 KiB to 200 KiB.
+                let n = MAX_LINE_BYTES + rng.gen_range(1..140_000);
+                ((0..n).map(|_| rng.gen_range(b' '..=b'~')).collect(), true)
+            } else {
+                fuzz_line(&mut rng)
+            };
+            let mut framed = line.clone();
+            framed.push(b'\n');
+            client.send(&framed);
+            if line.iter().all(u8::is_ascii_whitespace) {
+                continue; // blank lines get no reply
+            }
+            let reply = client.next().expect("the server keeps the connection open");
+            match reply {
+                Reply::Error { error } => {
+                    assert!(!error.is_empty());
+                    if line.len() > MAX_LINE_BYTES {
+                        assert!(error.starts_with("line longer than 65536 bytes"), "{error}");
+                    }
+                    errors += 1;
+                }
+                _ if must_fail => panic!("{} was accepted", String::from_utf8_lossy(&line)),
+                Reply::Ack { ok: Ack::Reset } => reference.policy.reset(),
+                Reply::Ack { ok: Ack::Continue } | Reply::Info { .. } => {}
+                decision @ Reply::Decision { .. } => {
+                    // Accepted, so it is valid JSON: replay its observation on the reference.
+                    let v: serde_json::Value = serde_json::from_slice(&line).unwrap();
+                    let obs: Vec<f32> = v["obs"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| x.as_f64().unwrap() as f32)
+                        .collect();
+                    check_decision(decision, &obs, &mut reference);
+                    decisions += 1;
+                }
+            }
+            if i % 10 == 0 {
+                let obs = random_obs(&mut rng);
+                let reply = client.ask(&observe_line(&obs, true));
+                check_decision(reply, &obs, &mut reference);
+            }
+        }
+        assert!(
+            errors > 500 && decisions > 100,
+            "{errors} errors, {decisions} decisions"
+        );
+        // A fresh connection starts from a zero state while this one carries on.
+        let mut other = Client::connect(&server);
+        let obs = [1.0, 0.0, 1.0, 0.0, 0.0];
+        check_decision(
+            other.ask(&observe_line(&obs, true)),
+            &obs,
+            &mut Reference::new(),
+        );
+        check_decision(client.ask(&observe_line(&obs, true)), &obs, &mut reference);
+    }
+
+    #[test]
+    fn connections_keep_separate_hidden_states_under_concurrent_load() {
+        let server = start(Limits::default());
+        let workers: Vec<_> = (0..4u64)
+            .map(|seed| {
+                let mut client = Client::connect(&server);
+                std::thread::spawn(move || {
+                    let mut reference = Reference::new();
+                    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                    for step in 0..300 {
+                        if step % 50 == 49 {
+                            assert_eq!(
+                                client.ask(r#"{"type":"reset"}"#),
+                                Reply::Ack { ok: Ack::Reset }
+                            );
+                            reference.policy.reset();
+                        }
+                        let obs = random_obs(&mut rng);
+                        if rng.gen_bool(0.3) {
+                            let reply = client.ask(&observe_line(&obs, false));
+                            assert_eq!(reply, Reply::Ack { ok: Ack::Continue });
+                        } else {
+                            check_decision(
+                                client.ask(&observe_line(&obs, true)),
+                                &obs,
+                                &mut reference,
+                            );
+                        }
+                    }
+                })
+            })
+            .collect();
+        for w in workers {
+            w.join()
+                .expect("every connection answers like its own reference");
+        }
+    }
+
+    #[test]
+    fn a_client_leaving_mid_line_is_closed_cleanly_and_others_carry_on() {
+        let server = start(Limits::default());
+        let mut steady = Client::connect(&server);
+        let mut reference = Reference::new();
+        let obs = [0.0, 1.0, 1.0, 0.0, 0.0];
+        check_decision(steady.ask(&observe_line(&obs, true)), &obs, &mut reference);
+        for partial in [
+            &b"{\"type\":\"obs"[..],
+            b"",
+            &vec![b'x'; 3 * MAX_LINE_BYTES],
+        ] {
+            let mut leaver = Client::connect(&server);
+            leaver.send(partial);
+            drop(leaver);
+            check_decision(steady.ask(&observe_line(&obs, true)), &obs, &mut reference);
+        }
+        // The leavers' threads end and free their slots.
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while server.active_connections() > 1 {
+            assert!(Instant::now() < deadline, "connections were not released");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    #[test]
+    fn connections_beyond_the_limit_are_refused_with_a_reason_until_a_slot_frees() {
+        let server = start(Limits {
+            max_connections: 2,
+            ..Limits::default()
+        });
+        let mut a = Client::connect(&server);
+        let mut b = Client::connect(&server);
+        assert!(matches!(
+            a.ask(r#"{"type":"info"}"#),
+            Reply::Info { agent: 0, .. }
+        ));
+        assert!(matches!(
+            b.ask(r#"{"type":"info"}"#),
+            Reply::Info { agent: 0, .. }
+        ));
+        let mut c = Client::connect(&server);
+        let Some(Reply::Error { error }) = c.next() else {
+            panic!("the third connection must be refused")
+        };
+        assert!(error.contains("at most 2"), "{error}");
+        assert_eq!(c.next(), None, "then closed");
+        drop(a);
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            let mut d = Client::connect(&server);
+            d.send(b"{\"type\":\"reset\"}\n");
+            match d.next() {
+                Some(Reply::Ack { ok: Ack::Reset }) => break,
+                _ => assert!(Instant::now() < deadline, "the freed slot was not reused"),
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert!(matches!(b.ask(r#"{"type":"info"}"#), Reply::Info { .. }));
+    }
+
+    #[test]
+    fn an_idle_connection_is_closed_after_the_idle_timeout() {
+        let server = start(Limits {
+            idle_timeout: Some(Duration::from_millis(100)),
+            ..Limits::default()
+        });
+        let mut idle = Client::connect(&server);
+        assert!(matches!(idle.ask(r#"{"type":"info"}"#), Reply::Info { .. }));
+        std::thread::sleep(Duration::from_millis(400));
+        assert_eq!(idle.next(), None);
+    }
+
+    #[test]
+    fn a_panicking_policy_closes_only_its_own_connection() {
+        struct Fragile(MockPolicy);
+        impl AgentPolicy for Fragile {
+            fn obs_len(&self) -> usize {
+                OBS
+            }
+            fn n_actions(&self) -> usize {
+                ACTIONS
+            }
+            fn reset(&mut self) {
+                self.0.reset()
+            }
+            fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
+                assert!(obs[0] != 7.0, "deliberate test panic: obs[0] = 7");
+                self.0.q_values(obs, q)
+            }
+        }
+        let server = start_with(
+            Limits::default(),
+            Arc::new(|| {
+                Box::new(Fragile(MockPolicy::new(OBS, ACTIONS, 0))) as Box<dyn AgentPolicy>
+            }),
+        );
+        let mut steady = Client::connect(&server);
+        let mut victim = Client::connect(&server);
+        let Reply::Error { error } = victim.ask(&observe_line(&[7.0, 0.0, 0.0, 0.0, 0.0], true))
+        else {
+            panic!("expected an error reply")
+        };
+        assert!(error.contains("panicked"), "{error}");
+        assert_eq!(victim.next(), None);
+        let obs = [0.0; OBS];
+        check_decision(
+            steady.ask(&observe_line(&obs, true)),
+            &obs,
+            &mut Reference::new(),
+        );
+    }
+
+    #[test]
+    fn shutdown_stops_accepting() {
+        let server = start(Limits::default());
+        let addr = server.local_addr();
+        server.shutdown();
+        let refused = TcpStream::connect(addr).map(|s| {
+            let mut r = BufReader::new(s);
+            let mut line = String::new();
+            r.read_line(&mut line).map(|n| n == 0).unwrap_or(true)
+        });
+        assert!(refused.unwrap_or(true));
+    }
+}

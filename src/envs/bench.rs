@@ -1,0 +1,125 @@
+//! Raw environment speed: primitive steps per second under uniformly random macro-actions, one
+//! thread (issue 4: the target is 100x the reference Python environment, about 6M steps/s).
+
+use std::time::Instant;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::{EnvError, EnvRng, EnvSpec, MacroEnv};
+
+/// One measured environment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvBench {
+    /// What was measured, e.g. "box-pushing 10x10 (horizon 100)".
+    pub name: String,
+    /// Primitive steps taken.
+    pub steps: u64,
+    /// Episodes started.
+    pub episodes: u64,
+    pub seconds: f64,
+    pub steps_per_second: f64,
+}
+
+/// Step `env` with uniformly random macro-actions for free agents (busy agents get 0, which is
+/// ignored), resetting at done, until at least `min_steps` primitive steps. Returns
+/// `(steps, episodes)`. Action sampling is included in the time, as in a training loop.
+pub fn random_macro_steps<E: MacroEnv>(
+    env: &mut E,
+    min_steps: u64,
+    policy_rng: &mut ChaCha8Rng,
+    env_rng: &mut EnvRng,
+) -> Result<(u64, u64), EnvError> {
+    let n_agents = env.n_agents();
+    let n_actions = env.n_actions().to_vec();
+    let mut actions = vec![0usize; n_agents];
+    let (mut steps, mut episodes) = (0u64, 1u64);
+    env.reset(env_rng);
+    while steps < min_steps {
+        for (agent, a) in actions.iter_mut().enumerate() {
+            *a = if env.is_free(agent) {
+                policy_rng.gen_range(0..n_actions[agent])
+            } else {
+                0
+            };
+        }
+        let out = env.step(&actions, env_rng)?;
+        steps += 1;
+        if out.done {
+            env.reset(env_rng);
+            episodes += 1;
+        }
+    }
+    Ok((steps, episodes))
+}
+
+/// Time [`random_macro_steps`] on the environment `spec` describes.
+pub fn bench_env(name: &str, spec: EnvSpec, min_steps: u64) -> Result<EnvBench, EnvError> {
+    let mut env = spec.build()?;
+    let mut policy_rng = ChaCha8Rng::seed_from_u64(1);
+    let mut env_rng = EnvRng::seed_from_u64(2);
+    let start = Instant::now();
+    let (steps, episodes) = random_macro_steps(&mut env, min_steps, &mut policy_rng, &mut env_rng)?;
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(EnvBench {
+        name: name.to_string(),
+        steps,
+        episodes,
+        seconds,
+        steps_per_second: steps as f64 / seconds,
+    })
+}
+
+/// The environments `macdec bench envs` measures, at the paper's settings.
+pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
+    vec![
+        (
+            "box-pushing 10x10 (horizon 100)",
+            EnvSpec::BoxPushing {
+                grid: 10,
+                horizon: 100,
+            },
+        ),
+        (
+            "box-pushing 30x30 (horizon 200)",
+            EnvSpec::BoxPushing {
+                grid: 30,
+                horizon: 200,
+            },
+        ),
+        (
+            "warehouse (horizon 150)",
+            EnvSpec::Warehouse {
+                horizon: 150,
+                tb_m_noisy: 0.0,
+            },
+        ),
+    ]
+}
+
+/// Measure every environment of [`bench_suite`] for at least `min_steps` primitive steps each.
+pub fn bench_envs(min_steps: u64) -> Result<Vec<EnvBench>, EnvError> {
+    bench_suite()
+        .into_iter()
+        .map(|(name, spec)| bench_env(name, spec, min_steps))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn random_stepping_counts_steps_and_restarts_episodes() {
+        // Stay-only episodes of BP last the horizon; random ones at most the horizon, so 1000
+        // steps with horizon 10 need at least 100 episodes.
+        let spec = EnvSpec::BoxPushing {
+            grid: 10,
+            horizon: 10,
+        };
+        let r = bench_env("bp", spec, 1000).unwrap();
+        assert_eq!(r.steps, 1000);
+        assert!(r.episodes >= 100, "{r:?}");
+        assert!(r.steps_per_second > 0.0);
+    }
+}

@@ -1,0 +1,292 @@
+//! Replay of a macro-action log: a trajectory anyone can diff against the reference.
+//!
+//! A replay file is JSON: `{"env": "box-pushing", "grid": 10, "horizon": 100, "steps": [[a0, a1],
+//! ...]}` (or `{"env": "warehouse", "horizon": 150, "steps": [[a0, a1, a2], ...]}`). The
+//! environment is reset, then fed one joint action per primitive step until done or the steps run
+//! out. An agent still busy with its macro-action ignores its entry, which may be -1 as in the
+//! reference's logs; a free agent's entry must be a valid macro-action index.
+
+use rand::SeedableRng;
+use serde::Serialize;
+use serde_json::Value;
+
+use super::{EnvError, EnvRng, EnvSpec, MacroEnv};
+
+/// Seed of the environment stream during a replay (Box Pushing never draws from it).
+pub const REPLAY_SEED: u64 = 0;
+
+/// A parsed replay file: which environment, and one row of actions per primitive step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayFile {
+    pub spec: EnvSpec,
+    /// `steps[k][i]`: agent i's entry at primitive step k+1 (ignored while agent i is busy).
+    pub steps: Vec<Vec<i64>>,
+}
+
+/// Why a replay file was refused. Messages name the step (1-based) and agent at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    #[error("not valid JSON: {0}")]
+    Json(#[source] serde_json::Error),
+    #[error("expected a JSON object with `env`, its parameters and `steps`, got {0}")]
+    NotAnObject(&'static str),
+    #[error("missing field `steps` (a list with one list of actions per primitive step)")]
+    MissingSteps,
+    #[error("`steps` must be a list of lists of integers: {0}")]
+    BadSteps(#[source] serde_json::Error),
+    #[error("bad environment description: {0}")]
+    BadSpec(#[source] serde_json::Error),
+    #[error("cannot build the environment: {0}")]
+    Build(#[source] EnvError),
+    #[error("step {step}: expected {expected} actions (one per agent), got {got}")]
+    RowLength {
+        step: usize,
+        expected: usize,
+        got: usize,
+    },
+    #[error("step {step}: agent {agent} is free and needs a macro-action in 0..{n_actions}, got {action}")]
+    BadAction {
+        step: usize,
+        agent: usize,
+        action: i64,
+        n_actions: usize,
+    },
+    #[error("step {step}: {source}")]
+    Step {
+        step: usize,
+        #[source]
+        source: EnvError,
+    },
+}
+
+/// Parse a replay file's text. Only the shape is checked here; actions are checked while
+/// replaying, since an entry matters only when its agent is free.
+pub fn parse_replay(text: &str) -> Result<ReplayFile, ReplayError> {
+    let value: Value = serde_json::from_str(text).map_err(ReplayError::Json)?;
+    let Value::Object(mut map) = value else {
+        return Err(ReplayError::NotAnObject(json_kind(&value)));
+    };
+    let steps = map.remove("steps").ok_or(ReplayError::MissingSteps)?;
+    let steps: Vec<Vec<i64>> = serde_json::from_value(steps).map_err(ReplayError::BadSteps)?;
+    let spec: EnvSpec = serde_json::from_value(Value::Object(map)).map_err(ReplayError::BadSpec)?;
+    Ok(ReplayFile { spec, steps })
+}
+
+fn json_kind(v: &Value) -> &'static str {
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "an array",
+        Value::Object(_) => "an object",
+    }
+}
+
+/// One output line. The first line (t = 0, after reset) has only `t` and `obs`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReplayLine {
+    pub t: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub executed: Option<Vec<usize>>,
+    /// Each agent's observation, in the spec's layout.
+    pub obs: Vec<Vec<f32>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reward: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub done: Option<bool>,
+    /// Each agent's macro-action-done flag as 0 or 1.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mac_done: Option<Vec<u8>>,
+}
+
+/// A replayed line and, when asked for, the ASCII picture of the state after it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayFrame {
+    pub line: ReplayLine,
+    pub picture: Option<String>,
+}
+
+/// The whole replay: one frame per line, and how many rows of `steps` were left unused because the
+/// episode ended first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Replay {
+    pub frames: Vec<ReplayFrame>,
+    pub unused_steps: usize,
+}
+
+fn all_obs<E: MacroEnv>(env: &E) -> Vec<Vec<f32>> {
+    (0..env.n_agents()).map(|i| env.obs(i).to_vec()).collect()
+}
+
+/// Replay `file`: build and reset its environment, then feed its rows until done or the rows run
+/// out. With `pictures`, each frame carries [`MacroEnv::render_ascii`] of the state after it. The
+/// whole file is checked (row lengths up front, free agents' entries as they are reached) before
+/// anything is returned, so a bad file yields an error and no partial output.
+pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayError> {
+    let mut env = file.spec.build().map_err(ReplayError::Build)?;
+    let n_agents = env.n_agents();
+    if let Some((k, row)) = file
+        .steps
+        .iter()
+        .enumerate()
+        .find(|(_, row)| row.len() != n_agents)
+    {
+        return Err(ReplayError::RowLength {
+            step: k + 1,
+            expected: n_agents,
+            got: row.len(),
+        });
+    }
+    let mut rng = EnvRng::seed_from_u64(REPLAY_SEED);
+    env.reset(&mut rng);
+    let picture = |env: &super::AnyEnv| pictures.then(|| env.render_ascii());
+    let mut frames = vec![ReplayFrame {
+        line: ReplayLine {
+            t: 0,
+            executed: None,
+            obs: all_obs(&env),
+            reward: None,
+            done: None,
+            mac_done: None,
+        },
+        picture: picture(&env),
+    }];
+    let mut actions = vec![0usize; n_agents];
+    let mut used = 0;
+    for (k, row) in file.steps.iter().enumerate() {
+        let step = k + 1;
+        for (agent, (&entry, slot)) in row.iter().zip(actions.iter_mut()).enumerate() {
+            if !env.is_free(agent) {
+                *slot = 0; // ignored by the environment
+                continue;
+            }
+            let n_actions = env.n_actions()[agent];
+            *slot = usize::try_from(entry)
+                .ok()
+                .filter(|&a| a < n_actions)
+                .ok_or(ReplayError::BadAction {
+                    step,
+                    agent,
+                    action: entry,
+                    n_actions,
+                })?;
+        }
+        let out = env
+            .step(&actions, &mut rng)
+            .map_err(|source| ReplayError::Step { step, source })?;
+        used += 1;
+        frames.push(ReplayFrame {
+            line: ReplayLine {
+                t: env.t(),
+                executed: Some(env.executed().to_vec()),
+                obs: all_obs(&env),
+                reward: Some(out.reward),
+                done: Some(out.done),
+                mac_done: Some(env.mac_done().iter().map(|&d| u8::from(d)).collect()),
+            },
+            picture: picture(&env),
+        });
+        if out.done {
+            break;
+        }
+    }
+    Ok(Replay {
+        frames,
+        unused_steps: file.steps.len() - used,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bp10(steps: &str) -> String {
+        format!(r#"{{"env": "box-pushing", "grid": 10, "horizon": 100, "steps": {steps}}}"#)
+    }
+
+    /// Scenario S2 as a log: robot 0 BB0, robot 1 BB1, then -1 while busy, then Push.
+    fn s2_log() -> String {
+        let mut rows = vec!["[2, 3]".to_string()];
+        rows.extend((0..6).map(|_| "[-1, -1]".to_string()));
+        rows.push("[4, 4]".to_string());
+        rows.extend((0..5).map(|_| "[-1, -1]".to_string()));
+        bp10(&format!("[{}]", rows.join(", ")))
+    }
+
+    #[test]
+    fn s2_log_replays_to_the_spec_trace_and_prints_spec_json() {
+        let file = parse_replay(&s2_log()).unwrap();
+        let replay = run_replay(&file, false).unwrap();
+        assert_eq!(replay.frames.len(), 12);
+        assert_eq!(replay.unused_steps, 2);
+        let first = serde_json::to_string(&replay.frames[0].line).unwrap();
+        assert_eq!(
+            first,
+            r#"{"t":0,"obs":[[0.0,0.0,1.0,0.0,0.0],[0.0,0.0,1.0,0.0,0.0]]}"#
+        );
+        let seventh = serde_json::to_string(&replay.frames[7].line).unwrap();
+        assert_eq!(
+            seventh,
+            r#"{"t":7,"executed":[2,3],"obs":[[0.0,1.0,0.0,0.0,0.0],[0.0,1.0,0.0,0.0,0.0]],"reward":-0.1,"done":false,"mac_done":[1,1]}"#
+        );
+        let last = &replay.frames[11].line;
+        assert_eq!(last.reward, Some(99.9));
+        assert_eq!(last.done, Some(true));
+        assert_eq!(last.executed, Some(vec![4, 4]));
+    }
+
+    #[test]
+    fn pictures_come_with_every_frame_when_asked() {
+        let file = parse_replay(&bp10("[[7, 7]]")).unwrap();
+        let replay = run_replay(&file, true).unwrap();
+        assert_eq!(replay.frames.len(), 2);
+        assert!(replay.frames[1]
+            .picture
+            .as_ref()
+            .unwrap()
+            .starts_with("t=1 "));
+    }
+
+    fn error_of(text: &str) -> String {
+        match parse_replay(text).and_then(|f| run_replay(&f, false)) {
+            Ok(_) => panic!("accepted a bad file: {text}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn bad_files_are_refused_with_the_reason() {
+        assert!(error_of("{").contains("not valid JSON"));
+        assert!(error_of("[1, 2]").contains("got an array"));
+        let e = error_of(r#"{"env": "box-pushing", "grid": 10, "horizon": 100}"#);
+        assert!(e.contains("missing field `steps`"), "{e}");
+        let e = error_of(r#"{"env": "sokoban", "horizon": 100, "steps": []}"#);
+        assert!(e.contains("unknown variant `sokoban`"), "{e}");
+        let e = error_of(r#"{"env": "box-pushing", "horizon": 100, "steps": []}"#);
+        assert!(e.contains("missing field `grid`"), "{e}");
+        let e = error_of(r#"{"env": "box-pushing", "grid": 7, "horizon": 100, "steps": []}"#);
+        assert!(e.contains("cannot build") && e.contains("grid"), "{e}");
+        let e = error_of(r#"{"env": "warehouse", "horizon": 0, "steps": []}"#);
+        assert!(e.contains("cannot build") && e.contains("horizon"), "{e}");
+        let e = error_of(&bp10("[[1, 2], [3]]"));
+        assert_eq!(e, "step 2: expected 2 actions (one per agent), got 1");
+        let e = error_of(&bp10("[[1, 8]]"));
+        assert_eq!(
+            e,
+            "step 1: agent 1 is free and needs a macro-action in 0..8, got 8"
+        );
+        let e = error_of(&bp10("[[-1, 7]]"));
+        assert!(e.starts_with("step 1: agent 0 is free"), "{e}");
+        let e = error_of(&bp10("[[1.5, 7]]"));
+        assert!(e.contains("`steps` must be"), "{e}");
+    }
+
+    #[test]
+    fn busy_agents_may_hold_any_integer() {
+        let file = parse_replay(&bp10("[[2, 7], [-1, 7], [99, 7]]")).unwrap();
+        let replay = run_replay(&file, false).unwrap();
+        assert_eq!(replay.frames.len(), 4);
+        assert_eq!(replay.frames[3].line.executed, Some(vec![2, 7]));
+    }
+}

@@ -1,0 +1,549 @@
+//! Experiment configs: the TOML files in `experiments/`, `--set` overrides, sweep grids, and the
+//! fully resolved, validated configuration of one run.
+//!
+//! Keys are the reference's command-line flag names (`total_epi`, `trace_len`, `l_rate`, ...), so a
+//! reference command translates key for key. Every key has the paper's value as its default for the
+//! chosen domain and method (spec `algorithms.md` 10): `env_name = "BP_MA"` alone is Figure 4a's
+//! setting. A key given as a list is a sweep axis; the grid's points become named variants.
+
+use crate::algos::hyper::{paper_defaults, EnvName, RunConfig};
+use crate::algos::method::Method;
+use crate::experiment::seeds::{parse_seeds, SeedsError};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Why a config could not be used. Messages name the file, the key and what was expected.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{path}: cannot read: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: not valid TOML: {message}")]
+    Toml { path: PathBuf, message: String },
+    #[error("{path}: unknown key `{key}` (keys are the reference's flag names, e.g. total_epi, trace_len, l_rate)")]
+    UnknownKey { path: PathBuf, key: String },
+    #[error("{path}: `{key}`: {message}")]
+    BadValue {
+        path: PathBuf,
+        key: String,
+        message: String,
+    },
+    #[error("{path}: {source}")]
+    Seeds { path: PathBuf, source: SeedsError },
+    #[error("--set `{0}`: expected key=value, e.g. total_epi=300 or dec-hddrqn.init_h=0.3")]
+    BadSet(String),
+    #[error("{path}: no methods to run")]
+    NoMethods { path: PathBuf },
+}
+
+/// The experiment file as written: name, methods, seeds, shared params, per-method overrides.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExperimentFile {
+    name: Option<String>,
+    methods: Option<Vec<String>>,
+    seeds: Option<SeedsField>,
+    #[serde(default)]
+    params: toml::Table,
+    #[serde(default)]
+    method: BTreeMap<String, toml::Table>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum SeedsField {
+    Text(String),
+    List(Vec<u64>),
+}
+
+/// One training run to perform: a method, a sweep point and a seed, with its resolved config.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSpec {
+    pub experiment: String,
+    pub method: Method,
+    /// Empty when the experiment has no sweep; else e.g. `trace_len=10,l_rate=0.001`.
+    pub variant: String,
+    pub seed: u64,
+    pub config: RunConfig,
+}
+
+impl RunSpec {
+    /// The run's directory below the results root: `<experiment>/<method>[@<variant>]/seed-<k>`.
+    pub fn dir(&self, results_root: &Path) -> PathBuf {
+        results_root
+            .join(&self.experiment)
+            .join(self.curve_name())
+            .join(format!("seed-{}", self.seed))
+    }
+
+    /// The name of the curve this run belongs to: the method, plus the sweep point if any.
+    pub fn curve_name(&self) -> String {
+        if self.variant.is_empty() {
+            self.method.name().to_string()
+        } else {
+            format!("{}@{}", self.method.name(), self.variant)
+        }
+    }
+}
+
+/// A parsed experiment: everything needed to list its runs.
+#[derive(Debug, Clone)]
+pub struct Experiment {
+    pub name: String,
+    pub methods: Vec<Method>,
+    pub seeds: Vec<u64>,
+    path: PathBuf,
+    params: toml::Table,
+    per_method: BTreeMap<Method, toml::Table>,
+}
+
+/// The command-line overrides of `macdec train`.
+#[derive(Debug, Clone, Default)]
+pub struct Overrides {
+    pub methods: Option<Vec<Method>>,
+    pub seeds: Option<Vec<u64>>,
+    /// `key=value` pairs; `method.key=value` targets one method.
+    pub set: Vec<String>,
+}
+
+/// The embedded default experiment: a short Box Pushing 10x10 Our-1 run for the README's first
+/// command (a few minutes on two cores).
+pub const DEFAULT_EXPERIMENT: &str = r#"
+name = "quickstart_bp10"
+methods = ["our1"]
+seeds = "0..2"
+
+[params]
+env_name = "BP_MA"
+grid_dim = 10
+total_epi = 1500
+eps_l_d_steps = 1000
+"#;
+
+impl Experiment {
+    /// Load an experiment file and apply command-line overrides.
+    pub fn load(path: &Path, overrides: &Overrides) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "experiment".into());
+        Self::parse(&text, path, &stem, overrides)
+    }
+
+    /// Parse experiment TOML text; `path` is only used in messages, `default_name` when the file
+    /// has no `name`.
+    pub fn parse(
+        text: &str,
+        path: &Path,
+        default_name: &str,
+        overrides: &Overrides,
+    ) -> Result<Self, ConfigError> {
+        let p = || path.to_path_buf();
+        let file: ExperimentFile = toml::from_str(text).map_err(|e| ConfigError::Toml {
+            path: p(),
+            message: e.message().to_string(),
+        })?;
+        let methods = match (&overrides.methods, &file.methods) {
+            (Some(m), _) => m.clone(),
+            (None, Some(names)) => names
+                .iter()
+                .map(|n| {
+                    n.parse::<Method>().map_err(|e| ConfigError::BadValue {
+                        path: p(),
+                        key: "methods".into(),
+                        message: e.to_string(),
+                    })
+                })
+                .collect::<Result<_, _>>()?,
+            (None, None) => vec![Method::Our1],
+        };
+        if methods.is_empty() {
+            return Err(ConfigError::NoMethods { path: p() });
+        }
+        let seeds = match (&overrides.seeds, file.seeds) {
+            (Some(s), _) => s.clone(),
+            (None, Some(SeedsField::Text(t))) => {
+                parse_seeds(&t).map_err(|source| ConfigError::Seeds { path: p(), source })?
+            }
+            (None, Some(SeedsField::List(l))) if !l.is_empty() => l,
+            (None, Some(SeedsField::List(_))) => {
+                return Err(ConfigError::Seeds {
+                    path: p(),
+                    source: SeedsError::Empty("[]".into()),
+                })
+            }
+            (None, None) => vec![0],
+        };
+        let mut params = file.params;
+        let mut per_method = BTreeMap::new();
+        for (name, table) in file.method {
+            let m = name.parse::<Method>().map_err(|e| ConfigError::BadValue {
+                path: p(),
+                key: format!("method.{name}"),
+                message: e.to_string(),
+            })?;
+            per_method.insert(m, table);
+        }
+        for item in &overrides.set {
+            let (key, value) = parse_set(item)?;
+            match key.split_once('.') {
+                Some((m, k)) => {
+                    let m = m
+                        .parse::<Method>()
+                        .map_err(|_| ConfigError::BadSet(item.clone()))?;
+                    per_method
+                        .entry(m)
+                        .or_default()
+                        .insert(k.to_string(), value);
+                }
+                None => {
+                    // A command-line value wins over the file's per-method values too.
+                    for table in per_method.values_mut() {
+                        table.remove(&key);
+                    }
+                    params.insert(key, value);
+                }
+            }
+        }
+        let exp = Experiment {
+            name: file.name.unwrap_or_else(|| default_name.to_string()),
+            methods,
+            seeds,
+            path: p(),
+            params,
+            per_method,
+        };
+        // Resolve every run once now, so a typo fails before any run starts.
+        exp.runs()?;
+        Ok(exp)
+    }
+
+    /// Every (method, sweep point, seed) run, methods outermost, seeds innermost.
+    pub fn runs(&self) -> Result<Vec<RunSpec>, ConfigError> {
+        let mut runs = Vec::new();
+        for &method in &self.methods {
+            let mut table = self.params.clone();
+            if let Some(extra) = self.per_method.get(&method) {
+                for (k, v) in extra {
+                    table.insert(k.clone(), v.clone());
+                }
+            }
+            for (variant, point) in expand_grid(&table) {
+                let config = resolve(&self.path, method, &point)?;
+                for &seed in &self.seeds {
+                    runs.push(RunSpec {
+                        experiment: self.name.clone(),
+                        method,
+                        variant: variant.clone(),
+                        seed,
+                        config: config.clone(),
+                    });
+                }
+            }
+        }
+        Ok(runs)
+    }
+}
+
+fn parse_set(item: &str) -> Result<(String, toml::Value), ConfigError> {
+    let (key, raw) = item
+        .split_once('=')
+        .ok_or_else(|| ConfigError::BadSet(item.to_string()))?;
+    let key = key.trim();
+    if key.is_empty() {
+        return Err(ConfigError::BadSet(item.to_string()));
+    }
+    // Read the value as TOML (numbers, booleans, lists); a bare word is a string.
+    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(raw.trim().to_string()));
+    Ok((key.to_string(), value))
+}
+
+/// Expand list-valued keys into the grid of their combinations (keys sorted by
+/// name, so variant names are stable). Each point is named by its swept keys.
+fn expand_grid(table: &toml::Table) -> Vec<(String, toml::Table)> {
+    let mut points = vec![(String::new(), toml::Table::new())];
+    for (key, value) in table {
+        let choices: Vec<toml::Value> = match value {
+            toml::Value::Array(items) => items.clone(),
+            other => vec![other.clone()],
+        };
+        let swept = matches!(value, toml::Value::Array(_));
+        let mut next = Vec::with_capacity(points.len() * choices.len());
+        for (name, point) in &points {
+            for choice in &choices {
+                let mut point = point.clone();
+                point.insert(key.clone(), choice.clone());
+                let name = if swept {
+                    let label = format!("{key}={}", value_label(choice));
+                    if name.is_empty() {
+                        label
+                    } else {
+                        format!("{name},{label}")
+                    }
+                } else {
+                    name.clone()
+                };
+                next.push((name, point));
+            }
+        }
+        points = next;
+    }
+    points
+}
+
+fn value_label(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// Resolve one sweep point for one method: paper defaults, then the user's keys, then checks.
+fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig, ConfigError> {
+    let p = || path.to_path_buf();
+    let bad = |key: &str, message: String| ConfigError::BadValue {
+        path: p(),
+        key: key.to_string(),
+        message,
+    };
+    let env: EnvName = match point.get("env_name") {
+        Some(v) => v.clone().try_into().map_err(|_| {
+            bad(
+                "env_name",
+                format!("expected \"BP_MA\" or \"OSD_S_4\", got {v}"),
+            )
+        })?,
+        None => EnvName::BoxPushing,
+    };
+    let grid_dim = match point.get("grid_dim") {
+        Some(toml::Value::Integer(n)) if *n > 0 => *n as usize,
+        Some(v) => {
+            return Err(bad(
+                "grid_dim",
+                format!("expected a positive integer, got {v}"),
+            ))
+        }
+        None => 10,
+    };
+    let defaults = paper_defaults(env, grid_dim, method);
+    let mut table = toml::Table::try_from(&defaults).expect("RunConfig serializes to a table");
+    for (key, value) in point {
+        if !table.contains_key(key) {
+            return Err(ConfigError::UnknownKey {
+                path: p(),
+                key: key.clone(),
+            });
+        }
+        // Accept integers where floats are expected (`l_rate = 1` means 1.0).
+        let value = match (&table[key], value) {
+            (toml::Value::Float(_), toml::Value::Integer(i)) => toml::Value::Float(*i as f64),
+            _ => value.clone(),
+        };
+        if std::mem::discriminant(&table[key]) != std::mem::discriminant(&value) {
+            return Err(bad(
+                key,
+                format!("expected {}, got {value}", table[key].type_str()),
+            ));
+        }
+        table.insert(key.clone(), value);
+    }
+    let config: RunConfig = toml::Value::Table(table)
+        .try_into()
+        .map_err(|e: toml::de::Error| bad("config", e.message().to_string()))?;
+    validate(&config, method).map_err(|(key, message)| bad(key, message))?;
+    Ok(config)
+}
+
+/// Range checks that types cannot express. Returns the offending key and why.
+fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
+    let positive = [
+        ("env_terminate_step", c.env_terminate_step),
+        ("total_epi", c.total_epi),
+        ("replay_buffer_size", c.replay_buffer_size),
+        ("h_stable_at", c.h_stable_at),
+        ("eps_l_d_steps", c.eps_l_d_steps),
+        ("train_freq", c.train_freq),
+        ("target_update_freq", c.target_update_freq),
+        ("trace_len", c.trace_len),
+        ("sub_trace_len", c.sub_trace_len),
+        ("batch_size", c.batch_size),
+        ("dec_mlp_layer_size", c.dec_mlp_layer_size),
+        ("dec_rnn_h_size", c.dec_rnn_h_size),
+        ("cen_mlp_layer_size", c.cen_mlp_layer_size),
+        ("cen_rnn_h_size", c.cen_rnn_h_size),
+        ("eval_freq", c.eval_freq),
+        ("eval_num_epi", c.eval_num_epi),
+        ("checkpoint_freq", c.checkpoint_freq),
+    ];
+    for (key, value) in positive {
+        if value == 0 {
+            return Err((key, "must be > 0, got 0".into()));
+        }
+    }
+    if c.env_name == EnvName::BoxPushing && c.grid_dim < 8 {
+        return Err((
+            "grid_dim",
+            format!("Box Pushing needs a grid of at least 8, got {}", c.grid_dim),
+        ));
+    }
+    let unit = [
+        ("eps_end", c.eps_end),
+        ("discount", c.discount),
+        ("init_h", c.init_h),
+        ("end_h", c.end_h),
+    ];
+    for (key, value) in unit {
+        if !(0.0..=1.0).contains(&value) {
+            return Err((key, format!("must be in [0, 1], got {value}")));
+        }
+    }
+    if !(c.l_rate > 0.0 && c.l_rate.is_finite()) {
+        return Err((
+            "l_rate",
+            format!("must be a positive number, got {}", c.l_rate),
+        ));
+    }
+    if !(c.tb_m_noisy >= 0.0 && c.tb_m_noisy.is_finite()) {
+        return Err(("tb_m_noisy", format!("must be >= 0, got {}", c.tb_m_noisy)));
+    }
+    if method == Method::Our2 && !c.sample_epi {
+        // Spec Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
+        return Err((
+            "sample_epi",
+            "our2 needs the episode buffer (sample_epi = true), as in the reference (spec Q10)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str, set: &[&str]) -> Result<Experiment, ConfigError> {
+        let o = Overrides {
+            set: set.iter().map(|s| s.to_string()).collect(),
+            ..Default::default()
+        };
+        Experiment::parse(text, Path::new("test.toml"), "test", &o)
+    }
+
+    #[test]
+    fn env_name_alone_gives_the_papers_bp10_setting() {
+        let e = parse("methods = [\"our1\"]\n[params]\nenv_name = \"BP_MA\"", &[]).unwrap();
+        let c = &e.runs().unwrap()[0].config;
+        assert_eq!((c.total_epi, c.trace_len, c.batch_size), (15000, 15, 128));
+        assert_eq!((c.dec_rnn_h_size, c.cen_rnn_h_size), (32, 64));
+        assert!(c.cen_explore && !c.h_explore && !c.sample_epi);
+        assert_eq!(c.discount, 0.98);
+    }
+
+    #[test]
+    fn dec_hddrqn_defaults_are_hysteretic_and_others_are_not() {
+        let e = parse("methods = [\"dec-hddrqn\", \"cen-ddrqn\"]", &[]).unwrap();
+        let runs = e.runs().unwrap();
+        assert_eq!((runs[0].config.init_h, runs[0].config.end_h), (0.2, 0.4));
+        assert_eq!((runs[1].config.init_h, runs[1].config.end_h), (1.0, 1.0));
+    }
+
+    #[test]
+    fn set_overrides_file_values_and_reads_numbers() {
+        let e = parse(
+            "[params]\ntotal_epi = 100\n[method.our1]\ntotal_epi = 50",
+            &["total_epi=300", "our1.l_rate=0.01"],
+        )
+        .unwrap();
+        let c = &e.runs().unwrap()[0].config;
+        assert_eq!(c.total_epi, 300);
+        assert_eq!(c.l_rate, 0.01);
+    }
+
+    #[test]
+    fn unknown_key_is_named_in_the_error() {
+        let err = parse("[params]\ntotal_episodes = 5", &[]).unwrap_err();
+        assert!(err.to_string().contains("`total_episodes`"), "{err}");
+        let err = parse("", &["trace_lenn=3"]).unwrap_err();
+        assert!(err.to_string().contains("`trace_lenn`"), "{err}");
+    }
+
+    #[test]
+    fn bad_values_name_the_key() {
+        for (set, key) in [
+            ("batch_size=0", "batch_size"),
+            ("l_rate=-1", "l_rate"),
+            ("discount=1.5", "discount"),
+            ("grid_dim=5", "grid_dim"),
+            ("total_epi=\"many\"", "total_epi"),
+        ] {
+            let err = parse("", &[set]).unwrap_err();
+            assert!(
+                err.to_string().contains(&format!("`{key}`")),
+                "{set}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn list_values_expand_into_named_variants() {
+        let e = parse(
+            "methods = [\"our1\"]\nseeds = [1, 2]\n[params]\ntrace_len = [10, 15]\nl_rate = [0.001, 0.01]",
+            &[],
+        )
+        .unwrap();
+        let runs = e.runs().unwrap();
+        assert_eq!(runs.len(), 8);
+        let mut names: Vec<_> = runs.iter().map(|r| r.curve_name()).collect();
+        names.dedup();
+        assert_eq!(names.len(), 4);
+        assert!(
+            names.contains(&"our1@l_rate=0.01,trace_len=15".to_string()),
+            "{names:?}"
+        );
+        let r = runs
+            .iter()
+            .find(|r| r.variant == "l_rate=0.01,trace_len=10")
+            .unwrap();
+        assert_eq!((r.config.trace_len, r.config.l_rate), (10, 0.01));
+    }
+
+    #[test]
+    fn warehouse_defaults_follow_figure_5() {
+        let e = parse(
+            "methods = [\"our2\"]\n[params]\nenv_name = \"OSD_S_4\"",
+            &[],
+        )
+        .unwrap();
+        let c = &e.runs().unwrap()[0].config;
+        assert!(c.sample_epi && c.h_explore);
+        assert_eq!((c.batch_size, c.train_freq, c.total_epi), (16, 30, 40000));
+        assert_eq!(
+            (c.l_rate, c.discount, c.replay_buffer_size),
+            (0.0006, 1.0, 1000)
+        );
+    }
+
+    #[test]
+    fn our2_on_windows_is_refused() {
+        let err = parse("methods = [\"our2\"]", &[]).unwrap_err();
+        assert!(err.to_string().contains("sample_epi"), "{err}");
+    }
+
+    #[test]
+    fn resolved_config_round_trips_through_toml() {
+        let e = parse(DEFAULT_EXPERIMENT, &[]).unwrap();
+        let c = e.runs().unwrap()[0].config.clone();
+        let text = toml::to_string(&c).unwrap();
+        assert_eq!(toml::from_str::<RunConfig>(&text).unwrap(), c);
+    }
+}

@@ -1,0 +1,11 @@
+//! Experiments: configs, seeds, the parallel runner, metrics and checkpoints.
+
+pub mod atomic;
+pub mod config;
+pub mod metrics;
+pub mod report;
+pub mod rollout;
+pub mod runner;
+pub mod seeds;
+pub mod slurm;
+pub mod train_run;

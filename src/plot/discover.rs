@@ -1,0 +1,424 @@
+//! Finding the runs of a results tree: `<results>/<experiment>/<curve>/seed-<k>/` with a
+//! `metrics.csv`, a `config.toml` and, once complete, a `finished` marker (`experiment::config`,
+//! `experiment::runner`).
+//!
+//! Results trees collect junk (a run killed before its first evaluation, a stray file, a copy
+//! being synced), so anything that is not a run is skipped with a note. A malformed metrics file
+//! is skipped with a warning as long as some other run is readable; if none is, it is the error.
+
+use super::error::PlotError;
+use super::setting::EnvSetting;
+use crate::algos::method::Method;
+use crate::experiment::metrics::{self, MetricsError};
+use crate::experiment::runner::FINISHED_MARKER;
+use std::path::{Path, PathBuf};
+
+/// The file each run writes its learning curve to.
+pub const METRICS_FILE: &str = "metrics.csv";
+/// The file each run writes its resolved config to.
+pub const CONFIG_FILE: &str = "config.toml";
+
+/// One run's learning curve and what a figure needs to know about it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunData {
+    pub seed: u64,
+    pub dir: PathBuf,
+    /// `(episode, eval_return)` per evaluation, episodes strictly increasing.
+    pub points: Vec<(u64, f64)>,
+    /// Whether the run wrote its `finished` marker.
+    pub finished: bool,
+    /// Wall-clock seconds at the run's last evaluation.
+    pub wall_seconds: f64,
+    /// The domain setting from `config.toml`, when it is present and readable.
+    pub setting: Option<EnvSetting>,
+}
+
+/// All runs of one curve (a method, or a method at one sweep point), seeds ascending.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveData {
+    /// The directory name: `our1` or `our1@trace_len=10,l_rate=0.001`.
+    pub name: String,
+    /// The method, when the name starts with one of the five.
+    pub method: Option<Method>,
+    /// The sweep point after `@`, empty without a sweep.
+    pub variant: String,
+    pub runs: Vec<RunData>,
+}
+
+impl CurveData {
+    /// The paper's legend name, with the sweep point appended:
+    /// `Our-1` or `Our-1 @ trace_len=10, l_rate=0.001`. Unknown methods keep their directory name.
+    pub fn legend(&self) -> String {
+        let base = self.method.map_or(self.name.as_str(), |m| m.legend());
+        if self.method.is_none() || self.variant.is_empty() {
+            base.to_string()
+        } else {
+            format!("{base} @ {}", self.variant.replace(',', ", "))
+        }
+    }
+}
+
+/// The curves of one experiment, in the paper's method order, then by sweep point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExperimentData {
+    pub name: String,
+    pub curves: Vec<CurveData>,
+}
+
+/// Everything found under a results root, plus notes on what was skipped and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Discovery {
+    pub experiments: Vec<ExperimentData>,
+    pub notes: Vec<String>,
+}
+
+/// Scan `results` for runs. Fails only when the root cannot be read, when it holds no run at
+/// all, or when every metrics file found is malformed.
+pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
+    let exp_dirs = sorted_subdirs(results).map_err(|source| PlotError::ReadResults {
+        path: results.to_path_buf(),
+        source,
+    })?;
+    let mut notes = Vec::new();
+    let mut malformed: Vec<(PathBuf, String)> = Vec::new();
+    let mut experiments = Vec::new();
+    for exp_dir in exp_dirs {
+        let mut curves = Vec::new();
+        for curve_dir in subdirs_or_note(&exp_dir, &mut notes) {
+            let name = file_name(&curve_dir);
+            let (method_name, variant) = name.split_once('@').unwrap_or((&name, ""));
+            let method = method_name.parse::<Method>().ok();
+            let mut runs = Vec::new();
+            for run_dir in subdirs_or_note(&curve_dir, &mut notes) {
+                match read_run(&run_dir) {
+                    Ok(run) => runs.push(run),
+                    Err(RunProblem::Skip(why)) => {
+                        notes.push(format!("skipping {}: {why}", run_dir.display()))
+                    }
+                    Err(RunProblem::Malformed(path, why)) => malformed.push((path, why)),
+                }
+            }
+            if runs.is_empty() {
+                continue;
+            }
+            if method.is_none() {
+                notes.push(format!(
+                    "{}: `{method_name}` is not a known method; using the directory name as its legend",
+                    curve_dir.display()
+                ));
+            }
+            runs.sort_by_key(|r| r.seed);
+            curves.push(CurveData {
+                method,
+                variant: variant.to_string(),
+                name,
+                runs,
+            });
+        }
+        curves.sort_by_key(curve_order);
+        if !curves.is_empty() {
+            experiments.push(ExperimentData {
+                name: file_name(&exp_dir),
+                curves,
+            });
+        }
+    }
+    if experiments.is_empty() {
+        return Err(match malformed.into_iter().next() {
+            Some((path, message)) => PlotError::Malformed { path, message },
+            None => PlotError::NoRuns {
+                path: results.to_path_buf(),
+            },
+        });
+    }
+    for (path, why) in malformed {
+        notes.push(format!(
+            "warning: skipping malformed {}: {why}",
+            path.display()
+        ));
+    }
+    Ok(Discovery { experiments, notes })
+}
+
+/// Paper order of methods (`Method::ALL`), then sweep point; unknown names last.
+fn curve_order(c: &CurveData) -> (usize, String, String) {
+    let rank = c
+        .method
+        .and_then(|m| Method::ALL.iter().position(|&x| x == m))
+        .unwrap_or(Method::ALL.len());
+    (rank, c.variant.clone(), c.name.clone())
+}
+
+enum RunProblem {
+    /// Not a run (or not one yet): a note.
+    Skip(String),
+    /// A run whose metrics file cannot be used: a warning, or the error if nothing else exists.
+    Malformed(PathBuf, String),
+}
+
+fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
+    let name = file_name(dir);
+    let seed = name
+        .strip_prefix("seed-")
+        .and_then(|s| s.parse::<u64>().ok())
+        .ok_or_else(|| RunProblem::Skip("not a seed-<k> directory".into()))?;
+    let metrics_path = dir.join(METRICS_FILE);
+    if !metrics_path.is_file() {
+        return Err(RunProblem::Skip(format!("no {METRICS_FILE}")));
+    }
+    let bad = |why: String| RunProblem::Malformed(metrics_path.clone(), why);
+    let rows = metrics::read(&metrics_path).map_err(|e| {
+        bad(match e {
+            MetricsError::Csv { source, .. } => source.to_string(),
+            MetricsError::Io { source, .. } => source.to_string(),
+        })
+    })?;
+    if rows.is_empty() {
+        // A header alone is a run before its first evaluation, unless it is not our header.
+        let header = std::fs::read_to_string(&metrics_path).unwrap_or_default();
+        let columns: Vec<&str> = header.lines().next().unwrap_or("").split(',').collect();
+        if !["episode", "eval_return"]
+            .iter()
+            .all(|c| columns.contains(c))
+        {
+            return Err(bad(
+                "the header lacks the `episode` and `eval_return` columns".into(),
+            ));
+        }
+        return Err(RunProblem::Skip("no evaluation rows yet".into()));
+    }
+    for (i, pair) in rows.windows(2).enumerate() {
+        if pair[1].episode <= pair[0].episode {
+            return Err(bad(format!(
+                "row {}: episode {} does not increase (previous {})",
+                i + 2,
+                pair[1].episode,
+                pair[0].episode
+            )));
+        }
+    }
+    if let Some(row) = rows.iter().find(|r| !r.eval_return.is_finite()) {
+        return Err(bad(format!(
+            "episode {}: eval_return is {}",
+            row.episode, row.eval_return
+        )));
+    }
+    let setting = std::fs::read_to_string(dir.join(CONFIG_FILE))
+        .ok()
+        .and_then(|text| EnvSetting::from_config_toml(&text).ok());
+    Ok(RunData {
+        seed,
+        dir: dir.to_path_buf(),
+        points: rows.iter().map(|r| (r.episode, r.eval_return)).collect(),
+        finished: dir.join(FINISHED_MARKER).exists(),
+        wall_seconds: rows.last().map_or(0.0, |r| r.wall_seconds),
+        setting,
+    })
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Subdirectories sorted by name (files are ignored: they are not part of the layout).
+fn sorted_subdirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut dirs = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let path = entry?.path();
+        if path.is_dir() {
+            dirs.push(path);
+        }
+    }
+    dirs.sort();
+    Ok(dirs)
+}
+
+fn subdirs_or_note(dir: &Path, notes: &mut Vec<String>) -> Vec<PathBuf> {
+    sorted_subdirs(dir).unwrap_or_else(|e| {
+        notes.push(format!("skipping {}: {e}", dir.display()));
+        Vec::new()
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::algos::hyper::{paper_defaults, EnvName};
+    use crate::experiment::metrics::MetricsRow;
+
+    /// Write a synthetic run: returns at the given episodes, a config, and optionally the marker.
+    pub(crate) fn write_run(
+        root: &Path,
+        experiment: &str,
+        curve: &str,
+        seed: u64,
+        points: &[(u64, f64)],
+        env: (EnvName, usize),
+        finished: bool,
+    ) -> PathBuf {
+        let dir = root
+            .join(experiment)
+            .join(curve)
+            .join(format!("seed-{seed}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rows: Vec<MetricsRow> = points
+            .iter()
+            .map(|&(episode, eval_return)| MetricsRow {
+                episode,
+                env_steps: episode * 50,
+                updates: episode / 2,
+                eval_return,
+                epsilon: 1.0,
+                hysteresis: 1.0,
+                loss: None,
+                wall_seconds: episode as f64 * 0.5,
+            })
+            .collect();
+        metrics::write(&dir.join(METRICS_FILE), &rows).unwrap();
+        let config = paper_defaults(env.0, env.1, Method::Our1);
+        std::fs::write(dir.join(CONFIG_FILE), toml::to_string(&config).unwrap()).unwrap();
+        if finished {
+            std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();
+        }
+        dir
+    }
+
+    const BP10: (EnvName, usize) = (EnvName::BoxPushing, 10);
+
+    #[test]
+    fn finds_experiments_curves_and_seeds_in_paper_order() {
+        let t = tempfile::tempdir().unwrap();
+        let pts = [(0, 1.0), (10, 2.0)];
+        write_run(t.path(), "fig4a", "our1", 10, &pts, BP10, true);
+        write_run(t.path(), "fig4a", "our1", 2, &pts[..1], BP10, false);
+        write_run(t.path(), "fig4a", "dec-hddrqn", 0, &pts, BP10, true);
+        write_run(t.path(), "fig4a", "our1@trace_len=10", 0, &pts, BP10, true);
+        let d = discover(t.path()).unwrap();
+        assert_eq!(d.experiments.len(), 1);
+        let names: Vec<&str> = d.experiments[0]
+            .curves
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect();
+        assert_eq!(names, ["dec-hddrqn", "our1", "our1@trace_len=10"]);
+        let our1 = &d.experiments[0].curves[1];
+        assert_eq!(
+            our1.runs.iter().map(|r| r.seed).collect::<Vec<_>>(),
+            [2, 10]
+        );
+        assert!(!our1.runs[0].finished && our1.runs[1].finished);
+        assert_eq!(our1.runs[0].points, vec![(0, 1.0)]);
+        assert_eq!(our1.runs[1].wall_seconds, 5.0);
+        assert_eq!(
+            our1.runs[1].setting.unwrap().optimal_return(),
+            Some(80.71093744250365)
+        );
+        assert!(d.notes.is_empty(), "{:?}", d.notes);
+    }
+
+    #[test]
+    fn legends_use_the_paper_names_with_the_sweep_point() {
+        let c = |name: &str, method, variant: &str| CurveData {
+            name: name.into(),
+            method,
+            variant: variant.into(),
+            runs: vec![],
+        };
+        assert_eq!(c("our1-r", Some(Method::Our1R), "").legend(), "Our-1-R");
+        assert_eq!(
+            c(
+                "our2@l_rate=0.001,trace_len=10",
+                Some(Method::Our2),
+                "l_rate=0.001,trace_len=10"
+            )
+            .legend(),
+            "Our-2 @ l_rate=0.001, trace_len=10"
+        );
+        assert_eq!(c("mine", None, "").legend(), "mine");
+    }
+
+    #[test]
+    fn junk_is_skipped_with_notes() {
+        let t = tempfile::tempdir().unwrap();
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        std::fs::create_dir_all(t.path().join("e/our1/seed-1")).unwrap(); // no metrics yet
+        std::fs::create_dir_all(t.path().join("e/our1/tmp")).unwrap(); // not a seed dir
+        std::fs::write(t.path().join("e/README.txt"), "stray file").unwrap();
+        std::fs::create_dir_all(t.path().join("empty_experiment/our1")).unwrap();
+        let d = discover(t.path()).unwrap();
+        assert_eq!(d.experiments.len(), 1);
+        assert_eq!(d.experiments[0].curves[0].runs.len(), 1);
+        assert_eq!(d.notes.len(), 2, "{:?}", d.notes);
+        assert!(d.notes[0].contains("seed-1") && d.notes[0].contains("no metrics.csv"));
+        assert!(d.notes[1].contains("tmp") && d.notes[1].contains("seed-<k>"));
+    }
+
+    #[test]
+    fn malformed_csv_is_a_warning_when_other_runs_exist() {
+        let t = tempfile::tempdir().unwrap();
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        let bad = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], BP10, true);
+        std::fs::write(bad.join(METRICS_FILE), "episode,eval_return\nten,abc\n").unwrap();
+        let d = discover(t.path()).unwrap();
+        assert_eq!(d.experiments[0].curves[0].runs.len(), 1);
+        assert!(d
+            .notes
+            .iter()
+            .any(|n| n.starts_with("warning") && n.contains("seed-1/metrics.csv")));
+    }
+
+    #[test]
+    fn malformed_csv_is_the_error_when_it_is_the_only_run() {
+        let t = tempfile::tempdir().unwrap();
+        let bad = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        std::fs::write(bad.join(METRICS_FILE), "episode,eval_return\nten,abc\n").unwrap();
+        let err = discover(t.path()).unwrap_err();
+        assert!(matches!(err, PlotError::Malformed { .. }));
+        assert!(err.to_string().contains("seed-0/metrics.csv"), "{err}");
+    }
+
+    #[test]
+    fn a_header_only_run_is_skipped_but_a_foreign_header_is_malformed() {
+        let t = tempfile::tempdir().unwrap();
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        write_run(t.path(), "e", "our1", 1, &[], BP10, false);
+        let foreign = write_run(t.path(), "e", "our1", 2, &[(0, 1.0)], BP10, true);
+        std::fs::write(foreign.join(METRICS_FILE), "x,y\n").unwrap();
+        let d = discover(t.path()).unwrap();
+        assert_eq!(d.experiments[0].curves[0].runs.len(), 1);
+        assert!(d.notes[0].contains("seed-1") && d.notes[0].contains("no evaluation rows"));
+        assert!(d.notes[1].starts_with("warning") && d.notes[1].contains("seed-2"));
+        assert!(d.notes[1].contains("eval_return"), "{:?}", d.notes);
+    }
+
+    #[test]
+    fn episodes_that_go_backwards_are_malformed() {
+        let t = tempfile::tempdir().unwrap();
+        write_run(
+            t.path(),
+            "e",
+            "our1",
+            0,
+            &[(10, 1.0), (10, 2.0)],
+            BP10,
+            true,
+        );
+        let err = discover(t.path()).unwrap_err();
+        assert!(err.to_string().contains("does not increase"), "{err}");
+    }
+
+    #[test]
+    fn empty_or_missing_results_are_errors() {
+        let t = tempfile::tempdir().unwrap();
+        assert!(matches!(
+            discover(t.path()).unwrap_err(),
+            PlotError::NoRuns { .. }
+        ));
+        assert!(matches!(
+            discover(&t.path().join("nope")).unwrap_err(),
+            PlotError::ReadResults { .. }
+        ));
+    }
+}

@@ -1,0 +1,278 @@
+//! From the runs of one experiment to what is drawn: one smoothed curve per method (or sweep
+//! point), its legend with the seed count, the optimal-return line, the partial-results mark, and
+//! the summary rows. Decides everything about the figure except pixels (`render` draws it).
+
+use super::discover::{CurveData, ExperimentData};
+use super::stats::{aggregate, smooth, CurvePoint, SMOOTH_HALF_WINDOW};
+use super::summary::CurveSummary;
+use crate::algos::method::Method;
+
+/// An RGB colour.
+pub type Rgb = (u8, u8, u8);
+
+/// One curve as drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend text, e.g. "Our-1 (n = 40 seeds)".
+    pub label: String,
+    pub colour: Rgb,
+    /// Smoothed mean and standard error per evaluation point (spec 7.2).
+    pub points: Vec<CurvePoint>,
+}
+
+/// Everything a figure shows, independent of the backend.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    pub title: String,
+    pub series: Vec<Series>,
+    /// The optimal return (red dash-dot line), when the runs' setting has a known one.
+    pub optimal: Option<f64>,
+    /// "partial: m of n runs unfinished", when any run lacks its `finished` marker.
+    pub partial: Option<String>,
+    /// What the curves and bands are.
+    pub caption: String,
+}
+
+/// A figure plus its summary rows and notes (e.g. why no optimal line is drawn).
+#[derive(Debug, Clone)]
+pub struct Built {
+    pub figure: Figure,
+    pub summary: Vec<CurveSummary>,
+    pub notes: Vec<String>,
+}
+
+/// Tableau-like colours without red, which is reserved for the optimal line.
+const PALETTE: [Rgb; 9] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (148, 103, 189),
+    (23, 190, 207),
+    (140, 86, 75),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+];
+
+/// Build the figure and summary of one experiment.
+pub fn build(exp: &ExperimentData) -> Built {
+    let mut notes = Vec::new();
+    let (optimal, setting_text) = common_setting(exp, &mut notes);
+    // A method keeps its colour across figures unless a sweep puts it on the figure twice.
+    let one_per_method = exp.curves.iter().all(|c| c.method.is_some())
+        && exp.curves.windows(2).all(|w| w[0].method != w[1].method);
+    let mut series = Vec::new();
+    let mut summary = Vec::new();
+    for (i, curve) in exp.curves.iter().enumerate() {
+        let colour = match curve.method {
+            Some(m) if one_per_method => PALETTE[method_rank(m)],
+            _ => PALETTE[i % PALETTE.len()],
+        };
+        let runs: Vec<&[(u64, f64)]> = curve.runs.iter().map(|r| r.points.as_slice()).collect();
+        let points = smooth(&aggregate(&runs), SMOOTH_HALF_WINDOW);
+        let last = *points
+            .last()
+            .expect("discover keeps only runs with at least one evaluation");
+        summary.push(summarize(curve, &last, optimal));
+        series.push(Series {
+            label: label(curve),
+            colour,
+            points,
+        });
+    }
+    let total: usize = exp.curves.iter().map(|c| c.runs.len()).sum();
+    let unfinished: usize = exp
+        .curves
+        .iter()
+        .map(|c| c.runs.iter().filter(|r| !r.finished).count())
+        .sum();
+    let partial =
+        (unfinished > 0).then(|| format!("partial: {unfinished} of {total} runs unfinished"));
+    let title = match setting_text {
+        Some(s) => format!("{}: {s}", exp.name),
+        None => exp.name.clone(),
+    };
+    let caption = format!(
+        "Mean over seeds of the greedy discounted return; band: standard error (ddof 1); \
+         both smoothed by a centred moving average over {} evaluation points.",
+        2 * SMOOTH_HALF_WINDOW + 1
+    );
+    Built {
+        figure: Figure {
+            title,
+            series,
+            optimal,
+            partial,
+            caption,
+        },
+        summary,
+        notes,
+    }
+}
+
+fn method_rank(m: Method) -> usize {
+    Method::ALL.iter().position(|&x| x == m).unwrap_or(0)
+}
+
+/// "Our-1 (n = 40 seeds)", or "(n = 3 seeds, 1 unfinished)" for partial curves.
+fn label(curve: &CurveData) -> String {
+    let n = curve.runs.len();
+    let unfinished = curve.runs.iter().filter(|r| !r.finished).count();
+    let seeds = if n == 1 { "seed" } else { "seeds" };
+    if unfinished > 0 {
+        format!(
+            "{} (n = {n} {seeds}, {unfinished} unfinished)",
+            curve.legend()
+        )
+    } else {
+        format!("{} (n = {n} {seeds})", curve.legend())
+    }
+}
+
+fn summarize(curve: &CurveData, last: &CurvePoint, optimal: Option<f64>) -> CurveSummary {
+    let finished: Vec<f64> = curve
+        .runs
+        .iter()
+        .filter(|r| r.finished)
+        .map(|r| r.wall_seconds)
+        .collect();
+    CurveSummary {
+        curve: curve.name.clone(),
+        legend: curve.legend(),
+        seeds: curve.runs.len(),
+        finished: finished.len(),
+        final_episode: last.episode,
+        final_mean: last.mean,
+        final_se: last.se,
+        final_n: last.n,
+        optimal,
+        run_minutes: (!finished.is_empty())
+            .then(|| finished.iter().sum::<f64>() / finished.len() as f64 / 60.0),
+    }
+}
+
+/// The optimal return and title description shared by every run that has a readable config.
+/// Runs that disagree (e.g. a sweep over grid_dim) get no line and no description.
+fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>, Option<String>) {
+    let runs = exp.curves.iter().flat_map(|c| &c.runs);
+    let settings: Vec<_> = runs.clone().filter_map(|r| r.setting).collect();
+    let missing = runs.count() - settings.len();
+    let Some(first) = settings.first() else {
+        notes.push(format!(
+            "{}: no readable config.toml; no optimal line",
+            exp.name
+        ));
+        return (None, None);
+    };
+    if missing > 0 {
+        notes.push(format!(
+            "{}: {missing} run(s) without a readable config.toml",
+            exp.name
+        ));
+    }
+    let optimals: Vec<Option<f64>> = settings.iter().map(|s| s.optimal_return()).collect();
+    let optimal = if optimals.iter().all(|o| *o == optimals[0]) {
+        optimals[0]
+    } else {
+        notes.push(format!(
+            "{}: runs have different optimal returns; no optimal line",
+            exp.name
+        ));
+        None
+    };
+    let describe = first.describe();
+    let same_text = settings.iter().all(|s| s.describe() == describe);
+    (optimal, same_text.then_some(describe))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::hyper::EnvName;
+    use crate::plot::discover::{discover, tests::write_run};
+
+    const BP10: (EnvName, usize) = (EnvName::BoxPushing, 10);
+
+    #[test]
+    fn partial_results_are_marked_and_counted_per_curve() {
+        let t = tempfile::tempdir().unwrap();
+        let full: Vec<(u64, f64)> = (0..5).map(|i| (i * 10, i as f64)).collect();
+        write_run(t.path(), "e", "our1", 0, &full, BP10, true);
+        write_run(t.path(), "e", "our1", 1, &full[..2], BP10, false);
+        write_run(t.path(), "e", "cen-ddrqn", 0, &full, BP10, true);
+        let d = discover(t.path()).unwrap();
+        let b = build(&d.experiments[0]);
+        let f = &b.figure;
+        assert_eq!(f.title, "e: Box Pushing 10x10, horizon 100");
+        assert_eq!(
+            f.partial.as_deref(),
+            Some("partial: 1 of 3 runs unfinished")
+        );
+        assert_eq!(f.optimal, Some(80.71093744250365));
+        assert_eq!(f.series[0].label, "Cen-DDRQN (n = 1 seed)");
+        assert_eq!(f.series[1].label, "Our-1 (n = 2 seeds, 1 unfinished)");
+        // Fixed per-method colours: Cen-DDRQN second, Our-1 third in the palette.
+        assert_eq!(f.series[0].colour, PALETTE[1]);
+        assert_eq!(f.series[1].colour, PALETTE[2]);
+        let s = &b.summary[1];
+        assert_eq!(
+            (s.seeds, s.finished, s.final_episode, s.final_n),
+            (2, 1, 40, 1)
+        );
+        // Raw means 0, 1, 2, 3, 4 (both runs agree where they overlap); smoothing over the whole
+        // (short) series gives 2 at every point.
+        assert!((s.final_mean - 2.0).abs() < 1e-12);
+        // SE is 0 everywhere (identical runs, then one run).
+        assert_eq!(s.final_se, 0.0);
+        // wall_seconds = episode * 0.5 = 20 s for the finished run.
+        assert!((s.run_minutes.unwrap() - 20.0 / 60.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn mixed_settings_have_no_optimal_line() {
+        let t = tempfile::tempdir().unwrap();
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        write_run(
+            t.path(),
+            "e",
+            "our2",
+            0,
+            &[(0, 1.0)],
+            (EnvName::Warehouse, 10),
+            true,
+        );
+        let d = discover(t.path()).unwrap();
+        let b = build(&d.experiments[0]);
+        assert_eq!(b.figure.optimal, None);
+        assert_eq!(b.figure.title, "e");
+        assert!(b.figure.partial.is_none());
+        assert!(b.notes.iter().any(|n| n.contains("different optimal")));
+    }
+
+    #[test]
+    fn sweep_variants_of_one_method_get_distinct_colours() {
+        let t = tempfile::tempdir().unwrap();
+        write_run(
+            t.path(),
+            "e",
+            "our1@trace_len=10",
+            0,
+            &[(0, 1.0)],
+            BP10,
+            true,
+        );
+        write_run(
+            t.path(),
+            "e",
+            "our1@trace_len=20",
+            0,
+            &[(0, 1.0)],
+            BP10,
+            true,
+        );
+        let d = discover(t.path()).unwrap();
+        let f = build(&d.experiments[0]).figure;
+        assert_ne!(f.series[0].colour, f.series[1].colour);
+        assert_eq!(f.series[1].label, "Our-1 @ trace_len=20 (n = 1 seed)");
+    }
+}

@@ -1,0 +1,164 @@
+//! Learning-curve figures like the paper's (spec `algorithms.md` 7.2), from a results tree.
+//!
+//! `discover` finds the runs, `stats` turns them into smoothed mean and standard-error curves,
+//! `figure` decides what is drawn, `render` draws it (PNG and SVG), `summary` tabulates the final
+//! returns. [`plot_results`] runs the whole pipeline for `macdec plot`.
+
+pub mod discover;
+pub mod error;
+pub mod figure;
+pub mod font;
+pub mod render;
+pub mod setting;
+pub mod stats;
+pub mod summary;
+
+pub use error::PlotError;
+
+use std::path::{Path, PathBuf};
+use summary::CurveSummary;
+
+/// The files written for one experiment and its summary.
+#[derive(Debug, Clone)]
+pub struct ExperimentPlot {
+    pub experiment: String,
+    /// The figure's title (experiment name and domain).
+    pub title: String,
+    pub png: PathBuf,
+    pub svg: PathBuf,
+    pub summary_csv: PathBuf,
+    pub summary: Vec<CurveSummary>,
+}
+
+/// What [`plot_results`] did, and what it skipped (`notes`, for the user to read).
+#[derive(Debug, Clone)]
+pub struct PlotReport {
+    pub plots: Vec<ExperimentPlot>,
+    pub notes: Vec<String>,
+}
+
+impl PlotReport {
+    /// The Markdown tables of every experiment (for stdout and the README).
+    pub fn markdown(&self) -> String {
+        self.plots
+            .iter()
+            .map(|p| summary::markdown_table(&p.title, &p.summary))
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+}
+
+/// Plot every experiment under `results` into `out`: `<experiment>.png`, `<experiment>.svg` and
+/// `<experiment>_summary.csv`. Works on partial results (unfinished runs, fewer seeds) and says so
+/// in the figure.
+pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError> {
+    let found = discover::discover(results)?;
+    let mut notes = found.notes;
+    std::fs::create_dir_all(out).map_err(|source| PlotError::Write {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut plots = Vec::new();
+    for exp in &found.experiments {
+        let built = figure::build(exp);
+        notes.extend(built.notes);
+        let png = out.join(format!("{}.png", exp.name));
+        let svg = out.join(format!("{}.svg", exp.name));
+        let summary_csv = out.join(format!("{}_summary.csv", exp.name));
+        render::render_png(&built.figure, &png)?;
+        let svg_text = render::render_svg(&built.figure, &svg)?;
+        crate::experiment::atomic::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
+            PlotError::Write {
+                path: svg.clone(),
+                source,
+            }
+        })?;
+        summary::write_csv(&summary_csv, &built.summary)?;
+        plots.push(ExperimentPlot {
+            experiment: exp.name.clone(),
+            title: built.figure.title.clone(),
+            png,
+            svg,
+            summary_csv,
+            summary: built.summary,
+        });
+    }
+    Ok(PlotReport { plots, notes })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::hyper::EnvName;
+    use discover::tests::write_run;
+
+    /// A noisy rising learning curve, deterministic per seed.
+    fn curve(seed: u64, scale: f64, len: u64) -> Vec<(u64, f64)> {
+        (0..len)
+            .map(|i| {
+                let t = i as f64 / 150.0;
+                let wiggle = ((i * 7919 + seed * 104729) % 23) as f64 - 11.0;
+                (i * 10, -20.0 + scale * (1.0 - (-3.0 * t).exp()) + wiggle)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn plots_synthetic_results_to_png_svg_and_summary() {
+        let t = tempfile::tempdir().unwrap();
+        let res = t.path().join("results");
+        let bp10 = (EnvName::BoxPushing, 10);
+        for seed in 0..3 {
+            let pts = curve(seed, 95.0, 151);
+            write_run(&res, "fig4a_bp10", "our1", seed, &pts, bp10, true);
+            let pts = curve(seed + 10, 60.0, 151);
+            write_run(&res, "fig4a_bp10", "dec-hddrqn", seed, &pts, bp10, true);
+        }
+        // Cen-DDRQN: two seeds, one unfinished at episode 800.
+        write_run(
+            &res,
+            "fig4a_bp10",
+            "cen-ddrqn",
+            0,
+            &curve(20, 85.0, 151),
+            bp10,
+            true,
+        );
+        write_run(
+            &res,
+            "fig4a_bp10",
+            "cen-ddrqn",
+            1,
+            &curve(21, 85.0, 81),
+            bp10,
+            false,
+        );
+        let out = t.path().join("plots");
+        let report = plot_results(&res, &out).unwrap();
+        assert_eq!(report.plots.len(), 1);
+        let p = &report.plots[0];
+        let png = std::fs::metadata(&p.png).unwrap().len();
+        let svg_len = std::fs::metadata(&p.svg).unwrap().len();
+        assert!(png > 20_000, "png only {png} bytes");
+        assert!(svg_len > 10_000, "svg only {svg_len} bytes");
+        let svg = std::fs::read_to_string(&p.svg).unwrap();
+        for needle in [
+            "Dec-HDDRQN (n = 3 seeds)",
+            "Cen-DDRQN (n = 2 seeds, 1 unfinished)",
+            "Our-1 (n = 3 seeds)",
+            "optimal return 80.71",
+            "partial: 1 of 8 runs unfinished",
+            "training episodes",
+            "discounted return",
+            "fig4a_bp10: Box Pushing 10x10, horizon 100",
+        ] {
+            assert!(svg.contains(needle), "SVG lacks {needle:?}");
+        }
+        let csv = std::fs::read_to_string(&p.summary_csv).unwrap();
+        assert_eq!(csv.lines().count(), 4);
+        assert!(csv.contains("cen-ddrqn,Cen-DDRQN,2,1,1500,"));
+        let md = report.markdown();
+        assert!(md.contains("| Our-1 | 3 (3) | 1500 |"), "{md}");
+        assert!(report.notes.is_empty(), "{:?}", report.notes);
+    }
+}

@@ -1,0 +1,284 @@
+//! Drawing a [`Figure`] with plotters, as PNG and SVG from the same code: the paper's layout
+//! (curves with shaded standard-error bands, a red dash-dot optimal line) with large, readable
+//! text.
+
+use super::error::PlotError;
+use super::figure::{Figure, Rgb};
+use super::font::{self, FAMILY};
+use super::summary::format_return;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::Path;
+
+/// Figure size in pixels (PNG) and user units (SVG).
+pub const SIZE: (u32, u32) = (1200, 800);
+
+const TITLE_PX: u32 = 30;
+const AXIS_DESC_PX: u32 = 24;
+const TICK_PX: u32 = 19;
+const LEGEND_PX: u32 = 19;
+const CAPTION_PX: u32 = 16;
+const OPTIMAL_RED: RGBColor = RGBColor(214, 39, 40);
+
+/// Draw `fig` into a PNG file at `path`.
+pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
+    font::register()?;
+    let err = |message: String| PlotError::Draw {
+        path: path.to_path_buf(),
+        message,
+    };
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    draw(&root, fig).map_err(err)?;
+    root.present().map_err(|e| err(e.to_string()))
+}
+
+/// Draw `fig` as SVG text; `path` is only used in error messages.
+pub fn render_svg(fig: &Figure, path: &Path) -> Result<String, PlotError> {
+    font::register()?;
+    let err = |message: String| PlotError::Draw {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw(&root, fig).map_err(err)?;
+        root.present().map_err(|e| err(e.to_string()))?;
+    }
+    Ok(svg)
+}
+
+fn rgb((r, g, b): Rgb) -> RGBColor {
+    RGBColor(r, g, b)
+}
+
+/// The data ranges shown: every curve's band and the optimal line, padded by 6% so nothing touches
+/// the frame. Never empty, even for a single point.
+fn ranges(fig: &Figure) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
+    let points = fig.series.iter().flat_map(|s| &s.points);
+    let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in points {
+        x0 = x0.min(p.episode as f64);
+        x1 = x1.max(p.episode as f64);
+        y0 = y0.min(p.mean - p.se);
+        y1 = y1.max(p.mean + p.se);
+    }
+    if let Some(opt) = fig.optimal {
+        y0 = y0.min(opt);
+        y1 = y1.max(opt);
+    }
+    if !x0.is_finite() {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    x0 = x0.min(0.0);
+    if x1 <= x0 {
+        x1 = x0 + 1.0;
+    }
+    let pad = if y1 > y0 { 0.06 * (y1 - y0) } else { 1.0 };
+    (x0..x1, (y0 - pad)..(y1 + pad))
+}
+
+/// The on-segments of a dash-dot pattern along [x0, x1], in data units, given data units per
+/// pixel: a 16 px dash, 6 px gap, 3 px dot, 6 px gap, repeated.
+fn dash_dot_segments(x0: f64, x1: f64, units_per_px: f64) -> Vec<(f64, f64)> {
+    let pattern = [(16.0, 6.0), (3.0, 6.0)];
+    let mut segs = Vec::new();
+    let mut x = x0;
+    'outer: loop {
+        for (on, off) in pattern {
+            if x >= x1 {
+                break 'outer;
+            }
+            let end = (x + on * units_per_px).min(x1);
+            segs.push((x, end));
+            x = end + off * units_per_px;
+        }
+    }
+    segs
+}
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let (w, h) = root.dim_in_pixel();
+    let (top, rest) = root.split_vertically(76);
+    let (main, bottom) = rest.split_vertically(h - 76 - 40);
+
+    let title_style =
+        TextStyle::from((FAMILY, TITLE_PX).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
+    top.draw_text(&fig.title, &title_style, (w as i32 / 2, 28))
+        .map_err(e)?;
+    if let Some(partial) = &fig.partial {
+        let style = TextStyle::from((FAMILY, LEGEND_PX).into_font())
+            .color(&RGBColor(170, 20, 20))
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        top.draw_text(partial, &style, (w as i32 / 2, 62))
+            .map_err(e)?;
+    }
+    let caption_style = TextStyle::from((FAMILY, CAPTION_PX).into_font())
+        .color(&RGBColor(80, 80, 80))
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    bottom
+        .draw_text(&fig.caption, &caption_style, (w as i32 / 2, 20))
+        .map_err(e)?;
+
+    let (xr, yr) = ranges(fig);
+    let (x_lo, x_hi) = (xr.start, xr.end);
+    let mut chart = ChartBuilder::on(&main)
+        .margin_left(16)
+        .margin_right(36)
+        .margin_top(8)
+        .x_label_area_size(64)
+        .y_label_area_size(90)
+        .build_cartesian_2d(xr, yr)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("training episodes")
+        .y_desc("discounted return")
+        .axis_desc_style((FAMILY, AXIS_DESC_PX))
+        .label_style((FAMILY, TICK_PX))
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| trim_number(*y))
+        .bold_line_style(BLACK.mix(0.10))
+        .light_line_style(BLACK.mix(0.03))
+        .axis_style(BLACK.mix(0.6))
+        .draw()
+        .map_err(e)?;
+
+    // Bands first, so every line is drawn on top of every band.
+    for s in &fig.series {
+        let upper = s.points.iter().map(|p| (p.episode as f64, p.mean + p.se));
+        let lower = s
+            .points
+            .iter()
+            .rev()
+            .map(|p| (p.episode as f64, p.mean - p.se));
+        let outline: Vec<(f64, f64)> = upper.chain(lower).collect();
+        chart
+            .draw_series(std::iter::once(Polygon::new(
+                outline,
+                rgb(s.colour).mix(0.22).filled(),
+            )))
+            .map_err(e)?;
+    }
+    for s in &fig.series {
+        let colour = rgb(s.colour);
+        let line: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .map(|p| (p.episode as f64, p.mean))
+            .collect();
+        let single = line.len() < 2;
+        chart
+            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(3)))
+            .map_err(e)?
+            .label(&s.label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 28, y)], colour.stroke_width(4))
+            });
+        if single {
+            chart
+                .draw_series(line.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(e)?;
+        }
+    }
+    if let Some(opt) = fig.optimal {
+        let px_width = chart.plotting_area().get_pixel_range().0.len().max(1) as f64;
+        let units_per_px = (x_hi - x_lo) / px_width;
+        let style = OPTIMAL_RED.stroke_width(3);
+        let segs = dash_dot_segments(x_lo, x_hi, units_per_px);
+        chart
+            .draw_series(
+                segs.into_iter()
+                    .map(|(a, b)| PathElement::new(vec![(a, opt), (b, opt)], style)),
+            )
+            .map_err(e)?
+            .label(format!("optimal return {}", format_return(opt)))
+            .legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(0, 0), (12, 0)], style)
+                    + PathElement::new(vec![(16, 0), (18, 0)], style)
+                    + PathElement::new(vec![(22, 0), (28, 0)], style)
+            });
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .margin(16)
+        .legend_area_size(36)
+        .label_font((FAMILY, LEGEND_PX))
+        .background_style(WHITE.mix(0.88))
+        .border_style(BLACK.mix(0.35))
+        .draw()
+        .map_err(e)?;
+    Ok(())
+}
+
+/// Tick labels without trailing zeros: 80, 2.5, -10.
+fn trim_number(v: f64) -> String {
+    let s = format!("{v:.2}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::stats::CurvePoint;
+
+    #[test]
+    fn dash_dot_alternates_long_dash_and_dot_and_stays_in_range() {
+        // 1 unit per pixel: dash [0, 16], gap to 22, dot [22, 25], gap to 31, dash [31, 47] ...
+        let segs = dash_dot_segments(0.0, 40.0, 1.0);
+        assert_eq!(segs, vec![(0.0, 16.0), (22.0, 25.0), (31.0, 40.0)]);
+    }
+
+    #[test]
+    fn y_range_covers_bands_and_the_optimal_line_with_padding() {
+        let fig = Figure {
+            title: "t".into(),
+            series: vec![crate::plot::figure::Series {
+                label: "a".into(),
+                colour: (0, 0, 0),
+                points: vec![
+                    CurvePoint {
+                        episode: 0,
+                        mean: -10.0,
+                        se: 2.0,
+                        n: 2,
+                    },
+                    CurvePoint {
+                        episode: 100,
+                        mean: 40.0,
+                        se: 5.0,
+                        n: 2,
+                    },
+                ],
+            }],
+            optimal: Some(80.0),
+            partial: None,
+            caption: String::new(),
+        };
+        let (x, y) = ranges(&fig);
+        assert_eq!(x, 0.0..100.0);
+        // data span -12 .. 80 = 92, padded by 6% = 5.52 each side
+        assert!((y.start - (-12.0 - 5.52)).abs() < 1e-9);
+        assert!((y.end - (80.0 + 5.52)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn tick_labels_drop_trailing_zeros() {
+        assert_eq!(trim_number(80.0), "80");
+        assert_eq!(trim_number(2.5), "2.5");
+        assert_eq!(trim_number(-0.001), "0");
+    }
+}

@@ -1,0 +1,163 @@
+//! What a figure needs to know about the domain of its runs: a readable description for the title
+//! and the optimal return for the red dash-dot line (spec `algorithms.md` 7.2).
+//!
+//! Read from each run's `config.toml` key by key rather than as a whole `RunConfig`, so an older
+//! results tree still plots after the config gains a field.
+
+use crate::algos::hyper::EnvName;
+
+/// Optimal discounted return of Box Pushing 10x10 (horizon 100, gamma 0.98); `box_pushing.md` 11.
+pub const BP10_OPTIMAL: f64 = 80.71093744250365;
+/// Optimal discounted return of Box Pushing 30x30 (horizon 200, gamma 0.98); `box_pushing.md` 11.
+pub const BP30_OPTIMAL: f64 = 41.75397237445474;
+/// Best achievable return of Warehouse Tool Delivery (horizon 150, gamma 1); `warehouse.md` 10.
+pub const WTD_OPTIMAL: f64 = 262.0;
+
+/// The domain settings of one run that decide the optimal return.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvSetting {
+    pub env_name: EnvName,
+    /// Box Pushing grid side (ignored by Warehouse).
+    pub grid_dim: usize,
+    /// Horizon in primitive steps (`env_terminate_step`).
+    pub horizon: usize,
+    /// Evaluation discount (`discount`).
+    pub discount: f64,
+}
+
+impl EnvSetting {
+    /// Read the setting from a run's `config.toml` text; `Err` says which key is missing or bad.
+    pub fn from_config_toml(text: &str) -> Result<Self, String> {
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
+        // A run directory's config.toml holds the run's identity and its resolved config under
+        // `[config]` (experiment::train_run::RunManifest); a bare RunConfig is accepted too.
+        if let Some(toml::Value::Table(inner)) = table.remove("config") {
+            table = inner;
+        }
+        let env_name: EnvName = table
+            .get("env_name")
+            .ok_or("no `env_name`")?
+            .clone()
+            .try_into()
+            .map_err(|_| "`env_name` is not BP_MA or OSD_S_4".to_string())?;
+        let int = |key: &str| -> Result<usize, String> {
+            match table.get(key) {
+                Some(toml::Value::Integer(n)) if *n >= 0 => Ok(*n as usize),
+                Some(v) => Err(format!("`{key}` is not a non-negative integer: {v}")),
+                None => Err(format!("no `{key}`")),
+            }
+        };
+        let discount = match table.get("discount") {
+            Some(toml::Value::Float(d)) => *d,
+            Some(toml::Value::Integer(d)) => *d as f64,
+            Some(v) => return Err(format!("`discount` is not a number: {v}")),
+            None => return Err("no `discount`".into()),
+        };
+        Ok(EnvSetting {
+            env_name,
+            grid_dim: int("grid_dim")?,
+            horizon: int("env_terminate_step")?,
+            discount,
+        })
+    }
+
+    /// The optimal return of this setting when the spec derives one: BP 10x10 horizon 100 and
+    /// BP 30x30 horizon 200 at gamma 0.98, WTD horizon 150 at gamma 1. `None` otherwise (another
+    /// grid, horizon or discount has no verified optimum, so no line is drawn).
+    pub fn optimal_return(&self) -> Option<f64> {
+        match (self.env_name, self.grid_dim, self.horizon) {
+            (EnvName::BoxPushing, 10, 100) if self.discount == 0.98 => Some(BP10_OPTIMAL),
+            (EnvName::BoxPushing, 30, 200) if self.discount == 0.98 => Some(BP30_OPTIMAL),
+            (EnvName::Warehouse, _, 150) if self.discount == 1.0 => Some(WTD_OPTIMAL),
+            _ => None,
+        }
+    }
+
+    /// A short description for the figure title, e.g. "Box Pushing 10x10, horizon 100".
+    pub fn describe(&self) -> String {
+        match self.env_name {
+            EnvName::BoxPushing => format!(
+                "Box Pushing {0}x{0}, horizon {1}",
+                self.grid_dim, self.horizon
+            ),
+            EnvName::Warehouse => format!("Warehouse Tool Delivery, horizon {}", self.horizon),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::hyper::paper_defaults;
+    use crate::algos::method::Method;
+
+    fn setting_of(env: EnvName, grid: usize) -> EnvSetting {
+        let text = toml::to_string(&paper_defaults(env, grid, Method::Our1)).unwrap();
+        EnvSetting::from_config_toml(&text).unwrap()
+    }
+
+    #[test]
+    fn a_run_manifest_is_read_through_its_config_table() {
+        let manifest = crate::experiment::train_run::RunManifest {
+            experiment: "e".into(),
+            method: Method::Our1,
+            variant: String::new(),
+            seed: 3,
+            config: paper_defaults(EnvName::BoxPushing, 30, Method::Our1),
+        };
+        let s = EnvSetting::from_config_toml(&toml::to_string(&manifest).unwrap()).unwrap();
+        assert_eq!((s.grid_dim, s.horizon), (30, 200));
+        assert_eq!(s.optimal_return(), Some(BP30_OPTIMAL));
+    }
+
+    #[test]
+    fn paper_settings_have_the_spec_optimal_returns() {
+        assert_eq!(
+            setting_of(EnvName::BoxPushing, 10).optimal_return(),
+            Some(80.71093744250365)
+        );
+        assert_eq!(
+            setting_of(EnvName::BoxPushing, 30).optimal_return(),
+            Some(41.75397237445474)
+        );
+        assert_eq!(
+            setting_of(EnvName::Warehouse, 10).optimal_return(),
+            Some(262.0)
+        );
+    }
+
+    #[test]
+    fn other_grids_horizons_and_discounts_have_no_line() {
+        let mut s = setting_of(EnvName::BoxPushing, 10);
+        s.grid_dim = 12;
+        assert_eq!(s.optimal_return(), None);
+        let mut s = setting_of(EnvName::BoxPushing, 10);
+        s.horizon = 50;
+        assert_eq!(s.optimal_return(), None);
+        let mut s = setting_of(EnvName::BoxPushing, 10);
+        s.discount = 0.99;
+        assert_eq!(s.optimal_return(), None);
+    }
+
+    #[test]
+    fn missing_keys_are_named() {
+        let err =
+            EnvSetting::from_config_toml("env_name = \"BP_MA\"\ngrid_dim = 10\ndiscount = 0.98\n")
+                .unwrap_err();
+        assert!(err.contains("env_terminate_step"), "{err}");
+        let err = EnvSetting::from_config_toml("env_name = \"Pong\"").unwrap_err();
+        assert!(err.contains("env_name"), "{err}");
+    }
+
+    #[test]
+    fn description_names_domain_grid_and_horizon() {
+        assert_eq!(
+            setting_of(EnvName::BoxPushing, 30).describe(),
+            "Box Pushing 30x30, horizon 200"
+        );
+        assert_eq!(
+            setting_of(EnvName::Warehouse, 10).describe(),
+            "Warehouse Tool Delivery, horizon 150"
+        );
+    }
+}

@@ -1,0 +1,210 @@
+//! The statistics behind a learning curve (spec `algorithms.md` 7.2): the mean over runs at each
+//! evaluation point, its standard error, and the centred moving average the paper calls
+//! "smoothed by 20 neighbors". Pure functions on numbers; no files, no drawing.
+
+use std::collections::BTreeMap;
+
+/// Points on each side of the centre in the paper's smoothing: window 21 = the point plus 10
+/// neighbours on each side (spec 7.2, open question O1).
+pub const SMOOTH_HALF_WINDOW: usize = 10;
+
+/// One evaluation point of a curve aggregated over runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurvePoint {
+    /// Training episodes completed (the metrics' `episode` column).
+    pub episode: u64,
+    /// Mean over the runs that have this point.
+    pub mean: f64,
+    /// Standard error of that mean: sample std (ddof 1) / sqrt(n); 0 when n = 1.
+    pub se: f64,
+    /// How many runs have this point (fewer at the tail when runs are unfinished).
+    pub n: usize,
+}
+
+/// Mean and standard error (sample std with ddof 1, over sqrt(n)) of `values`.
+/// The error is 0 for a single value, since one run says nothing about the spread.
+/// Returns `None` for no values.
+pub fn mean_and_se(values: &[f64]) -> Option<(f64, f64)> {
+    let n = values.len();
+    if n == 0 {
+        return None;
+    }
+    let mean = values.iter().sum::<f64>() / n as f64;
+    if n == 1 {
+        return Some((mean, 0.0));
+    }
+    let ss: f64 = values.iter().map(|v| (v - mean) * (v - mean)).sum();
+    let std = (ss / (n - 1) as f64).sqrt();
+    Some((mean, std / (n as f64).sqrt()))
+}
+
+/// Aggregate runs into one curve: at every episode any run evaluated at, the mean and standard
+/// error over the runs that have that episode. Runs of different lengths (unfinished runs) thus
+/// contribute where they have data, and `n` says how many did. Each run is a list of
+/// `(episode, return)` with distinct episodes. The result is sorted by episode.
+pub fn aggregate(runs: &[&[(u64, f64)]]) -> Vec<CurvePoint> {
+    let mut by_episode: BTreeMap<u64, Vec<f64>> = BTreeMap::new();
+    for run in runs {
+        for &(episode, value) in run.iter() {
+            by_episode.entry(episode).or_default().push(value);
+        }
+    }
+    by_episode
+        .into_iter()
+        .filter_map(|(episode, values)| {
+            let (mean, se) = mean_and_se(&values)?;
+            Some(CurvePoint {
+                episode,
+                mean,
+                se,
+                n: values.len(),
+            })
+        })
+        .collect()
+}
+
+/// Centred moving average: point i becomes the mean of points i-h ..= i+h that exist, so the
+/// window is truncated (not padded) at both ends.
+pub fn moving_average(xs: &[f64], half_window: usize) -> Vec<f64> {
+    (0..xs.len())
+        .map(|i| {
+            let lo = i.saturating_sub(half_window);
+            let hi = (i + half_window + 1).min(xs.len());
+            xs[lo..hi].iter().sum::<f64>() / (hi - lo) as f64
+        })
+        .collect()
+}
+
+/// The paper's smoothing of a curve: the moving average applied separately to the mean and to
+/// the standard error (spec 7.2). Episodes and counts are kept.
+pub fn smooth(points: &[CurvePoint], half_window: usize) -> Vec<CurvePoint> {
+    let means: Vec<f64> = points.iter().map(|p| p.mean).collect();
+    let ses: Vec<f64> = points.iter().map(|p| p.se).collect();
+    let means = moving_average(&means, half_window);
+    let ses = moving_average(&ses, half_window);
+    points
+        .iter()
+        .zip(means.into_iter().zip(ses))
+        .map(|(p, (mean, se))| CurvePoint { mean, se, ..*p })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-12
+    }
+
+    #[test]
+    fn se_uses_the_sample_std_with_ddof_one() {
+        // values 1, 2, 3, 6: mean 3; squared deviations 4 + 1 + 0 + 9 = 14;
+        // sample variance 14 / 3; SE = sqrt(14/3) / sqrt(4) = sqrt(14/3) / 2.
+        let (mean, se) = mean_and_se(&[1.0, 2.0, 3.0, 6.0]).unwrap();
+        assert!(close(mean, 3.0));
+        assert!(close(se, (14.0f64 / 3.0).sqrt() / 2.0));
+        assert!(close(se, 1.0801234497346435));
+    }
+
+    #[test]
+    fn se_of_one_run_is_zero_and_of_none_is_undefined() {
+        assert_eq!(mean_and_se(&[7.5]), Some((7.5, 0.0)));
+        assert_eq!(mean_and_se(&[]), None);
+    }
+
+    #[test]
+    fn moving_average_truncates_the_window_at_the_ends() {
+        // half window 1: [1, 2, 4, 8, 16] ->
+        // (1+2)/2, (1+2+4)/3, (2+4+8)/3, (4+8+16)/3, (8+16)/2
+        let got = moving_average(&[1.0, 2.0, 4.0, 8.0, 16.0], 1);
+        let want = [1.5, 7.0 / 3.0, 14.0 / 3.0, 28.0 / 3.0, 12.0];
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(want) {
+            assert!(close(*g, w), "{got:?}");
+        }
+    }
+
+    #[test]
+    fn paper_window_averages_21_points_in_the_middle_and_11_at_the_ends() {
+        // xs = 0..30: the centred mean of a linear series is the centre itself in the middle;
+        // at index 0 the window is 0..=10 (mean 5), at index 29 it is 19..=29 (mean 24).
+        let xs: Vec<f64> = (0..30).map(|i| i as f64).collect();
+        let got = moving_average(&xs, SMOOTH_HALF_WINDOW);
+        assert!(close(got[0], 5.0));
+        assert!(close(got[3], (0..=13).sum::<i32>() as f64 / 14.0));
+        assert!(close(got[15], 15.0));
+        assert!(close(got[29], 24.0));
+        // A spike of 21 in the middle spreads to 1 over exactly 21 points.
+        let mut spike = vec![0.0; 41];
+        spike[20] = 21.0;
+        let s = moving_average(&spike, SMOOTH_HALF_WINDOW);
+        assert!(s[10..=30].iter().all(|v| close(*v, 1.0)));
+        assert!(close(s[9], 0.0) && close(s[31], 0.0));
+    }
+
+    #[test]
+    fn moving_average_of_short_series_averages_what_exists() {
+        assert!(moving_average(&[], 10).is_empty());
+        let got = moving_average(&[2.0, 4.0, 9.0], 10);
+        assert!(got.iter().all(|v| close(*v, 5.0)));
+    }
+
+    #[test]
+    fn mixed_length_runs_average_over_the_runs_that_have_each_point() {
+        let a: &[(u64, f64)] = &[(0, 1.0), (10, 3.0), (20, 5.0)];
+        let b: &[(u64, f64)] = &[(0, 3.0), (10, 7.0)];
+        let c: &[(u64, f64)] = &[(0, 5.0)];
+        let got = aggregate(&[a, b, c]);
+        assert_eq!(got.len(), 3);
+        // episode 0: 1, 3, 5 -> mean 3, sample var 4, SE 2 / sqrt 3
+        assert_eq!((got[0].episode, got[0].n), (0, 3));
+        assert!(close(got[0].mean, 3.0));
+        assert!(close(got[0].se, 2.0 / 3f64.sqrt()));
+        // episode 10: 3, 7 -> mean 5, sample var 8, SE sqrt(8)/sqrt(2) = 2
+        assert_eq!((got[1].episode, got[1].n), (10, 2));
+        assert!(close(got[1].mean, 5.0));
+        assert!(close(got[1].se, 2.0));
+        // episode 20: only run a
+        assert_eq!((got[2].episode, got[2].n), (20, 1));
+        assert_eq!((got[2].mean, got[2].se), (5.0, 0.0));
+    }
+
+    #[test]
+    fn aggregate_sorts_by_episode_whatever_the_run_order() {
+        let a: &[(u64, f64)] = &[(20, 2.0)];
+        let b: &[(u64, f64)] = &[(0, 1.0), (10, 1.5)];
+        let eps: Vec<u64> = aggregate(&[a, b]).iter().map(|p| p.episode).collect();
+        assert_eq!(eps, vec![0, 10, 20]);
+    }
+
+    #[test]
+    fn smoothing_applies_to_mean_and_se_separately_and_keeps_counts() {
+        let pts = [
+            CurvePoint {
+                episode: 0,
+                mean: 0.0,
+                se: 3.0,
+                n: 2,
+            },
+            CurvePoint {
+                episode: 10,
+                mean: 6.0,
+                se: 0.0,
+                n: 2,
+            },
+            CurvePoint {
+                episode: 20,
+                mean: 9.0,
+                se: 0.0,
+                n: 1,
+            },
+        ];
+        let s = smooth(&pts, 1);
+        assert!(close(s[0].mean, 3.0) && close(s[0].se, 1.5));
+        assert!(close(s[1].mean, 5.0) && close(s[1].se, 1.0));
+        assert!(close(s[2].mean, 7.5) && close(s[2].se, 0.0));
+        assert_eq!(s.iter().map(|p| p.n).collect::<Vec<_>>(), vec![2, 2, 1]);
+        assert_eq!(s[2].episode, 20);
+    }
+}

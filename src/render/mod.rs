@@ -1,0 +1,104 @@
+//! Animated rollouts for the README (issue 6, `macdec render`): play an episode of either domain,
+//! draw every primitive step into a small indexed picture, and write the pictures as a GIF.
+//!
+//! No fonts or image libraries: [`canvas`] draws rectangles, discs and lines into palette indices
+//! ([`palette`]), a built-in 3 x 5 font writes the status bar, and the `gif` crate encodes.
+//! Each domain's picture lives in its own file (`box_pushing.rs`, `warehouse.rs`).
+//!
+//! ```no_run
+//! # use macdec::envs::{EnvSpec, EnvRng, MacroEnv};
+//! # use rand::SeedableRng;
+//! let mut env = EnvSpec::BoxPushing { grid: 10, horizon: 100 }.build()?;
+//! let mut rng = EnvRng::seed_from_u64(0);
+//! let frames = macdec::render::record_episode(&mut env, &mut rng, |env, actions| {
+//!     for i in 0..env.n_agents() {
+//!         if env.is_free(i) {
+//!             actions[i] = 7; // Stay
+//!         }
+//!     }
+//! })?;
+//! macdec::render::write_gif(&frames, "rollout.gif".as_ref(), 120)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::PathBuf;
+
+use crate::envs::{AnyEnv, EnvError};
+
+mod box_pushing;
+pub mod canvas;
+mod font;
+mod gif_out;
+mod hud;
+pub mod palette;
+mod record;
+mod warehouse;
+
+pub use canvas::Canvas;
+pub use gif_out::{write_gif, HOLD_MS};
+pub use palette::Colour;
+pub use record::record_episode;
+
+/// One drawn primitive step of an episode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// The picture: the domain on top, a status bar (step, return, executed macro-actions) below.
+    pub image: Canvas,
+    /// Primitive steps since reset when it was drawn.
+    pub t: usize,
+    /// Undiscounted team reward summed over steps 1..=t.
+    pub team_return: f64,
+    /// Last frame of an episode: [`write_gif`] shows it for at least [`HOLD_MS`].
+    pub hold: bool,
+}
+
+/// Why recording or writing a rollout failed. File errors name the path.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("step {t} of the recorded episode was refused: {source}")]
+    Env {
+        t: usize,
+        #[source]
+        source: EnvError,
+    },
+    #[error("{}: no frames to write", .path.display())]
+    NoFrames { path: PathBuf },
+    #[error("{}: frame {index} is {}x{} pixels but frame 0 is {}x{}; one GIF holds one size (record one domain per file)", .path.display(), .got.0, .got.1, .expected.0, .expected.1)]
+    SizeMismatch {
+        path: PathBuf,
+        index: usize,
+        got: (usize, usize),
+        expected: (usize, usize),
+    },
+    #[error("{}: frames of {width}x{height} pixels exceed the GIF limit of 65535", .path.display())]
+    TooLarge {
+        path: PathBuf,
+        width: usize,
+        height: usize,
+    },
+    #[error("{}: GIF encoding failed: {source}", .path.display())]
+    Encode {
+        path: PathBuf,
+        #[source]
+        source: gif::EncodingError,
+    },
+    #[error("{}: writing the GIF failed: {source}", .path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// The picture of `env`'s current state with `team_return` in the status bar. Sizes: Box
+/// Pushing 10 x 10 is 321 pixels wide (32 per cell), 30 x 30 is 361 (12 per cell); Warehouse is
+/// 420 (60 per metre); the status bar adds a few dozen rows.
+pub fn draw_frame(env: &AnyEnv, team_return: f64) -> Canvas {
+    match env {
+        AnyEnv::BoxPushing(e) => box_pushing::draw(e, team_return),
+        AnyEnv::Warehouse(e) => warehouse::draw(e, team_return),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,53 @@
+//! Play one episode and keep a picture of every primitive step.
+
+use super::{draw_frame, Frame, RenderError};
+use crate::envs::{AnyEnv, EnvRng, MacroEnv};
+
+/// Reset `env`, then let `choose` fill the actions and step until the episode ends, drawing a
+/// frame after the reset and after every step (so an episode of T steps gives T + 1 frames; the
+/// last is marked [`Frame::hold`]).
+///
+/// `choose(env, actions)` sees the state before each step and writes `actions[i]` for every free
+/// agent ([`MacroEnv::is_free`]); entries of busy agents are ignored by the environment (spec
+/// `algorithms.md` 1.1) and keep whatever was there. `actions` starts as zeros. At most
+/// `env.horizon()` steps are taken, so a loop that never sees `done` still stops. A step the
+/// environment refuses (an out-of-range action) is returned as [`RenderError::Env`].
+pub fn record_episode(
+    env: &mut AnyEnv,
+    rng: &mut EnvRng,
+    mut choose: impl FnMut(&AnyEnv, &mut [usize]),
+) -> Result<Vec<Frame>, RenderError> {
+    env.reset(rng);
+    let mut actions = vec![0usize; env.n_agents()];
+    let mut team_return = 0.0;
+    let mut frames = Vec::with_capacity(env.horizon() + 1);
+    frames.push(Frame::capture(env, team_return));
+    for _ in 0..env.horizon() {
+        choose(env, &mut actions);
+        let out = env.step(&actions, rng).map_err(|source| RenderError::Env {
+            t: env.t() + 1,
+            source,
+        })?;
+        team_return += out.reward;
+        frames.push(Frame::capture(env, team_return));
+        if out.done {
+            break;
+        }
+    }
+    if let Some(last) = frames.last_mut() {
+        last.hold = true;
+    }
+    Ok(frames)
+}
+
+impl Frame {
+    /// Draw `env` now. Not held.
+    pub fn capture(env: &AnyEnv, team_return: f64) -> Self {
+        Self {
+            image: draw_frame(env, team_return),
+            t: env.t(),
+            team_return,
+            hold: false,
+        }
+    }
+}

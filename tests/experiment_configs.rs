@@ -1,0 +1,77 @@
+//! Every shipped experiment config parses, and the paper figures carry the paper's settings.
+
+use macdec::algos::method::Method;
+use macdec::experiment::config::{Experiment, Overrides};
+use std::path::Path;
+
+fn load(name: &str) -> Experiment {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("experiments")
+        .join(name);
+    Experiment::load(&path, &Overrides::default()).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn every_shipped_config_parses_and_resolves() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let e = Experiment::load(&path, &Overrides::default())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(!e.runs().unwrap().is_empty());
+            n += 1;
+        }
+    }
+    assert!(
+        n >= 7,
+        "expected the four figures and three ablations, found {n}"
+    );
+}
+
+#[test]
+fn paper_figures_have_forty_seeds_and_their_methods() {
+    for (file, methods) in [
+        (
+            "fig4a_bp10.toml",
+            [Method::DecHddrqn, Method::CenDdrqn, Method::Our1],
+        ),
+        (
+            "fig4b_bp30.toml",
+            [Method::DecHddrqn, Method::CenDdrqn, Method::Our1],
+        ),
+        (
+            "fig5_wtd.toml",
+            [Method::DecHddrqn, Method::CenDdrqn, Method::Our2],
+        ),
+        (
+            "fig6_wtd_ablation.toml",
+            [Method::Our1, Method::Our1R, Method::Our2],
+        ),
+    ] {
+        let e = load(file);
+        assert_eq!(e.seeds, (0..40).collect::<Vec<u64>>(), "{file}");
+        assert_eq!(e.methods, methods, "{file}");
+    }
+}
+
+#[test]
+fn bp30_uses_longer_windows_and_horizon() {
+    let runs = load("fig4b_bp30.toml").runs().unwrap();
+    let c = &runs[0].config;
+    assert_eq!(
+        (c.grid_dim, c.env_terminate_step, c.trace_len, c.train_freq),
+        (30, 200, 45, 45)
+    );
+}
+
+#[test]
+fn sweeps_expand_into_variants() {
+    let e = load("ablation_bp10_lr_hidden.toml");
+    let runs = e.runs().unwrap();
+    assert_eq!(runs.len(), 2 * 9 * 10);
+    let mut curves: Vec<String> = runs.iter().map(|r| r.curve_name()).collect();
+    curves.dedup();
+    assert_eq!(curves.len(), 18);
+}

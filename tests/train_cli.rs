@@ -1,0 +1,161 @@
+//! `macdec train` end to end: determinism across --jobs, resume after a kill, clear errors.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+
+/// A tiny Box Pushing experiment: a few hundred episodes, frequent checkpoints.
+const TINY: &str = r#"
+name = "tiny"
+methods = ["dec-hddrqn", "our1"]
+seeds = "0..2"
+
+[params]
+env_name = "BP_MA"
+grid_dim = 8
+env_terminate_step = 40
+total_epi = 60
+eps_l_d_steps = 40
+batch_size = 16
+replay_buffer_size = 2000
+eval_freq = 5
+checkpoint_freq = 10
+"#;
+
+fn train(config: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    Command::new(BIN)
+        .arg("train")
+        .arg("--config")
+        .arg(config)
+        .arg("--out")
+        .arg(out)
+        .arg("--plots")
+        .arg(out.join("plots"))
+        .arg("--quiet")
+        .args(extra)
+        .output()
+        .expect("macdec runs")
+}
+
+/// The metrics file without its wall-clock column (the one column that is not reproducible).
+fn metrics_without_time(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    text.lines()
+        .map(|l| l.rsplit_once(',').map_or(l, |(head, _)| head).to_string())
+        .collect()
+}
+
+#[test]
+fn runs_are_bit_identical_whatever_the_job_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let a = dir.path().join("a");
+    let b = dir.path().join("b");
+    assert!(train(&config, &a, &["--jobs", "1"]).status.success());
+    assert!(train(&config, &b, &["--jobs", "2"]).status.success());
+    for method in ["dec-hddrqn", "our1"] {
+        for seed in 0..2 {
+            let rel = format!("tiny/{method}/seed-{seed}/metrics.csv");
+            let ma = metrics_without_time(&a.join(&rel));
+            assert!(ma.len() > 5, "{rel}: too few rows");
+            assert_eq!(ma, metrics_without_time(&b.join(&rel)), "{rel}");
+        }
+    }
+    // Different seeds give different curves (the test can fail).
+    assert_ne!(
+        metrics_without_time(&a.join("tiny/our1/seed-0/metrics.csv")),
+        metrics_without_time(&a.join("tiny/our1/seed-1/metrics.csv"))
+    );
+}
+
+#[test]
+fn a_killed_run_resumes_to_the_uninterrupted_metrics() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY.replace("total_epi = 60", "total_epi = 200")).unwrap();
+    let whole = dir.path().join("whole");
+    let args = ["--methods", "our1", "--seeds", "0"];
+    assert!(train(&config, &whole, &args).status.success());
+
+    let killed = dir.path().join("killed");
+    let checkpoint = killed.join("tiny/our1/seed-0/checkpoint.bin");
+    let mut child = Command::new(BIN)
+        .args(["train", "--quiet", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&killed)
+        .arg("--no-plot")
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill it once at least one checkpoint exists, mid-run.
+    let start = Instant::now();
+    while !checkpoint.exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(checkpoint.exists(), "no checkpoint was written");
+    assert!(
+        !killed.join("tiny/our1/seed-0/finished").exists(),
+        "the run finished before it could be killed; make it longer"
+    );
+    let resumed = train(&config, &killed, &args);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    let rel = "tiny/our1/seed-0/metrics.csv";
+    assert_eq!(
+        metrics_without_time(&whole.join(rel)),
+        metrics_without_time(&killed.join(rel))
+    );
+}
+
+#[test]
+fn finished_runs_are_not_recomputed() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("out");
+    let args = ["--methods", "our1", "--seeds", "0"];
+    assert!(train(&config, &out, &args).status.success());
+    let metrics = out.join("tiny/our1/seed-0/metrics.csv");
+    let before = std::fs::metadata(&metrics).unwrap().modified().unwrap();
+    let again = train(&config, &out, &args);
+    assert!(again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("already finished"));
+    assert_eq!(
+        before,
+        std::fs::metadata(&metrics).unwrap().modified().unwrap()
+    );
+}
+
+#[test]
+fn bad_config_keys_and_values_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("out");
+    for (set, needle) in [
+        ("total_episodes=3", "total_episodes"),
+        ("batch_size=0", "batch_size"),
+        ("l_rate=abc", "l_rate"),
+    ] {
+        let o = train(&config, &out, &["--set", set]);
+        assert!(!o.status.success(), "{set} was accepted");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "{set}: {err}");
+        assert!(!err.contains("panicked"), "{set}: {err}");
+    }
+    let o = train(&config, &out, &["--seeds", "3..1"]);
+    assert!(!o.status.success());
+    let o = train(&config, &out, &["--methods", "our9"]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("our9"));
+}
