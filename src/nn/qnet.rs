@@ -395,16 +395,21 @@ impl QNet {
         q
     }
 
-    /// [`QNet::forward_nograd_in`] with a throwaway pool (allocates every call).
+    /// [`QNet::forward_nograd_in`] with this thread's scratch pool, so repeated calls reuse
+    /// their buffers (fresh multi-megabyte allocations cost more than the forward itself at the
+    /// paper's shapes). The pool never changes a result: every buffer is fully overwritten.
     pub fn forward_nograd(&self, x: ArrayView2<f32>, packing: &SeqPacking) -> Array2<f32> {
-        self.forward_nograd_in(x, packing, &mut Pool::default())
+        with_scratch(|pool| self.forward_nograd_in(x, packing, pool))
     }
 
     /// [`QNet::forward_nograd`] for a padded batch x: [B, T, in] (see [`QNet::forward_padded`]).
     pub fn forward_nograd_padded(&self, x: ArrayView3<f32>, lengths: &[usize]) -> Array2<f32> {
-        let mut pool = Pool::default();
-        let flat = flatten_padded(x, lengths, &mut pool);
-        self.forward_nograd_in(flat.view(), &SeqPacking::new(lengths), &mut pool)
+        with_scratch(|pool| {
+            let flat = flatten_padded(x, lengths, pool);
+            let q = self.forward_nograd_in(flat.view(), &SeqPacking::new(lengths), pool);
+            pool.give_array(flat);
+            q
+        })
     }
 
     /// One acting step: Q-values for input x given the carried state, which advances
@@ -455,6 +460,16 @@ impl QNet {
             "q-net input rows differ from the packing's total"
         );
     }
+}
+
+thread_local! {
+    /// Scratch buffers of the no-tape forwards on this thread (see [`QNet::forward_nograd`]).
+    static SCRATCH: std::cell::RefCell<Pool> = std::cell::RefCell::new(Pool::default());
+}
+
+/// Run `f` with this thread's scratch pool.
+fn with_scratch<T>(f: impl FnOnce(&mut Pool) -> T) -> T {
+    SCRATCH.with(|p| f(&mut p.borrow_mut()))
 }
 
 /// out[k] = x[index[k]] (rows), in a buffer from `pool`.
