@@ -112,3 +112,64 @@ simd_dispatch! {
         }
     }
 }
+
+/// Dot product with 8 independent partial sums, so it vectorizes (a fixed order: deterministic).
+#[inline(always)]
+pub fn dot(a: &[f32], b: &[f32]) -> f32 {
+    let mut acc = [0.0f32; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for i in 0..8 {
+            acc[i] += x[i] * y[i];
+        }
+    }
+    let mut tail = 0.0;
+    for (x, y) in ra.iter().zip(rb) {
+        tail += x * y;
+    }
+    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
+}
+
+simd_dispatch! {
+    /// out[o] = act(w[o, :] . x + b[o]) for w: [out.len(), x.len()] row-major, act a leaky ReLU
+    /// with `slope` (1 = identity): one layer for one input row (acting).
+    pub fn matvec_act(w: &[f32], x: &[f32], b: &[f32], slope: f32, out: &mut [f32]) {
+        for (o, (row, &bv)) in out.iter_mut().zip(w.chunks_exact(x.len()).zip(b)) {
+            let z = dot(row, x) + bv;
+            *o = if z > 0.0 { z } else { slope * z };
+        }
+    }
+}
+
+simd_dispatch! {
+    /// gates[r] = w_ih[r, :] . x + b_ih[r] + w_hh[r, :] . h + b_hh[r]: the LSTM's gate
+    /// pre-activations for one input row (acting).
+    pub fn lstm_gates_row(
+        w_ih: &[f32],
+        x: &[f32],
+        w_hh: &[f32],
+        h: &[f32],
+        b_ih: &[f32],
+        b_hh: &[f32],
+        gates: &mut [f32],
+    ) {
+        let rows_ih = w_ih.chunks_exact(x.len());
+        let rows_hh = w_hh.chunks_exact(h.len());
+        for (r, (ri, rh)) in rows_ih.zip(rows_hh).enumerate() {
+            gates[r] = dot(ri, x) + b_ih[r] + dot(rh, h) + b_hh[r];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dot_handles_lengths_that_are_not_multiples_of_eight() {
+        let a: Vec<f32> = (0..13).map(|i| i as f32).collect();
+        let b = vec![1.0f32; 13];
+        assert_eq!(dot(&a, &b), 78.0);
+    }
+}
