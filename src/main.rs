@@ -95,6 +95,9 @@ enum Command {
         /// Timed iterations per configuration (nets).
         #[arg(long, default_value_t = 200)]
         iters: usize,
+        /// Only the configuration with this name (nets; e.g. torch-wtd).
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -255,11 +258,12 @@ fn main() -> Result<()> {
         }
         Command::Plot { results, out } => plot(&results, &out),
         Command::Demo { steps, seed } => demo_run(steps, seed),
-        Command::Bench { what, iters } => match what {
+        Command::Bench { what, iters, only } => match what {
             BenchTarget::Envs => bench_envs(),
             BenchTarget::Nets => {
                 let results: Vec<_> = nets::SHAPES
                     .iter()
+                    .filter(|s| only.as_deref().is_none_or(|o| o == s.name))
                     .map(|shape| nets::bench_shape(shape, iters, iters.div_ceil(10).max(3)))
                     .collect();
                 print!("{}", nets::format_table(&results));

@@ -17,6 +17,7 @@ pub struct SeqPacking {
     batch_sizes: Vec<usize>,
     offsets: Vec<usize>,
     packed_to_flat: Vec<usize>,
+    flat_to_packed: Vec<usize>,
 }
 
 impl SeqPacking {
@@ -56,6 +57,11 @@ impl SeqPacking {
             }
         }
         self.offsets.push(self.packed_to_flat.len());
+        self.flat_to_packed.clear();
+        self.flat_to_packed.resize(self.packed_to_flat.len(), 0);
+        for (p, &f) in self.packed_to_flat.iter().enumerate() {
+            self.flat_to_packed[f] = p;
+        }
     }
 
     /// Number of sequences.
@@ -93,6 +99,11 @@ impl SeqPacking {
         &self.packed_to_flat
     }
 
+    /// Packed row of flat row f (the inverse of [`SeqPacking::packed_to_flat`]).
+    pub fn flat_to_packed(&self) -> &[usize] {
+        &self.flat_to_packed
+    }
+
     /// Flat row of (sequence s, step t). Panics if t is past the sequence's end.
     pub fn flat_row(&self, s: usize, t: usize) -> usize {
         assert!(t < self.lengths[s], "step {t} past the end of sequence {s}");
@@ -127,5 +138,8 @@ mod tests {
         let mut seen = p.packed_to_flat().to_vec();
         seen.sort_unstable();
         assert_eq!(seen, (0..16).collect::<Vec<_>>());
+        for (pk, &f) in p.packed_to_flat().iter().enumerate() {
+            assert_eq!(p.flat_to_packed()[f], pk);
+        }
     }
 }

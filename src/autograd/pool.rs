@@ -14,13 +14,17 @@ impl Pool {
     /// A buffer of `len` floats. Its contents are unspecified (old values from an earlier use):
     /// the caller overwrites every element.
     pub fn take(&mut self, len: usize) -> Vec<f32> {
-        // Best fit: the smallest buffer that can hold `len` without reallocating.
-        let mut best: Option<usize> = None;
-        for (i, buf) in self.free.iter().enumerate() {
-            if buf.capacity() >= len
-                && best.is_none_or(|b| buf.capacity() < self.free[b].capacity())
-            {
-                best = Some(i);
+        // A buffer of exactly this length if there is one (an update loop asks for the same
+        // sizes every time, so this is the common case and needs no fill), else the smallest
+        // that can hold `len` without reallocating.
+        let mut best: Option<usize> = self.free.iter().position(|b| b.len() == len);
+        if best.is_none() {
+            for (i, buf) in self.free.iter().enumerate() {
+                if buf.capacity() >= len
+                    && best.is_none_or(|b| buf.capacity() < self.free[b].capacity())
+                {
+                    best = Some(i);
+                }
             }
         }
         match best {

@@ -65,6 +65,9 @@ pub struct NetBench {
     pub median_ms: f64,
     pub p10_ms: f64,
     pub p90_ms: f64,
+    /// Median CPU time of the thread per update (Linux `CLOCK_THREAD_CPUTIME_ID`), which stays
+    /// meaningful when other processes compete for the cores; `None` where unavailable.
+    pub cpu_median_ms: Option<f64>,
     /// Matrix-product flops of one update.
     pub flops: f64,
 }
@@ -124,34 +127,68 @@ pub fn bench_shape(shape: &NetShape, iters: usize, warmup: usize) -> NetBench {
     for _ in 0..warmup {
         updater.td_step(&mut net, &mut adam, &batch, 1.0);
     }
-    let mut times: Vec<f64> = (0..iters.max(1))
-        .map(|_| {
-            let t0 = Instant::now();
-            updater.td_step(&mut net, &mut adam, &batch, 1.0);
-            t0.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
+    let mut times = Vec::with_capacity(iters.max(1));
+    let mut cpu_times = Vec::with_capacity(iters.max(1));
+    for _ in 0..iters.max(1) {
+        let c0 = thread_cpu_ns();
+        let t0 = Instant::now();
+        updater.td_step(&mut net, &mut adam, &batch, 1.0);
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+        if let (Some(a), Some(b)) = (c0, thread_cpu_ns()) {
+            cpu_times.push(b.saturating_sub(a) as f64 * 1e-6);
+        }
+    }
     times.sort_by(f64::total_cmp);
-    let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+    cpu_times.sort_by(f64::total_cmp);
+    let at = |v: &[f64], q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
     NetBench {
         shape: *shape,
-        median_ms: at(0.5),
-        p10_ms: at(0.1),
-        p90_ms: at(0.9),
+        median_ms: at(&times, 0.5),
+        p10_ms: at(&times, 0.1),
+        p90_ms: at(&times, 0.9),
+        cpu_median_ms: (cpu_times.len() == times.len()).then(|| at(&cpu_times, 0.5)),
         flops: update_flops(shape.cfg, &batch.packing),
     }
+}
+
+/// Nanoseconds of CPU time this thread has used (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, from
+/// the C library std already links; no extra dependency).
+#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+fn thread_cpu_ns() -> Option<u64> {
+    #[repr(C)]
+    struct Timespec {
+        tv_sec: i64,
+        tv_nsec: i64,
+    }
+    extern "C" {
+        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
+    }
+    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+    let mut ts = Timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec (two 64-bit fields on 64-bit Linux).
+    let rc = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    (rc == 0).then(|| ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64)
+}
+
+#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+fn thread_cpu_ns() -> Option<u64> {
+    None
 }
 
 /// A plain-text table of results.
 pub fn format_table(results: &[NetBench]) -> String {
     let mut s = format!(
-        "{:<12} {:>16} {:>8} {:>9} {:>8} {:>8} {:>8} {:>8} {:>10}\n",
+        "{:<12} {:>12} {:>7} {:>9} {:>7} {:>7} {:>7} {:>6} {:>7} {:>8}\n",
         "shape",
         "in/M/H/out",
         "batch",
         "median_ms",
         "p10_ms",
         "p90_ms",
+        "cpu_ms",
         "GFLOP",
         "GFLOP/s",
         "torch_ms"
@@ -159,13 +196,15 @@ pub fn format_table(results: &[NetBench]) -> String {
     for r in results {
         let c = r.shape.cfg;
         s += &format!(
-            "{:<12} {:>16} {:>8} {:>9.3} {:>8.3} {:>8.3} {:>8.3} {:>8.1} {:>10}\n",
+            "{:<12} {:>12} {:>7} {:>9.3} {:>7.3} {:>7.3} {:>7} {:>6.3} {:>7.1} {:>8}\n",
             r.shape.name,
             format!("{}/{}/{}/{}", c.input, c.mlp, c.hidden, c.output),
             format!("{}x{}", r.shape.batch, r.shape.seq),
             r.median_ms,
             r.p10_ms,
             r.p90_ms,
+            r.cpu_median_ms
+                .map_or("-".to_string(), |t| format!("{t:.3}")),
             r.flops / 1e9,
             r.gflops(),
             r.shape

@@ -6,6 +6,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::init::xavier_uniform;
 use super::params::{flat, flat_mut, LinearParams};
+use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::{Activation, Tape, Var};
 
 impl LinearParams {
@@ -39,11 +40,11 @@ impl LinearParams {
     pub fn forward_row(&self, x: &[f32], act: Activation, out: &mut [f32]) {
         assert_eq!(x.len(), self.input(), "linear: input length");
         assert_eq!(out.len(), self.output(), "linear: output length");
-        let w = flat(&self.weight);
-        let b = flat(&self.bias);
-        for (o, (row, &b)) in out.iter_mut().zip(w.chunks_exact(x.len()).zip(b)) {
-            *o = act.apply(dot(row, x) + b);
-        }
+        let slope = match act {
+            Activation::Identity => 1.0,
+            Activation::LeakyRelu(s) => s,
+        };
+        matvec_act(flat(&self.weight), x, flat(&self.bias), slope, out);
     }
 }
 
@@ -84,24 +85,6 @@ pub(crate) fn copy_grad(tape: &Tape, v: Var, dst: &mut [f32]) {
     }
 }
 
-/// Dot product with 8 independent partial sums, so it vectorizes (a fixed order: deterministic).
-#[inline]
-pub(crate) fn dot(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0.0f32; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for i in 0..8 {
-            acc[i] += x[i] * y[i];
-        }
-    }
-    let mut tail = 0.0;
-    for (x, y) in ra.iter().zip(rb) {
-        tail += x * y;
-    }
-    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -122,12 +105,5 @@ mod tests {
         for (a, b) in out.iter().zip(tape.value(y).iter()) {
             assert!((a - b).abs() < 1e-6, "{a} vs {b}");
         }
-    }
-
-    #[test]
-    fn dot_handles_lengths_that_are_not_multiples_of_eight() {
-        let a: Vec<f32> = (0..13).map(|i| i as f32).collect();
-        let b = vec![1.0f32; 13];
-        assert_eq!(dot(&a, &b), 78.0);
     }
 }

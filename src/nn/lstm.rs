@@ -5,9 +5,10 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::init::{uniform1, uniform2};
-use super::linear::{copy_grad, dot};
+use super::linear::copy_grad;
 use super::params::{flat, flat_mut, LstmParams};
 use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace, tanh_into};
+use crate::autograd::kernels::dense::lstm_gates_row;
 use crate::autograd::{LstmVars, Tape};
 
 impl LstmParams {
@@ -47,11 +48,7 @@ impl LstmParams {
         state.gates.resize(4 * h, 0.0);
         let (w_ih, w_hh) = (flat(&self.weight_ih), flat(&self.weight_hh));
         let (b_ih, b_hh) = (flat(&self.bias_ih), flat(&self.bias_hh));
-        for r in 0..4 * h {
-            let zi = dot(&w_ih[r * x.len()..(r + 1) * x.len()], x);
-            let zh = dot(&w_hh[r * h..(r + 1) * h], &state.h);
-            state.gates[r] = zi + b_ih[r] + zh + b_hh[r];
-        }
+        lstm_gates_row(w_ih, x, w_hh, &state.h, b_ih, b_hh, &mut state.gates);
         let g = &mut state.gates;
         sigmoid_inplace(&mut g[..2 * h]);
         tanh_inplace(&mut g[2 * h..3 * h]);

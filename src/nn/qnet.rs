@@ -289,12 +289,16 @@ impl QNet {
         packing: &SeqPacking,
     ) -> Var {
         self.check_input(x, packing);
-        let x = tape.constant(x);
-        let a1 = vars.fc1.forward(tape, x, LEAKY);
+        // The whole net runs in packed order (each LSTM step then touches contiguous rows);
+        // only the input and the Q-values are reordered.
+        let xp = gather_rows(x, packing.packed_to_flat(), tape.pool());
+        let xp = tape.constant_owned(xp);
+        let a1 = vars.fc1.forward(tape, xp, LEAKY);
         let a2 = vars.fc2.forward(tape, a1, LEAKY);
-        let h = tape.lstm(a2, vars.lstm, packing);
+        let h = tape.lstm_packed(a2, vars.lstm, packing);
         let a3 = vars.fc3.forward(tape, h, LEAKY);
-        vars.fc4.forward(tape, a3, Activation::Identity)
+        let q = vars.fc4.forward(tape, a3, Activation::Identity);
+        tape.gather_rows(q, packing.flat_to_packed())
     }
 
     /// [`QNet::forward`] for a padded batch x: [B, T, in] whose row b is valid for its first
@@ -307,9 +311,9 @@ impl QNet {
         lengths: &[usize],
     ) -> Var {
         let packing = SeqPacking::new(lengths);
-        let flat = flatten_padded(x, lengths, tape_pool(tape));
+        let flat = flatten_padded(x, lengths, tape.pool());
         let q = self.forward(tape, vars, flat.view(), &packing);
-        tape_pool(tape).give_array(flat);
+        tape.pool().give_array(flat);
         q
     }
 
@@ -326,9 +330,10 @@ impl QNet {
         let cfg = self.config();
         let p = &self.params;
         let k = packing.total();
+        let xp = gather_rows(x, packing.packed_to_flat(), pool);
         let mut a1 = pool.array(k, cfg.mlp);
         linear_forward(
-            x,
+            xp.view(),
             p.fc1.weight.view(),
             flat(&p.fc1.bias),
             LEAKY,
@@ -342,9 +347,9 @@ impl QNet {
             LEAKY,
             a2.view_mut(),
         );
-        let [s_xh, s_g, s_c, s_tc] = LstmCache::shapes(k, cfg.hidden, cfg.hidden);
+        let [s_hp, s_g, s_c, s_tc] = LstmCache::shapes(k, cfg.hidden);
         let mut cache = LstmCache {
-            xh: pool.array(s_xh.0, s_xh.1),
+            h_prev: pool.array(s_hp.0, s_hp.1),
             gates: pool.array(s_g.0, s_g.1),
             c: pool.array(s_c.0, s_c.1),
             tanh_c: pool.array(s_tc.0, s_tc.1),
@@ -364,31 +369,47 @@ impl QNet {
             LEAKY,
             a1.view_mut(),
         );
-        let mut q = pool.array(k, cfg.output);
+        let mut qp = pool.array(k, cfg.output);
         let fc4 = &p.fc4;
         linear_forward(
             a1.view(),
             fc4.weight.view(),
             flat(&fc4.bias),
             Activation::Identity,
-            q.view_mut(),
+            qp.view_mut(),
         );
-        for a in [a1, a2, h, cache.xh, cache.gates, cache.c, cache.tanh_c] {
+        let q = gather_rows(qp.view(), packing.flat_to_packed(), pool);
+        for a in [
+            xp,
+            a1,
+            a2,
+            h,
+            qp,
+            cache.h_prev,
+            cache.gates,
+            cache.c,
+            cache.tanh_c,
+        ] {
             pool.give_array(a);
         }
         q
     }
 
-    /// [`QNet::forward_nograd_in`] with a throwaway pool (allocates every call).
+    /// [`QNet::forward_nograd_in`] with this thread's scratch pool, so repeated calls reuse
+    /// their buffers (fresh multi-megabyte allocations cost more than the forward itself at the
+    /// paper's shapes). The pool never changes a result: every buffer is fully overwritten.
     pub fn forward_nograd(&self, x: ArrayView2<f32>, packing: &SeqPacking) -> Array2<f32> {
-        self.forward_nograd_in(x, packing, &mut Pool::default())
+        with_scratch(|pool| self.forward_nograd_in(x, packing, pool))
     }
 
     /// [`QNet::forward_nograd`] for a padded batch x: [B, T, in] (see [`QNet::forward_padded`]).
     pub fn forward_nograd_padded(&self, x: ArrayView3<f32>, lengths: &[usize]) -> Array2<f32> {
-        let mut pool = Pool::default();
-        let flat = flatten_padded(x, lengths, &mut pool);
-        self.forward_nograd_in(flat.view(), &SeqPacking::new(lengths), &mut pool)
+        with_scratch(|pool| {
+            let flat = flatten_padded(x, lengths, pool);
+            let q = self.forward_nograd_in(flat.view(), &SeqPacking::new(lengths), pool);
+            pool.give_array(flat);
+            q
+        })
     }
 
     /// One acting step: Q-values for input x given the carried state, which advances
@@ -441,8 +462,23 @@ impl QNet {
     }
 }
 
-fn tape_pool(tape: &mut Tape) -> &mut Pool {
-    tape.pool()
+thread_local! {
+    /// Scratch buffers of the no-tape forwards on this thread (see [`QNet::forward_nograd`]).
+    static SCRATCH: std::cell::RefCell<Pool> = std::cell::RefCell::new(Pool::default());
+}
+
+/// Run `f` with this thread's scratch pool.
+fn with_scratch<T>(f: impl FnOnce(&mut Pool) -> T) -> T {
+    SCRATCH.with(|p| f(&mut p.borrow_mut()))
+}
+
+/// out[k] = x[index[k]] (rows), in a buffer from `pool`.
+fn gather_rows(x: ArrayView2<f32>, index: &[usize], pool: &mut Pool) -> Array2<f32> {
+    let mut out = pool.array(index.len(), x.ncols());
+    for (mut row, &i) in out.rows_mut().into_iter().zip(index) {
+        row.assign(&x.row(i));
+    }
+    out
 }
 
 /// The valid rows of a padded [B, T, in] batch, flattened in (sequence, time) order.
@@ -602,8 +638,7 @@ mod tests {
         let mut grads = QNetParams::zeros(CFG);
         loss_of(&net, Some(&mut grads));
         let step = 1e-2f32;
-        let n_tensors = net.params.slices().len();
-        for t in 0..n_tensors {
+        for (t, name) in TENSOR_NAMES.iter().enumerate() {
             let len = net.params.slices()[t].len();
             for e in [0, len / 2, len - 1] {
                 let mut plus = net.clone();
@@ -614,8 +649,7 @@ mod tests {
                 let analytic = grads.slices()[t][e] as f64;
                 assert!(
                     (numeric - analytic).abs() <= 2e-3 + 2e-2 * numeric.abs().max(analytic.abs()),
-                    "{} element {e}: analytic {analytic}, numeric {numeric}",
-                    TENSOR_NAMES[t]
+                    "{name} element {e}: analytic {analytic}, numeric {numeric}"
                 );
             }
         }

@@ -5,7 +5,6 @@
 
 use ndarray::{s, Array2};
 
-use super::matmul::column_sums_into;
 use super::Op;
 use crate::autograd::kernels::gemm::{gemm, Mode};
 use crate::autograd::kernels::lstm::{
@@ -31,7 +30,7 @@ pub(crate) struct LstmNode {
     x: Var,
     w: LstmVars,
     packing: SeqPacking,
-    xh: Var,
+    h_prev: Var,
     gates: Var,
     c: Var,
     tanh_c: Var,
@@ -40,9 +39,18 @@ pub(crate) struct LstmNode {
 impl Tape {
     /// h for every valid position of every sequence, each unrolled from a zero state
     /// (spec `algorithms.md` 2.3). x: [K, in] in flat (sequence, time) order with
-    /// K = packing.total(); result [K, H] in the same order. Panics on inconsistent shapes.
+    /// K = packing.total(); result [K, H] in the same order. Reorders rows around
+    /// [`Tape::lstm_packed`]; nets that stay in packed order throughout skip that.
     pub fn lstm(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {
-        let (k, input) = self.shape(x);
+        let xp = self.gather_rows(x, packing.packed_to_flat());
+        let yp = self.lstm_packed(xp, w, packing);
+        self.gather_rows(yp, packing.flat_to_packed())
+    }
+
+    /// [`Tape::lstm`] with x and the result in packed order (see [`SeqPacking`]), where every
+    /// step reads and writes contiguous rows. Panics on inconsistent shapes.
+    pub fn lstm_packed(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {
+        let k = self.shape(x).0;
         let h = self.shape(w.w_hh).1;
         assert_eq!(
             k,
@@ -50,9 +58,9 @@ impl Tape {
             "lstm: x has {k} rows, the packing {}",
             packing.total()
         );
-        let [s_xh, s_g, s_c, s_tc] = LstmCache::shapes(k, input, h);
+        let [s_hp, s_g, s_c, s_tc] = LstmCache::shapes(k, h);
         let mut cache = LstmCache {
-            xh: self.pool().array(s_xh.0, s_xh.1),
+            h_prev: self.pool().array(s_hp.0, s_hp.1),
             gates: self.pool().array(s_g.0, s_g.1),
             c: self.pool().array(s_c.0, s_c.1),
             tanh_c: self.pool().array(s_tc.0, s_tc.1),
@@ -72,7 +80,7 @@ impl Tape {
             x,
             w,
             packing: packing.clone(),
-            xh: self.push_aux(cache.xh),
+            h_prev: self.push_aux(cache.h_prev),
             gates: self.push_aux(cache.gates),
             c: self.push_aux(cache.c),
             tanh_c: self.push_aux(cache.tanh_c),
@@ -92,67 +100,72 @@ impl LstmNode {
         if k == 0 {
             return;
         }
-        let input = cx.value(self.x).ncols();
-        let xh = cx.value(self.xh);
-        let w_ih = cx.value(self.w.w_ih);
-        let w_hh = cx.value(self.w.w_hh);
+        let (x, h_prev) = (cx.value(self.x), cx.value(self.h_prev));
+        let (w_ih, w_hh) = (cx.value(self.w.w_ih), cx.value(self.w.w_hh));
+        let (gates, c, tanh_c) = (
+            cx.value(self.gates),
+            cx.value(self.c),
+            cx.value(self.tanh_c),
+        );
+        let input = x.ncols();
+        let wants_w = cx.wants(self.w.w_ih) || cx.wants(self.w.w_hh);
 
         let mut dgates = cx.pool.array(k, 4 * h);
         let rows = lstm_backward_scratch_rows(p);
         let mut dh_rec = cx.pool.array(rows, h);
         let mut dc = cx.pool.array(rows, h);
+        let mut db = cx.pool.array(1, 4 * h);
+        let mut dw_ih = cx.pool.array(4 * h, input);
+        let mut dw_hh = cx.pool.array(4 * h, h);
+        let mut dx = cx.slot(self.x);
+        // Each gradient is a product over all steps, dW_ih = dG^T x, dW_hh = dG^T h_prev,
+        // dx = dG W_ih, computed chunk by chunk while the chunk's dG is still in cache.
+        let mut first = true;
         lstm_backward(
             g.view(),
             w_hh.view(),
             p,
-            cx.value(self.gates),
-            cx.value(self.c),
-            cx.value(self.tanh_c),
+            gates,
+            c,
+            tanh_c,
             &mut dgates,
             &mut dh_rec,
             &mut dc,
+            db.as_slice_mut().expect("pool arrays are contiguous"),
+            |r, dg| {
+                let dg = dg.slice(s![r.clone(), ..]);
+                if wants_w {
+                    let mode = if first {
+                        Mode::Overwrite
+                    } else {
+                        Mode::Accumulate
+                    };
+                    gemm(dg.t(), x.slice(s![r.clone(), ..]), dw_ih.view_mut(), mode);
+                    gemm(
+                        dg.t(),
+                        h_prev.slice(s![r.clone(), ..]),
+                        dw_hh.view_mut(),
+                        mode,
+                    );
+                }
+                first = false;
+                if let Some((d, mode)) = dx.as_mut() {
+                    gemm(dg, w_ih.view(), d.slice_mut(s![r, ..]), *mode);
+                }
+            },
         );
-
-        // Weight gradients: one product over all steps, dW = dG^T [x | h_prev].
-        let wants_ih = cx.wants(self.w.w_ih);
-        let wants_hh = cx.wants(self.w.w_hh);
-        if wants_ih && wants_hh {
-            let mut dw = cx.pool.array(4 * h, input + h);
-            gemm(dgates.t(), xh.view(), dw.view_mut(), Mode::Overwrite);
-            for (v, cols) in [(self.w.w_ih, 0..input), (self.w.w_hh, input..input + h)] {
-                if let Some((d, mode)) = cx.slot(v) {
-                    super::put!(mode, d, dw.slice(s![.., cols]); |g| g);
-                }
-            }
-            cx.pool.give_array(dw);
-        } else {
-            for (v, cols) in [(self.w.w_ih, 0..input), (self.w.w_hh, input..input + h)] {
-                if let Some((d, mode)) = cx.slot(v) {
-                    gemm(dgates.t(), xh.slice(s![.., cols]), d.view_mut(), mode);
-                }
+        for (v, dw) in [(self.w.w_ih, &dw_ih), (self.w.w_hh, &dw_hh)] {
+            if let Some((d, mode)) = cx.slot(v) {
+                super::put!(mode, d, dw; |g| g);
             }
         }
+        // Both biases get the column sums of dG.
         for v in [self.w.b_ih, self.w.b_hh] {
             if let Some((d, mode)) = cx.slot(v) {
-                column_sums_into(dgates.view(), d, mode);
+                super::put!(mode, d, &db; |g| g);
             }
         }
-        // Input gradient: dx = dG W_ih in packed order, scattered back to flat order.
-        if cx.wants(self.x) {
-            let mut dxp = cx.pool.array(k, input);
-            gemm(dgates.view(), w_ih.view(), dxp.view_mut(), Mode::Overwrite);
-            if let Some((d, mode)) = cx.slot(self.x) {
-                for (pr, &f) in p.packed_to_flat().iter().enumerate() {
-                    let mut row = d.row_mut(f);
-                    match mode {
-                        Mode::Overwrite => row.assign(&dxp.row(pr)),
-                        Mode::Accumulate => row += &dxp.row(pr),
-                    }
-                }
-            }
-            cx.pool.give_array(dxp);
-        }
-        for a in [dgates, dh_rec, dc] {
+        for a in [dgates, dh_rec, dc, db, dw_ih, dw_hh] {
             cx.pool.give_array(a);
         }
     }

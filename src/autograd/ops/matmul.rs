@@ -4,7 +4,7 @@
 use ndarray::{Array2, ArrayView2, Axis};
 
 use super::{put, Op};
-use crate::autograd::kernels::dense::linear_forward;
+use crate::autograd::kernels::dense::{act_backward_rows, add_column_sums, linear_forward};
 use crate::autograd::kernels::gemm::{gemm, Mode};
 use crate::autograd::tape::{GradCx, Tape, Var};
 
@@ -91,9 +91,14 @@ pub(crate) fn column_sums_into(g: ArrayView2<f32>, dst: &mut Array2<f32>, mode: 
     if mode == Mode::Overwrite {
         dst.fill(0.0);
     }
-    for row in g.axis_iter(Axis(0)) {
-        for (d, &v) in dst.iter_mut().zip(row.iter()) {
-            *d += v;
+    match g.as_slice() {
+        Some(rows) => add_column_sums(rows, dst),
+        None => {
+            for row in g.axis_iter(Axis(0)) {
+                for (d, &v) in dst.iter_mut().zip(row.iter()) {
+                    *d += v;
+                }
+            }
         }
     }
 }
@@ -119,14 +124,20 @@ pub(super) fn linear_backward(
     cx: &mut GradCx,
 ) {
     let (vx, vw) = (cx.value(x), cx.value(w));
+    // dz and its column sums (the bias gradient) in one pass.
+    let mut db = cx.pool.zeros(1, g.ncols());
+    let sums = db.as_slice_mut().expect("pool arrays are contiguous");
+    let g_rows = g.as_slice().expect("tape arrays are contiguous");
     let dz_owned = match act {
-        Activation::Identity => None,
-        Activation::LeakyRelu(_) => {
+        Activation::Identity => {
+            add_column_sums(g_rows, sums);
+            None
+        }
+        Activation::LeakyRelu(slope) => {
             let mut dz = cx.pool.array(g.nrows(), g.ncols());
-            ndarray::Zip::from(&mut dz)
-                .and(g)
-                .and(y)
-                .for_each(|d, &g, &y| *d = g * act.slope_at_output(y));
+            let y_rows = y.as_slice().expect("tape arrays are contiguous");
+            let dz_rows = dz.as_slice_mut().expect("pool arrays are contiguous");
+            act_backward_rows(g_rows, y_rows, slope, dz_rows, sums);
             Some(dz)
         }
     };
@@ -135,8 +146,9 @@ pub(super) fn linear_backward(
         gemm(dz.t(), vx.view(), d.view_mut(), mode);
     }
     if let Some((d, mode)) = cx.slot(b) {
-        column_sums_into(dz.view(), d, mode);
+        put!(mode, d, &db; |g| g);
     }
+    cx.pool.give_array(db);
     if let Some((d, mode)) = cx.slot(x) {
         gemm(dz.view(), vw.view(), d.view_mut(), mode);
     }
