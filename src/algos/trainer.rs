@@ -264,6 +264,16 @@ impl Trainer {
         self.episodes
     }
 
+    /// Primitive steps taken by the training env(s).
+    pub fn env_steps(&self) -> u64 {
+        self.env_steps
+    }
+
+    /// Training iterations run.
+    pub fn updates(&self) -> u64 {
+        self.updates
+    }
+
     /// Every evaluation so far, in order.
     pub fn evals(&self) -> &[EvalPoint] {
         &self.evals
