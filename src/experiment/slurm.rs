@@ -82,6 +82,7 @@ pub fn job_script(experiment: &str, labels: &[String], o: &SlurmOptions<'_>) -> 
             "--jobs",
             "1",
             "--quiet",
+            "--no-plot",
             "--run-index",
             "\"$SLURM_ARRAY_TASK_ID\"",
         ]
