@@ -170,11 +170,16 @@ fn a_diverging_run_fails_clearly_and_the_others_finish() {
     let o = train(&config, &out, &["--set", "our1.l_rate=1e30"]);
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("our1 seed 0: non-finite") && err.contains("at episode"), "{err}");
+    assert!(
+        err.contains("our1 seed 0: non-finite") && err.contains("at episode"),
+        "{err}"
+    );
     assert!(err.contains("2 of 4 run(s) failed"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     for seed in 0..2 {
-        assert!(out.join(format!("tiny/dec-hddrqn/seed-{seed}/finished")).exists());
+        assert!(out
+            .join(format!("tiny/dec-hddrqn/seed-{seed}/finished"))
+            .exists());
         assert!(!out.join(format!("tiny/our1/seed-{seed}/finished")).exists());
     }
 }

@@ -29,7 +29,9 @@ pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
         message,
     };
     // Draw into a sibling temp file and rename it over `path`, so a reader never sees a torn PNG.
-    let name = path.file_name().map_or_else(|| "figure.png".into(), |n| n.to_string_lossy());
+    let name = path
+        .file_name()
+        .map_or_else(|| "figure.png".into(), |n| n.to_string_lossy());
     let tmp = path.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
     {
         let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
