@@ -319,12 +319,6 @@ pub fn lstm_backward(
         let (n, o) = (packing.batch_size(t), packing.offset(t));
         let c_prev: &[f32] = if t > 0 {
             let po = packing.offset(t - 1);
-            prefetch(&gates[po * 4 * h..o * 4 * h]);
-            prefetch(&tc_all[po * h..o * h]);
-            prefetch(&dy[po * h..o * h]);
-            if t > 1 {
-                prefetch(&c_all[packing.offset(t - 2) * h..po * h]);
-            }
             &c_all[po * h..(po + n) * h]
         } else {
             &zeros[..n * h]
@@ -353,22 +347,6 @@ pub fn lstm_backward(
             chunk_end = o;
         }
     }
-}
-
-/// Hint the CPU to bring `data` into cache ahead of use (no effect on results).
-#[inline]
-fn prefetch(data: &[f32]) {
-    #[cfg(target_arch = "x86_64")]
-    for line in data.chunks(16) {
-        // SAFETY: prefetching reads nothing architecturally and the address is in bounds.
-        unsafe {
-            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-                line.as_ptr().cast(),
-            );
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = data;
 }
 
 /// The backward of the cell for L lanes: dL/dh (output plus recurrent part), the carried
