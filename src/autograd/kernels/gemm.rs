@@ -21,7 +21,7 @@ pub enum Mode {
 
 /// c (=|+=) a · b with a: [m, k], b: [k, n], c: [m, n]. Any strides (pass `.t()` views for
 /// transposes); b with non-unit column stride is copied to a contiguous buffer first, so hot
-/// loops should pass b pre-transposed (see [`transpose_into`]). Panics on mismatched shapes.
+/// loops should pass b pre-transposed (see [`transposed`]). Panics on mismatched shapes.
 pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, mode: Mode) {
     assert_eq!(a.ncols(), b.nrows(), "gemm: inner dimensions differ");
     assert_eq!(c.dim(), (a.nrows(), b.ncols()), "gemm: output shape");
@@ -45,8 +45,7 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
                 // (it is borrowed mutably while they are borrowed).
                 unsafe { avx512::gemm_views(a, b, c, mode) };
             } else {
-                let mut bt = Array2::zeros((k, n));
-                bt.assign(&b);
+                let bt = b.as_standard_layout();
                 // SAFETY: as above; `bt` is a fresh standard-layout array.
                 unsafe { avx512::gemm_views(a, bt.view(), c, mode) };
             }
@@ -60,15 +59,10 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
     general_mat_mul(1.0, &a, &b, beta, &mut c);
 }
 
-/// dst = src^T for src: [r, c], dst: [c, r] (e.g. a weight W [out, in] into W^T, the right
-/// operand of x W^T, once per pass instead of once per product).
-pub fn transpose_into(src: ArrayView2<f32>, dst: &mut Array2<f32>) {
-    assert_eq!(
-        dst.dim(),
-        (src.ncols(), src.nrows()),
-        "transpose_into: shape"
-    );
-    dst.assign(&src.t());
+/// src^T as a standard-layout array (e.g. a weight W [out, in] into W^T, the right operand of
+/// x W^T, once per pass instead of once per product).
+pub fn transposed(src: ArrayView2<f32>) -> Array2<f32> {
+    src.t().as_standard_layout().into_owned()
 }
 
 /// Number of floating-point operations of one [m, k] · [k, n] product (a multiply-add counts 2).

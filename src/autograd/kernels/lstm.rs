@@ -19,7 +19,7 @@
 use ndarray::{s, Array2, ArrayView2};
 
 use super::activations::{sigmoid_approx, simd_dispatch, tanh_approx};
-use super::gemm::{gemm, transpose_into, Mode};
+use super::gemm::{gemm, transposed, Mode};
 use crate::autograd::SeqPacking;
 
 /// The four LSTM parameter tensors. w_ih: [4H, in], w_hh: [4H, H], biases: [4H].
@@ -100,10 +100,8 @@ pub fn lstm_forward(
     cache.h_prev.slice_mut(s![..n0, ..]).fill(0.0);
 
     // Right operands in unit-stride layout once, not once per product.
-    let mut w_ih_t = Array2::zeros((input, 4 * h));
-    transpose_into(w.w_ih, &mut w_ih_t);
-    let mut w_hh_t = Array2::zeros((h, 4 * h));
-    transpose_into(w.w_hh, &mut w_hh_t);
+    let w_ih_t = transposed(w.w_ih);
+    let w_hh_t = transposed(w.w_hh);
 
     let bias: Vec<f32> = w.b_ih.iter().zip(w.b_hh).map(|(a, b)| a + b).collect();
     let zeros = vec![0.0f32; n0 * h];
