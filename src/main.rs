@@ -95,9 +95,12 @@ enum Command {
         /// Timed iterations per configuration (nets).
         #[arg(long, default_value_t = 200)]
         iters: usize,
-        /// Only the configuration with this name (nets; e.g. torch-wtd).
+        /// Only the configuration with this name (nets: e.g. torch-wtd; train: e.g. "bp10 our1").
         #[arg(long)]
         only: Option<String>,
+        /// Training episodes per run (train).
+        #[arg(long, default_value_t = 200)]
+        episodes: usize,
     },
 }
 
@@ -107,6 +110,9 @@ enum BenchTarget {
     Envs,
     /// One Q-net training update (forward, backward, Adam) at the paper's shapes, 1 thread.
     Nets,
+    /// Whole training (first --episodes episodes) of every method on BP 10x10 and WTD, 1 thread;
+    /// then two BP Our-1 runs at once on two threads against one alone.
+    Train,
 }
 
 #[derive(clap::Args)]
@@ -258,7 +264,13 @@ fn main() -> Result<()> {
         }
         Command::Plot { results, out } => plot(&results, &out),
         Command::Demo { steps, seed } => demo_run(steps, seed),
-        Command::Bench { what, iters, only } => match what {
+        Command::Bench {
+            what,
+            iters,
+            only,
+            episodes,
+        } => match what {
+            BenchTarget::Train => bench_train(only.as_deref(), episodes),
             BenchTarget::Envs => bench_envs(),
             BenchTarget::Nets => {
                 let results: Vec<_> = nets::SHAPES
@@ -435,6 +447,39 @@ fn demo_run(steps: usize, seed: u64) -> Result<()> {
         println!("step {step:>6}  loss {loss:.5}")
     })?;
     println!("done in {:.1} s", t0.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
+    use macdec::algos::hyper::EnvName;
+    use macdec::algos::method::Method;
+    use macdec::bench::train;
+    let mut rows = Vec::new();
+    for (env, method) in train::suite() {
+        if only.is_some_and(|o| o != train::name(env, method)) {
+            continue;
+        }
+        let row = train::bench_train(env, method, episodes)?;
+        eprintln!("{}: {:.1} s", row.name, row.seconds);
+        rows.push(row);
+    }
+    print!("{}", train::format_table(&rows));
+    if only.is_none() {
+        // Two runs on two threads should take no longer than one alone (no shared state).
+        let one = train::bench_train(EnvName::BoxPushing, Method::Our1, episodes)?;
+        let (a, b) = rayon::join(
+            || train::bench_train(EnvName::BoxPushing, Method::Our1, episodes),
+            || train::bench_train(EnvName::BoxPushing, Method::Our1, episodes),
+        );
+        let (a, b) = (a?, b?);
+        println!(
+            "\nbp10 our1 alone: {:.1} s; two at once on two threads: {:.1} s and {:.1} s (ratio {:.2})",
+            one.seconds,
+            a.seconds,
+            b.seconds,
+            a.seconds.max(b.seconds) / one.seconds
+        );
+    }
     Ok(())
 }
 

@@ -159,3 +159,27 @@ fn bad_config_keys_and_values_are_named() {
     let o = train(&config, &out, &["--methods", "our9"]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("our9"));
 }
+
+#[test]
+fn a_diverging_run_fails_clearly_and_the_others_finish() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("out");
+    // An absurd learning rate makes Our-1's Q-values overflow within a few updates.
+    let o = train(&config, &out, &["--set", "our1.l_rate=1e30"]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("our1 seed 0: non-finite") && err.contains("at episode"),
+        "{err}"
+    );
+    assert!(err.contains("2 of 4 run(s) failed"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for seed in 0..2 {
+        assert!(out
+            .join(format!("tiny/dec-hddrqn/seed-{seed}/finished"))
+            .exists());
+        assert!(!out.join(format!("tiny/our1/seed-{seed}/finished")).exists());
+    }
+}

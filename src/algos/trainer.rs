@@ -60,6 +60,9 @@ struct Lane {
     dec_states: Vec<LstmState>,
     cen_state: Option<LstmState>,
     actions: Vec<usize>,
+    /// Quirk Q12: Our-1 / Our-1-R under centralized exploration still run the decentralized
+    /// selection each step (hidden states advance, draws are consumed) and discard its actions.
+    shadow_dec_selection: bool,
     discarded: Vec<usize>,
     #[serde(skip, default)]
     scratch: Option<ActScratch>,
@@ -191,6 +194,8 @@ impl Trainer {
                 dec_states: dec_zero_states(&dec),
                 cen_state: cen.as_ref().map(|c| c.policy.zero_state()),
                 actions: vec![0; layout.n_agents()],
+                shadow_dec_selection: exploration == Exploration::Centralized
+                    && matches!(method, Method::Our1 | Method::Our1R),
                 discarded: vec![0; layout.n_agents()],
                 scratch: None,
                 env,
@@ -257,6 +262,16 @@ impl Trainer {
     /// Completed training episodes.
     pub fn episodes(&self) -> u64 {
         self.episodes
+    }
+
+    /// Primitive steps taken by the training env(s).
+    pub fn env_steps(&self) -> u64 {
+        self.env_steps
+    }
+
+    /// Training iterations run.
+    pub fn updates(&self) -> u64 {
+        self.updates
     }
 
     /// Every evaluation so far, in order.
@@ -382,61 +397,49 @@ impl Trainer {
             .get_or_insert_with(|| ActScratch::new(&lane.env));
         let dec_nets: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
         let carry = self.config.h_explore;
-        match lane.exploration {
-            Exploration::Decentralized => {
-                let explore = Explore {
-                    rng: &mut self.rngs.explore,
-                    epsilon: self.epsilon,
-                    carry_state: carry,
-                };
-                select_dec(
-                    &lane.env,
-                    &dec_nets,
-                    &mut lane.dec_states,
-                    Some(explore),
-                    &mut lane.actions,
-                );
-            }
-            Exploration::Centralized => {
-                if !dec_nets.is_empty() {
-                    // Q12: Our-1 still runs (and discards) the decentralized selection.
-                    let explore = Explore {
-                        rng: &mut self.rngs.explore,
-                        epsilon: self.epsilon,
-                        carry_state: carry,
-                    };
-                    select_dec(
-                        &lane.env,
-                        &dec_nets,
-                        &mut lane.dec_states,
-                        Some(explore),
-                        &mut lane.discarded,
-                    );
-                }
-                let cen = &self
-                    .cen
-                    .as_ref()
-                    .expect("centralized exploration needs the centralized net")
-                    .policy;
-                let explore = Explore {
-                    rng: &mut self.rngs.explore,
-                    epsilon: self.epsilon,
-                    carry_state: carry,
-                };
-                let state = lane
-                    .cen_state
-                    .as_mut()
-                    .expect("a centralized net has a state");
-                select_cen(
-                    &lane.env,
-                    cen,
-                    state,
-                    Some(explore),
-                    scratch,
-                    &mut lane.actions,
-                );
-            }
-            Exploration::Parallel => unreachable!("Our-2 is split into two lanes at construction"),
+        let explore_dec = lane.exploration == Exploration::Decentralized;
+        if explore_dec || lane.shadow_dec_selection {
+            let explore = Explore {
+                rng: &mut self.rngs.explore,
+                epsilon: self.epsilon,
+                carry_state: carry,
+            };
+            let out = if explore_dec {
+                &mut lane.actions
+            } else {
+                &mut lane.discarded
+            };
+            select_dec(
+                &lane.env,
+                &dec_nets,
+                &mut lane.dec_states,
+                Some(explore),
+                out,
+            );
+        }
+        if lane.exploration == Exploration::Centralized {
+            let cen = &self
+                .cen
+                .as_ref()
+                .expect("centralized exploration needs the centralized net")
+                .policy;
+            let explore = Explore {
+                rng: &mut self.rngs.explore,
+                epsilon: self.epsilon,
+                carry_state: carry,
+            };
+            let state = lane
+                .cen_state
+                .as_mut()
+                .expect("a centralized net has a state");
+            select_cen(
+                &lane.env,
+                cen,
+                state,
+                Some(explore),
+                scratch,
+                &mut lane.actions,
+            );
         }
         let outcome = lane.env.step(&lane.actions, &mut lane.rng)?;
         self.env_steps += 1;

@@ -7,24 +7,13 @@
 //! before the first), `wall_seconds` (time since the run started, including resumed segments; the
 //! only column that is not reproducible bit for bit).
 
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The file name of a run's learning curve.
 pub const METRICS_FILE: &str = "metrics.csv";
 
-/// One evaluation point of a run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MetricsRow {
-    pub episode: u64,
-    pub env_steps: u64,
-    pub updates: u64,
-    pub eval_return: f64,
-    pub epsilon: f64,
-    pub hysteresis: f64,
-    pub loss: Option<f64>,
-    pub wall_seconds: f64,
-}
+/// One evaluation point of a run: the trainer's own record, written as one CSV row.
+pub use crate::algos::trainer::EvalPoint as MetricsRow;
 
 /// Why a metrics file could not be read or written.
 #[derive(Debug, thiserror::Error)]

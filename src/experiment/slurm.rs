@@ -1,7 +1,7 @@
 //! Slurm job arrays: one array task per run of an experiment.
 //!
 //! Each task runs `macdec train` for exactly one run (`--run-index $SLURM_ARRAY_TASK_ID`) into the
-//! shared results directory. Runs checkpoint and resume, so a preempted and requeued task
+//! shared results directory (no figures: tasks would race to draw them). Runs checkpoint and resume, so a preempted and requeued task
 //! continues where it stopped; `macdec plot` then reads the union of the run directories.
 
 use std::fmt::Write as _;
@@ -82,6 +82,7 @@ pub fn job_script(experiment: &str, labels: &[String], o: &SlurmOptions<'_>) -> 
             "--jobs",
             "1",
             "--quiet",
+            "--no-plot",
             "--run-index",
             "\"$SLURM_ARRAY_TASK_ID\"",
         ]
@@ -120,7 +121,7 @@ mod tests {
         assert!(s.contains("#SBATCH --partition=cpu\n"));
         assert!(s.contains("#   5: our1/seed-5\n"));
         assert!(s.ends_with(
-            "/home/me/macdec train --config /home/me/fig4a.toml --out /scratch/results --set total_epi=300 --jobs 1 --quiet --run-index \"$SLURM_ARRAY_TASK_ID\"\n"
+            "/home/me/macdec train --config /home/me/fig4a.toml --out /scratch/results --set total_epi=300 --jobs 1 --quiet --no-plot --run-index \"$SLURM_ARRAY_TASK_ID\"\n"
         ));
     }
 }

@@ -11,7 +11,7 @@ use crate::algos::method::Method;
 use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
 use crate::experiment::atomic::write_atomic;
 use crate::experiment::config::RunSpec;
-use crate::experiment::metrics::{self, MetricsRow, METRICS_FILE};
+use crate::experiment::metrics::{self, METRICS_FILE};
 use crate::experiment::runner::{Progress, FINISHED_MARKER};
 use crate::experiment::seeds::{stream, Role};
 use serde::{Deserialize, Serialize};
@@ -81,22 +81,9 @@ fn save_checkpoint(path: &Path, trainer: &mut Trainer) -> Result<(), RunError> {
 }
 
 fn save_metrics(dir: &Path, trainer: &Trainer) -> Result<(), RunError> {
-    let rows: Vec<MetricsRow> = trainer
-        .evals()
-        .iter()
-        .map(|e| MetricsRow {
-            episode: e.episode,
-            env_steps: e.env_steps,
-            updates: e.updates,
-            eval_return: e.eval_return,
-            epsilon: e.epsilon,
-            hysteresis: e.hysteresis,
-            loss: e.loss,
-            wall_seconds: e.wall_seconds,
-        })
-        .collect();
+    let rows = trainer.evals();
     let path = dir.join(METRICS_FILE);
-    metrics::write(&path, &rows).map_err(|e| io(&path, e))
+    metrics::write(&path, rows).map_err(|e| io(&path, e))
 }
 
 /// Train one run to completion in `dir`, resuming from its checkpoint if there is one.

@@ -28,9 +28,20 @@ pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
         path: path.to_path_buf(),
         message,
     };
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    draw(&root, fig).map_err(err)?;
-    root.present().map_err(|e| err(e.to_string()))
+    // Draw into a sibling temp file and rename it over `path`, so a reader never sees a torn PNG.
+    let name = path
+        .file_name()
+        .map_or_else(|| "figure.png".into(), |n| n.to_string_lossy());
+    let tmp = path.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
+    {
+        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
+        draw(&root, fig).map_err(err)?;
+        root.present().map_err(|e| err(e.to_string()))?;
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        err(e.to_string())
+    })
 }
 
 /// Draw `fig` as SVG text; `path` is only used in error messages.

@@ -1,0 +1,97 @@
+//! `macdec bench train`: whole training, end to end (acting, env steps, replay, squeezing,
+//! updates, evaluation), single run, one thread, at the paper's settings for the first episodes.
+//!
+//! The reference's figures quoted in the issues were taken the same way (first 200 episodes of
+//! Box Pushing 10x10, all costs included), so the rates compare like for like.
+
+use crate::algos::hyper::{paper_defaults, EnvName};
+use crate::algos::method::Method;
+use crate::algos::trainer::{Advance, TrainError, Trainer};
+use crate::experiment::train_run::run_rngs;
+use std::time::Instant;
+
+/// What one benchmarked run did and how fast.
+#[derive(Debug, Clone)]
+pub struct TrainBench {
+    pub name: String,
+    pub episodes: u64,
+    pub env_steps: u64,
+    pub updates: u64,
+    pub seconds: f64,
+}
+
+impl TrainBench {
+    pub fn episodes_per_second(&self) -> f64 {
+        self.episodes as f64 / self.seconds
+    }
+    pub fn env_steps_per_second(&self) -> f64 {
+        self.env_steps as f64 / self.seconds
+    }
+    pub fn updates_per_second(&self) -> f64 {
+        self.updates as f64 / self.seconds
+    }
+}
+
+/// The configurations benchmarked: every method on BP 10x10 (Our-2 is episode-buffer only, quirk
+/// Q10) and every method on Warehouse.
+pub fn suite() -> Vec<(EnvName, Method)> {
+    let mut v: Vec<(EnvName, Method)> = Method::ALL
+        .into_iter()
+        .filter(|&m| m != Method::Our2)
+        .map(|m| (EnvName::BoxPushing, m))
+        .collect();
+    v.extend(Method::ALL.into_iter().map(|m| (EnvName::Warehouse, m)));
+    v
+}
+
+/// Train `method` on `env` at the paper's settings for `episodes` episodes (seed 0) and time it.
+pub fn bench_train(
+    env: EnvName,
+    method: Method,
+    episodes: usize,
+) -> Result<TrainBench, TrainError> {
+    let mut config = paper_defaults(env, 10, method);
+    config.total_epi = episodes;
+    let start = Instant::now();
+    let mut trainer = Trainer::new(config, method, 0, run_rngs(0))?;
+    while trainer.advance()? != Advance::Finished {}
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(TrainBench {
+        name: name(env, method),
+        episodes: trainer.episodes(),
+        env_steps: trainer.env_steps(),
+        updates: trainer.updates(),
+        seconds,
+    })
+}
+
+/// The row name of a configuration, e.g. `bp10 our1`.
+pub fn name(env: EnvName, method: Method) -> String {
+    let env_name = match env {
+        EnvName::BoxPushing => "bp10",
+        EnvName::Warehouse => "wtd",
+    };
+    format!("{env_name} {method}")
+}
+
+/// A Markdown table of the results.
+pub fn format_table(rows: &[TrainBench]) -> String {
+    let mut s = String::from(
+        "| run | episodes | env steps | updates | seconds | episodes/s | env steps/s | updates/s | ms per update (all costs) |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        s += &format!(
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.0} | {:.1} | {:.2} |\n",
+            r.name,
+            r.episodes,
+            r.env_steps,
+            r.updates,
+            r.seconds,
+            r.episodes_per_second(),
+            r.env_steps_per_second(),
+            r.updates_per_second(),
+            1e3 * r.seconds / r.updates.max(1) as f64
+        );
+    }
+    s
+}
