@@ -321,6 +321,31 @@ mod tests {
     }
 
     #[test]
+    fn a_tensor_of_another_dtype_is_an_error_naming_it() {
+        let params = net().params;
+        let data: Vec<(&str, Vec<usize>, Vec<u8>, Dtype)> = params
+            .named()
+            .into_iter()
+            .map(|(name, a)| {
+                if name == "fc4.bias" {
+                    let bytes = a.iter().flat_map(|v| (*v as f64).to_le_bytes()).collect();
+                    (name, a.shape().to_vec(), bytes, Dtype::F64)
+                } else {
+                    let bytes = a.iter().flat_map(|v| v.to_le_bytes()).collect();
+                    (name, a.shape().to_vec(), bytes, Dtype::F32)
+                }
+            })
+            .collect();
+        let views = data
+            .iter()
+            .map(|(n, s, b, d)| (*n, TensorView::new(*d, s.clone(), b).unwrap()));
+        let bytes = safetensors::serialize(views, &None).unwrap();
+        let err = from_safetensors_bytes(&bytes, CFG, Path::new("x")).unwrap_err();
+        assert!(matches!(err, WeightsError::Dtype { .. }), "{err}");
+        assert!(err.to_string().contains("fc4.bias"), "{err}");
+    }
+
+    #[test]
     fn garbage_is_a_format_error() {
         let err = from_safetensors_bytes(b"not a file", CFG, Path::new("x")).unwrap_err();
         assert!(matches!(err, WeightsError::Format { .. }));

@@ -21,7 +21,7 @@ pub enum Mode {
 
 /// c (=|+=) a · b with a: [m, k], b: [k, n], c: [m, n]. Any strides (pass `.t()` views for
 /// transposes); b with non-unit column stride is copied to a contiguous buffer first, so hot
-/// loops should pass b pre-transposed (see [`transpose_into`]). Panics on mismatched shapes.
+/// loops should pass b pre-transposed (see [`transposed`]). Panics on mismatched shapes.
 pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, mode: Mode) {
     assert_eq!(a.ncols(), b.nrows(), "gemm: inner dimensions differ");
     assert_eq!(c.dim(), (a.nrows(), b.ncols()), "gemm: output shape");
@@ -45,8 +45,7 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
                 // (it is borrowed mutably while they are borrowed).
                 unsafe { avx512::gemm_views(a, b, c, mode) };
             } else {
-                let mut bt = Array2::zeros((k, n));
-                bt.assign(&b);
+                let bt = b.as_standard_layout();
                 // SAFETY: as above; `bt` is a fresh standard-layout array.
                 unsafe { avx512::gemm_views(a, bt.view(), c, mode) };
             }
@@ -60,15 +59,10 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
     general_mat_mul(1.0, &a, &b, beta, &mut c);
 }
 
-/// dst = src^T for src: [r, c], dst: [c, r] (e.g. a weight W [out, in] into W^T, the right
-/// operand of x W^T, once per pass instead of once per product).
-pub fn transpose_into(src: ArrayView2<f32>, dst: &mut Array2<f32>) {
-    assert_eq!(
-        dst.dim(),
-        (src.ncols(), src.nrows()),
-        "transpose_into: shape"
-    );
-    dst.assign(&src.t());
+/// src^T as a standard-layout array (e.g. a weight W [out, in] into W^T, the right operand of
+/// x W^T, once per pass instead of once per product).
+pub fn transposed(src: ArrayView2<f32>) -> Array2<f32> {
+    src.t().as_standard_layout().into_owned()
 }
 
 /// Number of floating-point operations of one [m, k] · [k, n] product (a multiply-add counts 2).
@@ -143,19 +137,21 @@ mod avx512 {
         rsc: isize,
         accumulate: bool,
     ) {
+        // Narrow outputs (n <= 16, e.g. a Q-net's last layer with 3 or 8 actions) use a tall
+        // 16 x 16 tile so fewer masked lanes are wasted.
+        let (mr, narrow) = if n <= 16 { (16, true) } else { (MR, false) };
         let mut k0 = 0;
         while k0 < k {
             let kc = (k - k0).min(KC);
             let (ak, bk) = (a.offset(k0 as isize * csa), b.offset(k0 as isize * rsb));
+            let acc = accumulate || k0 > 0;
             let mut i = 0;
             while i < m {
-                let rows = (m - i).min(MR);
+                let rows = (m - i).min(mr);
                 let (ai, ci) = (ak.offset(i as isize * rsa), c.offset(i as isize * rsc));
                 let mut j = 0;
                 while j < n {
                     let cols = (n - j).min(NR);
-                    let m0 = lane_mask(cols);
-                    let m1 = lane_mask(cols.saturating_sub(16));
                     let t = Tile {
                         k: kc,
                         a: ai,
@@ -165,23 +161,30 @@ mod avx512 {
                         rsb,
                         c: ci.add(j),
                         rsc,
-                        m0,
-                        m1,
+                        m0: lane_mask(cols),
+                        m1: lane_mask(cols.saturating_sub(16)),
                     };
-                    let acc = accumulate || k0 > 0;
-                    match rows {
-                        8 => t.run::<8>(acc),
-                        7 => t.run::<7>(acc),
-                        6 => t.run::<6>(acc),
-                        5 => t.run::<5>(acc),
-                        4 => t.run::<4>(acc),
-                        3 => t.run::<3>(acc),
-                        2 => t.run::<2>(acc),
-                        _ => t.run::<1>(acc),
+                    if narrow {
+                        if rows == 16 {
+                            t.run_narrow::<16>(acc)
+                        } else {
+                            t.run_narrow_partial(rows, acc)
+                        }
+                    } else {
+                        match rows {
+                            8 => t.run::<8>(acc),
+                            7 => t.run::<7>(acc),
+                            6 => t.run::<6>(acc),
+                            5 => t.run::<5>(acc),
+                            4 => t.run::<4>(acc),
+                            3 => t.run::<3>(acc),
+                            2 => t.run::<2>(acc),
+                            _ => t.run::<1>(acc),
+                        }
                     }
                     j += NR;
                 }
-                i += MR;
+                i += mr;
             }
             k0 += kc;
         }
@@ -198,6 +201,7 @@ mod avx512 {
     }
 
     /// One register tile's operands.
+    #[derive(Clone, Copy)]
     struct Tile {
         k: usize,
         a: *const f32,
@@ -212,6 +216,52 @@ mod avx512 {
     }
 
     impl Tile {
+        /// The leftover rows (< 16) of a narrow product, in tiles of 8, 4, 2, 1 rows.
+        #[inline(always)]
+        unsafe fn run_narrow_partial(&self, rows: usize, accumulate: bool) {
+            let mut done = 0;
+            for step in [8, 4, 2, 1] {
+                while rows - done >= step {
+                    let t = Tile {
+                        a: self.a.offset(done as isize * self.rsa),
+                        c: self.c.offset(done as isize * self.rsc),
+                        ..*self
+                    };
+                    match step {
+                        8 => t.run_narrow::<8>(accumulate),
+                        4 => t.run_narrow::<4>(accumulate),
+                        2 => t.run_narrow::<2>(accumulate),
+                        _ => t.run_narrow::<1>(accumulate),
+                    }
+                    done += step;
+                }
+            }
+        }
+
+        /// C[0..R, 0..16] (=|+=) A[0..R, 0..k] · B[0..k, 0..16] under the first column mask
+        /// (one vector per row).
+        #[inline(always)]
+        unsafe fn run_narrow<const R: usize>(&self, accumulate: bool) {
+            let mut acc = [_mm512_setzero_ps(); R];
+            let (mut ap, mut bp) = (self.a, self.b);
+            for _ in 0..self.k {
+                let b0 = _mm512_maskz_loadu_ps(self.m0, bp);
+                for (r, a) in acc.iter_mut().enumerate() {
+                    let av = _mm512_set1_ps(*ap.offset(r as isize * self.rsa));
+                    *a = _mm512_fmadd_ps(av, b0, *a);
+                }
+                ap = ap.offset(self.csa);
+                bp = bp.offset(self.rsb);
+            }
+            for (r, a) in acc.iter_mut().enumerate() {
+                let cp = self.c.offset(r as isize * self.rsc);
+                if accumulate {
+                    *a = _mm512_add_ps(*a, _mm512_maskz_loadu_ps(self.m0, cp));
+                }
+                _mm512_mask_storeu_ps(cp, self.m0, *a);
+            }
+        }
+
         /// C[0..R, 0..32] (=|+=) A[0..R, 0..k] · B[0..k, 0..32] under the column masks.
         #[inline(always)]
         unsafe fn run<const R: usize>(&self, accumulate: bool) {
@@ -285,7 +335,8 @@ mod tests {
 
     #[test]
     fn every_tile_edge_and_stride_case_matches_a_naive_product() {
-        // Sizes around the 8 x 32 tile and the 384 k-block; strided, transposed and sliced views.
+        // Sizes around the 8 x 32 and 16 x 16 tiles and the 384 k-block; strided, transposed and
+        // sliced views.
         for &(m, k, n) in &[
             (1, 1, 1),
             (7, 3, 33),
@@ -293,6 +344,9 @@ mod tests {
             (9, 17, 16),
             (17, 400, 47),
             (3, 800, 65),
+            (31, 9, 3),
+            (16, 5, 8),
+            (45, 390, 16),
         ] {
             let a = Array2::from_shape_fn((m, k + 2), |(i, j)| {
                 ((i * 31 + j * 17) % 13) as f32 / 7.0 - 0.9

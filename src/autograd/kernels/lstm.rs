@@ -19,7 +19,7 @@
 use ndarray::{s, Array2, ArrayView2};
 
 use super::activations::{sigmoid_approx, simd_dispatch, tanh_approx};
-use super::gemm::{gemm, transpose_into, Mode};
+use super::gemm::{gemm, transposed, Mode};
 use crate::autograd::SeqPacking;
 
 /// The four LSTM parameter tensors. w_ih: [4H, in], w_hh: [4H, H], biases: [4H].
@@ -100,10 +100,8 @@ pub fn lstm_forward(
     cache.h_prev.slice_mut(s![..n0, ..]).fill(0.0);
 
     // Right operands in unit-stride layout once, not once per product.
-    let mut w_ih_t = Array2::zeros((input, 4 * h));
-    transpose_into(w.w_ih, &mut w_ih_t);
-    let mut w_hh_t = Array2::zeros((h, 4 * h));
-    transpose_into(w.w_hh, &mut w_hh_t);
+    let w_ih_t = transposed(w.w_ih);
+    let w_hh_t = transposed(w.w_hh);
 
     let bias: Vec<f32> = w.b_ih.iter().zip(w.b_hh).map(|(a, b)| a + b).collect();
     let zeros = vec![0.0f32; n0 * h];
@@ -319,12 +317,6 @@ pub fn lstm_backward(
         let (n, o) = (packing.batch_size(t), packing.offset(t));
         let c_prev: &[f32] = if t > 0 {
             let po = packing.offset(t - 1);
-            prefetch(&gates[po * 4 * h..o * 4 * h]);
-            prefetch(&tc_all[po * h..o * h]);
-            prefetch(&dy[po * h..o * h]);
-            if t > 1 {
-                prefetch(&c_all[packing.offset(t - 2) * h..po * h]);
-            }
             &c_all[po * h..(po + n) * h]
         } else {
             &zeros[..n * h]
@@ -353,22 +345,6 @@ pub fn lstm_backward(
             chunk_end = o;
         }
     }
-}
-
-/// Hint the CPU to bring `data` into cache ahead of use (no effect on results).
-#[inline]
-fn prefetch(data: &[f32]) {
-    #[cfg(target_arch = "x86_64")]
-    for line in data.chunks(16) {
-        // SAFETY: prefetching reads nothing architecturally and the address is in bounds.
-        unsafe {
-            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-                line.as_ptr().cast(),
-            );
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = data;
 }
 
 /// The backward of the cell for L lanes: dL/dh (output plus recurrent part), the carried

@@ -226,6 +226,55 @@ mod tests {
     }
 
     #[test]
+    fn unary_ops_fan_out_matches_finite_differences() {
+        // Each op's input also feeds the result directly: y = op(x) * x, or op(x) - x.
+        grad_check(
+            |t, v| {
+                let y = t.sigmoid(v[0]);
+                t.mul(y, v[0])
+            },
+            &[(3, 3)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let y = t.square(v[0]);
+                t.sub(y, v[0])
+            },
+            &[(2, 4)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let y = t.scale(v[0], 3.0);
+                t.mul(y, v[0])
+            },
+            &[(2, 2)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let y = t.leaky_relu(v[0], 0.2);
+                t.mul(y, v[0])
+            },
+            &[(3, 2)],
+            Inputs::AwayFromZero,
+        );
+    }
+
+    #[test]
+    fn sub_fan_out_cancels() {
+        // y = x - x = 0: the two contributions cancel exactly.
+        grad_check(|t, v| t.sub(v[0], v[0]), &[(2, 3)], Inputs::Any);
+        let mut t = crate::autograd::Tape::new();
+        let x = t.param(ndarray::arr2(&[[1.0f32, -2.0]]).view());
+        let y = t.sub(x, x);
+        let s = t.sum(y);
+        t.backward(s);
+        assert_eq!(t.grad(x).unwrap(), ndarray::arr2(&[[0.0f32, 0.0]]));
+    }
+
+    #[test]
     fn leaky_relu_with_slope_h_is_the_hysteretic_transform() {
         // spec 5: max(h d, d) for h <= 1
         let mut t = crate::autograd::Tape::new();

@@ -183,6 +183,20 @@ mod tests {
     }
 
     #[test]
+    fn matmul_nt_and_add_bias_fan_out_match_finite_differences() {
+        // x x^T uses x as both factors; the bias row is added to itself through a second path.
+        grad_check(|t, v| t.matmul_nt(v[0], v[0]), &[(3, 4)], Inputs::Any);
+        grad_check(
+            |t, v| {
+                let y = t.add_bias(v[0], v[1]);
+                t.add_bias(y, v[1])
+            },
+            &[(3, 2), (1, 2)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
     fn add_bias_matches_finite_differences() {
         grad_check(
             |t, v| t.add_bias(v[0], v[1]),

@@ -181,6 +181,23 @@ mod tests {
     }
 
     #[test]
+    fn masked_mean_and_mse_fan_out_match_finite_differences() {
+        let mask = Array2::from_shape_fn((3, 2), |(i, _)| (i != 1) as u8 as f32);
+        let target = Array2::from_elem((3, 2), 0.5f32);
+        grad_check(
+            move |t, v| {
+                let a = t.masked_mean(v[0], mask.view());
+                let b = t.mse(v[0], target.view());
+                let s = t.sum(v[0]);
+                let ab = t.mul(a, b);
+                t.mul(ab, s)
+            },
+            &[(3, 2)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
     fn mse_of_known_values() {
         let mut t = crate::autograd::Tape::new();
         let x = t.param(ndarray::arr2(&[[1.0f32, 3.0]]).view());

@@ -243,6 +243,27 @@ mod tests {
     }
 
     #[test]
+    fn gathers_fan_out_matches_finite_differences() {
+        grad_check(
+            |t, v| {
+                let q = t.gather_cols(v[0], &[1, 1, 0]);
+                let r = t.slice_cols(v[0], 0, 1);
+                t.mul(q, r)
+            },
+            &[(3, 2)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let g = t.gather_rows(v[0], &[1, 0]);
+                t.add(g, v[0])
+            },
+            &[(2, 3)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
     fn gather_rows_with_repeats_matches_finite_differences() {
         grad_check(
             |t, v| t.gather_rows(v[0], &[2, 0, 2]),
