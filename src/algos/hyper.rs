@@ -90,81 +90,60 @@ pub fn paper_defaults(env: EnvName, grid_dim: usize, method: Method) -> RunConfi
     } else {
         (1.0, 1.0)
     };
-    let cen_explore = matches!(method, Method::Our1 | Method::Our1R);
-    let eval_num_epi = if dec_hysteretic { 20 } else { 1 };
+    // 10x10: horizon 100, windows of 15; 30x30: horizon 200, windows of 45 (spec 10.1, 10.2).
+    let big = grid_dim >= 30;
+    let trace_len = if big { 45 } else { 15 };
+    let box_pushing = RunConfig {
+        env_name: EnvName::BoxPushing,
+        grid_dim,
+        env_terminate_step: if big { 200 } else { 100 },
+        tb_m_noisy: 0.0,
+        total_epi: 15000,
+        replay_buffer_size: 80000,
+        sample_epi: false,
+        dynamic_h: true,
+        init_h,
+        end_h,
+        h_stable_at: 6000,
+        eps_l_d: true,
+        eps_l_d_steps: 6000,
+        eps_end: 0.1,
+        h_explore: false,
+        cen_explore: matches!(method, Method::Our1 | Method::Our1R),
+        l_rate: 0.001,
+        discount: 0.98,
+        start_train: 2,
+        train_freq: trace_len,
+        target_update_freq: 5000,
+        trace_len,
+        sub_trace_len: 1,
+        batch_size: 128,
+        dec_mlp_layer_size: 32,
+        dec_rnn_h_size: 32,
+        cen_mlp_layer_size: 32,
+        cen_rnn_h_size: 64,
+        eval_freq: 10,
+        eval_num_epi: if dec_hysteretic { 20 } else { 1 },
+        checkpoint_freq: 500,
+        early_return_skips_all: true,
+    };
     match env {
-        EnvName::BoxPushing => {
-            // 10x10: horizon 100, windows of 15; 30x30: horizon 200, windows of 45 (spec 10.2).
-            let big = grid_dim >= 30;
-            let trace_len = if big { 45 } else { 15 };
-            RunConfig {
-                env_name: env,
-                grid_dim,
-                env_terminate_step: if big { 200 } else { 100 },
-                tb_m_noisy: 0.0,
-                total_epi: 15000,
-                replay_buffer_size: 80000,
-                sample_epi: false,
-                dynamic_h: true,
-                init_h,
-                end_h,
-                h_stable_at: 6000,
-                eps_l_d: true,
-                eps_l_d_steps: 6000,
-                eps_end: 0.1,
-                h_explore: false,
-                cen_explore,
-                l_rate: 0.001,
-                discount: 0.98,
-                start_train: 2,
-                train_freq: trace_len,
-                target_update_freq: 5000,
-                trace_len,
-                sub_trace_len: 1,
-                batch_size: 128,
-                dec_mlp_layer_size: 32,
-                dec_rnn_h_size: 32,
-                cen_mlp_layer_size: 32,
-                cen_rnn_h_size: 64,
-                eval_freq: 10,
-                eval_num_epi,
-                checkpoint_freq: 500,
-                early_return_skips_all: true,
-            }
-        }
+        EnvName::BoxPushing => box_pushing,
+        // Figure 5's commands differ from Box Pushing's only in these keys (spec 10.3).
         EnvName::Warehouse => RunConfig {
-            env_name: env,
-            grid_dim,
+            env_name: EnvName::Warehouse,
             env_terminate_step: 150,
-            tb_m_noisy: 0.0,
             total_epi: 40000,
             replay_buffer_size: 1000,
             sample_epi: true,
-            dynamic_h: true,
-            init_h,
-            end_h,
-            h_stable_at: 6000,
-            eps_l_d: true,
-            eps_l_d_steps: 6000,
-            eps_end: 0.1,
             h_explore: true,
-            cen_explore,
             l_rate: 0.0006,
             discount: 1.0,
-            start_train: 2,
             train_freq: 30,
-            target_update_freq: 5000,
             trace_len: 10,
-            sub_trace_len: 1,
             batch_size: 16,
-            dec_mlp_layer_size: 32,
             dec_rnn_h_size: 64,
-            cen_mlp_layer_size: 32,
-            cen_rnn_h_size: 64,
-            eval_freq: 10,
-            eval_num_epi,
-            checkpoint_freq: 500,
-            early_return_skips_all: true,
+            ..box_pushing
         },
     }
 }
