@@ -117,24 +117,14 @@ enum BenchTarget {
 
 #[derive(clap::Args)]
 struct TrainArgs {
-    /// Experiment TOML (see experiments/); without it, a short built-in Box Pushing 10x10 run.
-    #[arg(long)]
-    config: Option<PathBuf>,
-    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
-    #[arg(long, value_delimiter = ',')]
-    methods: Option<Vec<String>>,
-    /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
-    #[arg(long)]
-    seeds: Option<String>,
+    #[command(flatten)]
+    select: Selection,
     /// Runs in parallel (default: the number of cores).
     #[arg(long)]
     jobs: Option<usize>,
     /// Results root: runs go to <out>/<experiment>/<method>/seed-<k>/.
     #[arg(long, default_value = "results")]
     out: PathBuf,
-    /// Override a config key, e.g. total_epi=300 or dec-hddrqn.init_h=0.3 (repeatable).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
     /// Recompute runs that already finished (their directories are replaced).
     #[arg(long)]
     force: bool,
@@ -155,18 +145,40 @@ struct TrainArgs {
 /// Which runs of an experiment, as `train` and `slurm` both select them.
 #[derive(clap::Args)]
 struct Selection {
-    /// Experiment TOML (see experiments/).
+    /// Experiment TOML (see experiments/); without it, a short built-in Box Pushing 10x10 run.
     #[arg(long)]
-    config: PathBuf,
+    config: Option<PathBuf>,
     /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
     #[arg(long, value_delimiter = ',')]
     methods: Option<Vec<String>>,
     /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
     #[arg(long)]
     seeds: Option<String>,
-    /// Override a config key, e.g. total_epi=300 (repeatable).
+    /// Override a config key, e.g. total_epi=300 or dec-hddrqn.init_h=0.3 (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
+}
+
+impl Selection {
+    /// The experiment with the command line's methods, seeds and `--set` applied.
+    fn load(&self) -> Result<Experiment> {
+        let o = overrides(
+            self.methods.clone(),
+            self.seeds.as_deref(),
+            self.set.clone(),
+        )?;
+        Ok(match &self.config {
+            Some(path) => {
+                Experiment::load(path, &o).with_context(|| format!("loading {}", path.display()))?
+            }
+            None => Experiment::parse(
+                DEFAULT_EXPERIMENT,
+                Path::new("<built-in default>"),
+                "quickstart_bp10",
+                &o,
+            )?,
+        })
+    }
 }
 
 #[derive(clap::Args)]
@@ -286,17 +298,7 @@ fn main() -> Result<()> {
 }
 
 fn train(args: TrainArgs) -> Result<()> {
-    let overrides = overrides(args.methods, args.seeds.as_deref(), args.set)?;
-    let experiment = match &args.config {
-        Some(path) => Experiment::load(path, &overrides)
-            .with_context(|| format!("loading {}", path.display()))?,
-        None => Experiment::parse(
-            DEFAULT_EXPERIMENT,
-            Path::new("<built-in default>"),
-            "quickstart_bp10",
-            &overrides,
-        )?,
-    };
+    let experiment = args.select.load()?;
     let mut runs = experiment.runs()?;
     if let Some(i) = args.run_index {
         if i >= runs.len() {
@@ -399,16 +401,18 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     for item in &sel.set {
         train_args.extend(["--set".to_string(), shell_quote(item)]);
     }
-    let o = overrides(sel.methods, sel.seeds.as_deref(), sel.set)?;
-    let experiment = Experiment::load(&sel.config, &o)
-        .with_context(|| format!("loading {}", sel.config.display()))?;
+    let config = sel
+        .config
+        .as_deref()
+        .context("slurm needs --config FILE (the experiment the array tasks train)")?;
+    let experiment = sel.load()?;
     let labels: Vec<String> = experiment
         .runs()?
         .iter()
         .map(|r| format!("{}/seed-{}", r.curve_name(), r.seed))
         .collect();
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let config = absolute(&sel.config);
+    let config = absolute(config);
     let out = absolute(&args.out);
     let binary = std::env::current_exe().context("locating the macdec binary")?;
     let script = job_script(
