@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod config;
 pub mod metrics;
+pub mod provenance;
 pub mod report;
 pub mod rollout;
 pub mod runner;

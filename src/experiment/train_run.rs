@@ -12,6 +12,7 @@ use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
 use crate::experiment::atomic::write_atomic;
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics::{self, METRICS_FILE};
+use crate::experiment::provenance::Provenance;
 use crate::experiment::runner::{Progress, FINISHED_MARKER};
 use crate::experiment::seeds::{stream, Role};
 use serde::{Deserialize, Serialize};
@@ -31,6 +32,21 @@ pub struct RunManifest {
     pub variant: String,
     pub seed: u64,
     pub config: RunConfig,
+    /// The build and machine that started the run (absent in runs from before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+}
+
+impl RunManifest {
+    /// Whether two manifests describe the same run (provenance aside: a run may resume on
+    /// another build or machine).
+    pub fn same_run(&self, other: &RunManifest) -> bool {
+        self.experiment == other.experiment
+            && self.method == other.method
+            && self.variant == other.variant
+            && self.seed == other.seed
+            && self.config == other.config
+    }
 }
 
 /// Why a run could not proceed.
@@ -104,12 +120,13 @@ pub fn train_run(
         variant: spec.variant.clone(),
         seed: spec.seed,
         config: spec.config.clone(),
+        provenance: Some(Provenance::current()),
     };
     let config_path = dir.join(CONFIG);
     if config_path.exists() {
         let text = std::fs::read_to_string(&config_path).map_err(|e| io(&config_path, e))?;
         let existing: Result<RunManifest, _> = toml::from_str(&text);
-        if existing.ok().as_ref() != Some(&manifest) {
+        if !existing.is_ok_and(|m| m.same_run(&manifest)) {
             return Err(RunError::ConfigMismatch {
                 dir: dir.to_path_buf(),
             });

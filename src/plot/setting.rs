@@ -104,6 +104,7 @@ mod tests {
             variant: String::new(),
             seed: 3,
             config: paper_defaults(EnvName::BoxPushing, 30, Method::Our1),
+            provenance: None,
         };
         let s = EnvSetting::from_config_toml(&toml::to_string(&manifest).unwrap()).unwrap();
         assert_eq!((s.grid_dim, s.horizon), (30, 200));

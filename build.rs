@@ -1,0 +1,48 @@
+//! Records the git commit the binary is built from, so every run can say what trained it.
+//!
+//! `MACDEC_GIT_COMMIT` is the commit hash, with `-dirty` when tracked code (src/, Cargo.*,
+//! build.rs) differs from it, or `unknown` outside a git checkout.
+
+use std::process::Command;
+
+fn git(args: &[&str]) -> Option<String> {
+    let out = Command::new("git").args(args).output().ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+fn main() {
+    for path in [
+        ".git/HEAD",
+        ".git/index",
+        "src",
+        "Cargo.toml",
+        "Cargo.lock",
+        "build.rs",
+    ] {
+        println!("cargo:rerun-if-changed={path}");
+    }
+    let commit = match git(&["rev-parse", "HEAD"]) {
+        Some(hash) if !hash.is_empty() => {
+            let dirty = git(&[
+                "status",
+                "--porcelain",
+                "--untracked-files=no",
+                "--",
+                "src",
+                "Cargo.toml",
+                "Cargo.lock",
+                "build.rs",
+            ])
+            .is_none_or(|s| !s.is_empty());
+            if dirty {
+                format!("{hash}-dirty")
+            } else {
+                hash
+            }
+        }
+        _ => "unknown".to_string(),
+    };
+    println!("cargo:rustc-env=MACDEC_GIT_COMMIT={commit}");
+}

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The reproduction campaign (issue 15): every curve of the paper's four figures, 40 seeds, full
+# length, into reproduction/. Resumable: finished runs are skipped and unfinished ones resume from
+# their checkpoints, so run it again at the start of every session.
+#
+#   scripts/campaign.sh run       # train, in the order Fig 4a; Fig 5/6 seeds 0..10; Fig 4b; WTD 10..40
+#   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it for a commit
+#   scripts/campaign.sh status    # finished seeds per curve
+#
+# MACDEC names the binary (default target/release/macdec; copy it elsewhere before a long run so
+# rebuilding the tree does not touch the running binary). JOBS defaults to 2.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+MACDEC=${MACDEC:-target/release/macdec}
+JOBS=${JOBS:-2}
+OUT=reproduction
+
+train() {
+    "$MACDEC" train --config "experiments/$1.toml" --out "$OUT" --jobs "$JOBS" --quiet --no-plot "${@:2}"
+}
+
+case "${1:-}" in
+run)
+    train fig4a_bp10
+    train fig5_wtd --seeds 0..10
+    train fig6_wtd_ablation --seeds 0..10
+    train fig4b_bp30
+    train fig5_wtd
+    train fig6_wtd_ablation
+    ;;
+collect)
+    find "$OUT" -name finished -type f | sort | while read -r marker; do
+        dir=$(dirname "$marker")
+        if [[ -f "$dir/metrics.csv" ]]; then
+            gzip -9 -n -c "$dir/metrics.csv" >"$dir/.metrics.csv.gz.tmp"
+            mv "$dir/.metrics.csv.gz.tmp" "$dir/metrics.csv.gz"
+        fi
+        git add -f "$dir/config.toml" "$dir/metrics.csv.gz" "$dir/finished"
+    done
+    ;;
+status)
+    for curve in "$OUT"/*/*/; do
+        [[ -d $curve ]] || continue
+        n=$(find "$curve" -maxdepth 2 -name finished | wc -l)
+        echo "$(basename "$(dirname "$curve")")/$(basename "$curve"): $n finished"
+    done
+    ;;
+*)
+    echo "usage: $0 run|collect|status" >&2
+    exit 2
+    ;;
+esac
