@@ -88,6 +88,9 @@ enum Command {
     /// Run the policy's domain here and one `macdec robot` process per agent over loopback TCP,
     /// each robot seeing only its own observations; print one JSON line per episode.
     Deploy(DeployArgs),
+    /// Retrain committed runs from their recorded config and check their metrics are identical
+    /// (wall-clock column aside). Exits non-zero if any differs or cannot be retrained.
+    Audit(AuditArgs),
     /// Measure speed.
     Bench {
         /// What to measure.
@@ -113,6 +116,25 @@ enum BenchTarget {
     /// Whole training (first --episodes episodes) of every method on BP 10x10 and WTD, 1 thread;
     /// then two BP Our-1 runs at once on two threads against one alone.
     Train,
+}
+
+#[derive(clap::Args)]
+struct AuditArgs {
+    /// Results root holding finished runs: <results>/<experiment>/<curve>/seed-<k>/.
+    #[arg(long, default_value = "reproduction")]
+    results: PathBuf,
+    /// How many finished runs to retrain, chosen at random (ignored with --run).
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Retrain exactly these run directories instead (repeatable).
+    #[arg(long)]
+    run: Vec<PathBuf>,
+    /// Seed of the random choice (default: from the clock; printed so a choice can be repeated).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Runs retrained in parallel (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
 }
 
 #[derive(clap::Args)]
@@ -259,6 +281,7 @@ fn main() -> Result<()> {
         Command::Robot(args) => robot(args),
         Command::Deploy(args) => deploy(args),
         Command::Slurm(args) => slurm(args),
+        Command::Audit(args) => audit(args),
         Command::Render {
             run,
             episodes,
@@ -429,6 +452,62 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         },
     );
     print!("{script}");
+    Ok(())
+}
+
+fn audit(args: AuditArgs) -> Result<()> {
+    use macdec::experiment::audit::{audit_all, choose, finished_runs, AuditOutcome};
+    use macdec::experiment::provenance::Provenance;
+    let dirs = if args.run.is_empty() {
+        let all = finished_runs(&args.results)?;
+        if all.is_empty() {
+            bail!("{}: no finished runs to audit", args.results.display());
+        }
+        if args.runs == 0 {
+            bail!("--runs must be at least 1");
+        }
+        let seed = args.seed.unwrap_or_else(|| {
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs())
+        });
+        let chosen = choose(&all, args.runs, seed);
+        eprintln!(
+            "auditing {} of {} finished run(s) under {} (choice seed {seed})",
+            chosen.len(),
+            all.len(),
+            args.results.display()
+        );
+        chosen
+    } else {
+        args.run.clone()
+    };
+    let here = Provenance::current();
+    let jobs = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let results = audit_all(&dirs, jobs, |r| match r {
+        Ok(a) => {
+            println!("{}", a.line());
+            if let Some(p) = &a.provenance {
+                if p.kernel_path != here.kernel_path {
+                    println!(
+                        "  note: trained on the {} kernel path, retrained on {}: rounding may differ",
+                        p.kernel_path, here.kernel_path
+                    );
+                }
+            }
+        }
+        Err((dir, e)) => println!("{}: CANNOT AUDIT: {e}", dir.display()),
+    });
+    let bad = results
+        .iter()
+        .filter(|r| !matches!(r, Ok(a) if matches!(a.outcome, AuditOutcome::Identical { .. })))
+        .count();
+    if bad > 0 {
+        bail!("{bad} of {} audited run(s) not identical", results.len());
+    }
+    println!("all {} audited run(s) identical", results.len());
     Ok(())
 }
 

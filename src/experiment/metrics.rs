@@ -11,6 +11,17 @@ use std::path::Path;
 
 /// The file name of a run's learning curve.
 pub const METRICS_FILE: &str = "metrics.csv";
+/// The same curve gzip-compressed, as committed results store it (`scripts/campaign.sh collect`).
+pub const METRICS_FILE_GZ: &str = "metrics.csv.gz";
+
+/// The metrics file of the run in `dir`: `metrics.csv` (what a run writes as it goes) if present,
+/// else the committed `metrics.csv.gz`; `None` when neither exists.
+pub fn locate(dir: &Path) -> Option<std::path::PathBuf> {
+    [METRICS_FILE, METRICS_FILE_GZ]
+        .iter()
+        .map(|name| dir.join(name))
+        .find(|p| p.is_file())
+}
 
 /// One evaluation point of a run: the trainer's own record, written as one CSV row.
 pub use crate::algos::trainer::EvalPoint as MetricsRow;
@@ -56,11 +67,26 @@ pub fn write(path: &Path, rows: &[MetricsRow]) -> Result<(), MetricsError> {
         .map_err(|source| MetricsError::Io { path: p(), source })
 }
 
-/// Read a curve written by [`write`].
+/// The bytes of a metrics file as CSV text, decompressing a `.gz` file.
+pub fn read_text(path: &Path) -> Result<Vec<u8>, MetricsError> {
+    let p = || path.display().to_string();
+    let io = |source| MetricsError::Io { path: p(), source };
+    let bytes = std::fs::read(path).map_err(io)?;
+    if path.extension().is_some_and(|e| e == "gz") {
+        let mut text = Vec::new();
+        std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&bytes[..]), &mut text)
+            .map_err(io)?;
+        Ok(text)
+    } else {
+        Ok(bytes)
+    }
+}
+
+/// Read a curve written by [`write`] (or its gzip-compressed copy).
 pub fn read(path: &Path) -> Result<Vec<MetricsRow>, MetricsError> {
     let p = || path.display().to_string();
-    let mut r =
-        csv::Reader::from_path(path).map_err(|source| MetricsError::Csv { path: p(), source })?;
+    let text = read_text(path)?;
+    let mut r = csv::Reader::from_reader(&text[..]);
     r.deserialize()
         .collect::<Result<_, _>>()
         .map_err(|source| MetricsError::Csv { path: p(), source })
@@ -102,5 +128,17 @@ mod tests {
         assert!(text.starts_with(
             "episode,env_steps,updates,eval_return,epsilon,hysteresis,loss,wall_seconds\n"
         ));
+        assert_eq!(locate(dir.path()), Some(p.clone()));
+
+        // The committed form: gzip only, read back to the same rows.
+        let gz = dir.path().join(METRICS_FILE_GZ);
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        std::io::Write::write_all(&mut enc, text.as_bytes()).unwrap();
+        std::fs::write(&gz, enc.finish().unwrap()).unwrap();
+        std::fs::remove_file(&p).unwrap();
+        assert_eq!(locate(dir.path()), Some(gz.clone()));
+        assert_eq!(read(&gz).unwrap(), rows);
+        std::fs::write(&gz, b"not gzip").unwrap();
+        assert!(matches!(read(&gz), Err(MetricsError::Io { .. })));
     }
 }

@@ -1,6 +1,7 @@
 //! Experiments: configs, seeds, the parallel runner, metrics and checkpoints.
 
 pub mod atomic;
+pub mod audit;
 pub mod config;
 pub mod metrics;
 pub mod provenance;

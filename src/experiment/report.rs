@@ -2,7 +2,7 @@
 //! evenly spaced evaluation points, with a bar per point.
 
 use crate::experiment::config::RunSpec;
-use crate::experiment::metrics::{self, METRICS_FILE};
+use crate::experiment::metrics;
 use crate::plot::stats::aggregate;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -14,10 +14,9 @@ const POINTS: usize = 12;
 pub fn print_curves(results: &Path, runs: &[RunSpec]) -> Result<(), metrics::MetricsError> {
     let mut by_curve: BTreeMap<String, Vec<Vec<(u64, f64)>>> = BTreeMap::new();
     for run in runs {
-        let path = run.dir(results).join(METRICS_FILE);
-        if !path.exists() {
+        let Some(path) = metrics::locate(&run.dir(results)) else {
             continue;
-        }
+        };
         let rows = metrics::read(&path)?;
         by_curve
             .entry(format!("{}/{}", run.experiment, run.curve_name()))

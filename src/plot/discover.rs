@@ -13,8 +13,7 @@ use crate::experiment::metrics::{self, MetricsError};
 use crate::experiment::runner::FINISHED_MARKER;
 use std::path::{Path, PathBuf};
 
-/// The file each run writes its learning curve to.
-pub const METRICS_FILE: &str = "metrics.csv";
+pub use crate::experiment::metrics::METRICS_FILE;
 /// The file each run writes its resolved config to.
 pub const CONFIG_FILE: &str = "config.toml";
 
@@ -162,10 +161,9 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
         .strip_prefix("seed-")
         .and_then(|s| s.parse::<u64>().ok())
         .ok_or_else(|| RunProblem::Skip("not a seed-<k> directory".into()))?;
-    let metrics_path = dir.join(METRICS_FILE);
-    if !metrics_path.is_file() {
+    let Some(metrics_path) = metrics::locate(dir) else {
         return Err(RunProblem::Skip(format!("no {METRICS_FILE}")));
-    }
+    };
     let bad = |why: String| RunProblem::Malformed(metrics_path.clone(), why);
     let rows = metrics::read(&metrics_path).map_err(|e| {
         bad(match e {
@@ -175,7 +173,8 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
     })?;
     if rows.is_empty() {
         // A header alone is a run before its first evaluation, unless it is not our header.
-        let header = std::fs::read_to_string(&metrics_path).unwrap_or_default();
+        let header = metrics::read_text(&metrics_path).unwrap_or_default();
+        let header = String::from_utf8_lossy(&header);
         let columns: Vec<&str> = header.lines().next().unwrap_or("").split(',').collect();
         if !["episode", "eval_return"]
             .iter()

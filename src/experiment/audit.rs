@@ -1,0 +1,286 @@
+//! Checking committed results by recomputing them: `macdec audit`.
+//!
+//! A committed run directory holds `config.toml` (the run's identity, resolved config and
+//! provenance), its metrics (`metrics.csv` or `metrics.csv.gz`) and `finished`. Auditing a run
+//! retrains it from that config alone in a scratch directory and compares the metrics row by row,
+//! byte for byte, with the `wall_seconds` column (the only one that depends on the machine's
+//! speed) left out. Every committed run must pass at HEAD; a change that alters numerics must
+//! recompute the results it affects.
+
+use crate::experiment::config::RunSpec;
+use crate::experiment::metrics::{self, MetricsError};
+use crate::experiment::provenance::Provenance;
+use crate::experiment::runner::{Progress, FINISHED_MARKER};
+use crate::experiment::train_run::{train_run, RunError, RunManifest, CONFIG};
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use std::path::{Path, PathBuf};
+
+/// The column a retrained run may differ in.
+const WALL_COLUMN: &str = "wall_seconds";
+
+/// Why a run could not be audited (as opposed to being audited and found different).
+#[derive(Debug, thiserror::Error)]
+pub enum AuditError {
+    #[error("{path}: cannot read the results tree: {source}")]
+    ReadTree {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{dir}: not a finished run (needs {CONFIG}, metrics.csv[.gz] and `finished`)")]
+    NotARun { dir: PathBuf },
+    #[error("{path}: not a run config: {message}")]
+    BadConfig { path: PathBuf, message: String },
+    #[error(transparent)]
+    Metrics(#[from] MetricsError),
+    #[error("{path}: the header's last column is not `{WALL_COLUMN}`")]
+    BadHeader { path: PathBuf },
+    #[error("retraining failed: {0}")]
+    Retrain(#[from] RunError),
+    #[error("{path}: cannot make a scratch directory: {source}")]
+    Scratch {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// What retraining a run showed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AuditOutcome {
+    /// Every row equal (wall-clock aside).
+    Identical { rows: usize },
+    /// The first data row (1-based) whose text differs; a missing row is shown as `<none>`.
+    Differs {
+        row: usize,
+        committed: String,
+        retrained: String,
+    },
+}
+
+/// The audit of one run: where it is, how it was made, what retraining gave.
+#[derive(Debug, Clone)]
+pub struct RunAudit {
+    pub dir: PathBuf,
+    /// The build that trained the committed run, if it recorded one.
+    pub provenance: Option<Provenance>,
+    pub outcome: AuditOutcome,
+}
+
+impl RunAudit {
+    /// One line for the terminal: the run and `identical`, or where it first differs.
+    pub fn line(&self) -> String {
+        match &self.outcome {
+            AuditOutcome::Identical { rows } => {
+                format!("{}: identical ({rows} rows)", self.dir.display())
+            }
+            AuditOutcome::Differs {
+                row,
+                committed,
+                retrained,
+            } => format!(
+                "{}: DIFFERS at row {row}\n  committed: {committed}\n  retrained: {retrained}",
+                self.dir.display()
+            ),
+        }
+    }
+}
+
+/// Every finished run under `results` (`<experiment>/<curve>/seed-<k>/` with `finished`),
+/// sorted by path. Shared curves reached through another experiment are listed once, where they
+/// live.
+pub fn finished_runs(results: &Path) -> Result<Vec<PathBuf>, AuditError> {
+    let read_err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| AuditError::ReadTree { path, source }
+    };
+    let mut runs = Vec::new();
+    for exp in subdirs(results).map_err(read_err(results))? {
+        for curve in subdirs(&exp).map_err(read_err(&exp))? {
+            for run in subdirs(&curve).map_err(read_err(&curve))? {
+                if run.join(FINISHED_MARKER).is_file() && run.join(CONFIG).is_file() {
+                    runs.push(run);
+                }
+            }
+        }
+    }
+    runs.sort();
+    Ok(runs)
+}
+
+fn subdirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut dirs = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        // Real directories only: a symlinked curve is someone else's run, audited where it lives.
+        if entry.file_type()?.is_dir() {
+            dirs.push(entry.path());
+        }
+    }
+    dirs.sort();
+    Ok(dirs)
+}
+
+/// `k` of `runs` chosen at random with `seed` (all of them when `k` is at least their number),
+/// in path order.
+pub fn choose(runs: &[PathBuf], k: usize, seed: u64) -> Vec<PathBuf> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut chosen: Vec<PathBuf> = runs.choose_multiple(&mut rng, k).cloned().collect();
+    chosen.sort();
+    chosen
+}
+
+/// Read a committed run's manifest.
+pub fn read_manifest(dir: &Path) -> Result<RunManifest, AuditError> {
+    let path = dir.join(CONFIG);
+    let text = std::fs::read_to_string(&path).map_err(|e| AuditError::BadConfig {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    toml::from_str(&text).map_err(|e| AuditError::BadConfig {
+        path,
+        message: e.to_string(),
+    })
+}
+
+/// Retrain the run in `dir` inside `scratch` (which must not hold another run) and compare.
+pub fn audit_run(dir: &Path, scratch: &Path) -> Result<RunAudit, AuditError> {
+    let committed_path = metrics::locate(dir)
+        .filter(|_| dir.join(FINISHED_MARKER).is_file())
+        .ok_or_else(|| AuditError::NotARun {
+            dir: dir.to_path_buf(),
+        })?;
+    let manifest = read_manifest(dir)?;
+    let spec = RunSpec {
+        experiment: manifest.experiment.clone(),
+        method: manifest.method,
+        variant: manifest.variant.clone(),
+        seed: manifest.seed,
+        config: manifest.config.clone(),
+    };
+    let run_dir = scratch.join("run");
+    train_run(&spec, &run_dir, &Progress::hidden(), true)?;
+    let retrained_path = run_dir.join(metrics::METRICS_FILE);
+    let committed = rows_without_wall(&committed_path)?;
+    let retrained = rows_without_wall(&retrained_path)?;
+    Ok(RunAudit {
+        dir: dir.to_path_buf(),
+        provenance: manifest.provenance,
+        outcome: compare(&committed, &retrained),
+    })
+}
+
+/// The lines of a metrics file (header included) with the last column, `wall_seconds`, cut off.
+fn rows_without_wall(path: &Path) -> Result<Vec<String>, AuditError> {
+    let text = metrics::read_text(path)?;
+    let text = String::from_utf8_lossy(&text);
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or("");
+    if header.rsplit(',').next() != Some(WALL_COLUMN) {
+        return Err(AuditError::BadHeader {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(std::iter::once(header)
+        .chain(lines)
+        .map(|l| l.rsplit_once(',').map_or(l, |(rest, _)| rest).to_string())
+        .collect())
+}
+
+/// Compare two metrics files' lines (header first): identical, or the first data row that differs.
+fn compare(committed: &[String], retrained: &[String]) -> AuditOutcome {
+    let none = || "<none>".to_string();
+    for i in 0..committed.len().max(retrained.len()) {
+        let (a, b) = (committed.get(i), retrained.get(i));
+        if a != b {
+            return AuditOutcome::Differs {
+                row: i,
+                committed: a.cloned().unwrap_or_else(none),
+                retrained: b.cloned().unwrap_or_else(none),
+            };
+        }
+    }
+    AuditOutcome::Identical {
+        rows: committed.len().saturating_sub(1),
+    }
+}
+
+/// Audit each of `dirs`, `jobs` at a time, each in its own scratch directory under the system's
+/// temp dir (removed afterwards). `report` is called with each audit as soon as it ends.
+pub fn audit_all(
+    dirs: &[PathBuf],
+    jobs: usize,
+    report: impl Fn(&Result<RunAudit, (PathBuf, AuditError)>) + Sync,
+) -> Vec<Result<RunAudit, (PathBuf, AuditError)>> {
+    use rayon::prelude::*;
+    let one = |dir: &PathBuf| {
+        let scratch = tempfile::Builder::new()
+            .prefix("macdec-audit-")
+            .tempdir()
+            .map_err(|source| AuditError::Scratch {
+                path: std::env::temp_dir(),
+                source,
+            });
+        let result = scratch
+            .and_then(|s| audit_run(dir, s.path()))
+            .map_err(|e| (dir.clone(), e));
+        report(&result);
+        result
+    };
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.clamp(1, dirs.len().max(1)))
+        .build()
+    {
+        Ok(pool) => pool.install(|| dirs.par_iter().map(one).collect()),
+        Err(_) => dirs.iter().map(one).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lines(xs: &[&str]) -> Vec<String> {
+        xs.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn wall_seconds_is_cut_and_the_first_differing_row_is_named() {
+        let t = tempfile::tempdir().unwrap();
+        let p = t.path().join("metrics.csv");
+        std::fs::write(
+            &p,
+            "episode,eval_return,wall_seconds\n0,1.5,0.1\n10,2.5,0.2\n",
+        )
+        .unwrap();
+        let a = rows_without_wall(&p).unwrap();
+        assert_eq!(a, lines(&["episode,eval_return", "0,1.5", "10,2.5"]));
+        assert_eq!(compare(&a, &a), AuditOutcome::Identical { rows: 2 });
+        let b = lines(&["episode,eval_return", "0,1.5", "10,2.6"]);
+        assert_eq!(
+            compare(&a, &b),
+            AuditOutcome::Differs {
+                row: 2,
+                committed: "10,2.5".into(),
+                retrained: "10,2.6".into()
+            }
+        );
+        let short = lines(&["episode,eval_return", "0,1.5"]);
+        assert!(matches!(
+            compare(&a, &short),
+            AuditOutcome::Differs { row: 2, ref retrained, .. } if retrained == "<none>"
+        ));
+        std::fs::write(&p, "episode,eval_return\n0,1.5\n").unwrap();
+        assert!(matches!(
+            rows_without_wall(&p),
+            Err(AuditError::BadHeader { .. })
+        ));
+    }
+
+    #[test]
+    fn choosing_is_reproducible_and_bounded() {
+        let runs: Vec<PathBuf> = (0..10).map(|i| PathBuf::from(format!("r{i}"))).collect();
+        assert_eq!(choose(&runs, 3, 7), choose(&runs, 3, 7));
+        assert_eq!(choose(&runs, 3, 7).len(), 3);
+        assert_eq!(choose(&runs, 30, 7), runs);
+    }
+}
