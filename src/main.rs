@@ -351,6 +351,15 @@ fn train(args: TrainArgs) -> Result<()> {
         jobs,
         args.out.join(&experiment.name).display()
     );
+    for (curve, home) in &experiment.shared_curves {
+        eprintln!(
+            "  {curve}: shared with {home}, runs in {}",
+            args.out.join(home).join(curve).display()
+        );
+    }
+    experiment
+        .write_shared_curves(&args.out)
+        .with_context(|| format!("recording the shared curves in {}", args.out.display()))?;
     let force = args.force;
     let statuses = run_all(&runs, &opts, |spec, dir, progress| {
         train_run(spec, dir, progress, force).map_err(|e| e.to_string())
@@ -574,10 +583,11 @@ fn plot(results: &Path, out: &Path) -> Result<()> {
     }
     for p in &report.plots {
         eprintln!(
-            "wrote {}, {}, {}",
+            "wrote {}, {}, {}, {}",
             p.png.display(),
             p.svg.display(),
-            p.summary_csv.display()
+            p.summary_csv.display(),
+            p.tests_csv.display()
         );
     }
     print!("{}", report.markdown());

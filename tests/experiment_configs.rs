@@ -75,3 +75,46 @@ fn sweeps_expand_into_variants() {
     curves.dedup();
     assert_eq!(curves.len(), 18);
 }
+
+#[test]
+fn figure_6_shares_figure_5s_our2_runs_with_identical_configs() {
+    let fig5 = load("fig5_wtd.toml").runs().unwrap();
+    let fig6 = load("fig6_wtd_ablation.toml").runs().unwrap();
+    let our2 = |runs: &[macdec::experiment::config::RunSpec]| -> Vec<_> {
+        runs.iter()
+            .filter(|r| r.method == Method::Our2)
+            .cloned()
+            .collect()
+    };
+    let (a, b) = (our2(&fig5), our2(&fig6));
+    assert_eq!(a.len(), 40);
+    // Same experiment name, seeds, configs and so directories: one set of runs serves both.
+    assert_eq!(a, b);
+    assert!(b.iter().all(|r| r.experiment == "fig5_wtd"));
+    assert_eq!(
+        b[3].dir(Path::new("reproduction")),
+        Path::new("reproduction/fig5_wtd/our2/seed-3")
+    );
+    // Figure 6's own curves stay its own.
+    assert!(fig6
+        .iter()
+        .filter(|r| r.method != Method::Our2)
+        .all(|r| r.experiment == "fig6_wtd_ablation"));
+}
+
+#[test]
+fn a_shared_curve_must_name_a_method_and_a_plain_experiment() {
+    let parse =
+        |text: &str| Experiment::parse(text, Path::new("t.toml"), "t", &Overrides::default());
+    let err = parse("methods = [\"our1\"]\nshared_curves = { our2 = \"fig5_wtd\" }")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("shared_curves.our2") && err.contains("not one of"),
+        "{err}"
+    );
+    let err = parse("methods = [\"our1\"]\nshared_curves = { our1 = \"../x\" }")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("expected an experiment name"), "{err}");
+}

@@ -50,6 +50,8 @@ struct ExperimentFile {
     params: toml::Table,
     #[serde(default)]
     method: BTreeMap<String, toml::Table>,
+    #[serde(default)]
+    shared_curves: BTreeMap<String, String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -95,10 +97,17 @@ pub struct Experiment {
     pub name: String,
     pub methods: Vec<Method>,
     pub seeds: Vec<u64>,
+    /// Curves whose runs belong to another experiment (curve name -> that experiment's name):
+    /// Figure 6's Our-2 is Figure 5's Our-2, trained once and drawn in both.
+    pub shared_curves: BTreeMap<String, String>,
     path: PathBuf,
     params: toml::Table,
     per_method: BTreeMap<Method, toml::Table>,
 }
+
+/// The file in `<results>/<experiment>/` naming the curves that live in another experiment's
+/// directory (`our2 = "fig5_wtd"`), written by `macdec train` and read by `macdec plot`.
+pub const SHARED_CURVES_FILE: &str = "shared_curves.toml";
 
 /// The command-line overrides of `macdec train`.
 #[derive(Debug, Clone, Default)]
@@ -212,10 +221,32 @@ impl Experiment {
                 }
             }
         }
+        for (curve, home) in &file.shared_curves {
+            let bad = |message: String| ConfigError::BadValue {
+                path: p(),
+                key: format!("shared_curves.{curve}"),
+                message,
+            };
+            if !methods.iter().any(|m| m.name() == curve) {
+                return Err(bad(format!(
+                    "`{curve}` is not one of this experiment's methods"
+                )));
+            }
+            let plain = !home.is_empty()
+                && home
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+            if !plain {
+                return Err(bad(format!(
+                    "expected an experiment name (letters, digits, `_`, `-`), got {home:?}"
+                )));
+            }
+        }
         let exp = Experiment {
             name: file.name.unwrap_or_else(|| default_name.to_string()),
             methods,
             seeds,
+            shared_curves: file.shared_curves,
             path: p(),
             params,
             per_method,
@@ -237,9 +268,17 @@ impl Experiment {
             }
             for (variant, point) in expand_grid(&table) {
                 let config = resolve(&self.path, method, &point)?;
+                // A shared curve's runs live (and are identified) under the experiment they
+                // belong to; their resolved config must match that experiment's, or the run
+                // directory refuses them.
+                let experiment = self
+                    .shared_curves
+                    .get(method.name())
+                    .unwrap_or(&self.name)
+                    .clone();
                 for &seed in &self.seeds {
                     runs.push(RunSpec {
-                        experiment: self.name.clone(),
+                        experiment: experiment.clone(),
                         method,
                         variant: variant.clone(),
                         seed,
@@ -249,6 +288,21 @@ impl Experiment {
             }
         }
         Ok(runs)
+    }
+}
+
+impl Experiment {
+    /// Record the experiment's shared curves in `<out>/<name>/shared_curves.toml` so plots find
+    /// them; nothing is written for an experiment without any.
+    pub fn write_shared_curves(&self, out: &Path) -> std::io::Result<()> {
+        if self.shared_curves.is_empty() {
+            return Ok(());
+        }
+        let text = toml::to_string(&self.shared_curves).map_err(std::io::Error::other)?;
+        crate::experiment::atomic::write_atomic(
+            &out.join(&self.name).join(SHARED_CURVES_FILE),
+            text.as_bytes(),
+        )
     }
 }
 

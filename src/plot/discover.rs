@@ -10,9 +10,11 @@ use super::error::PlotError;
 use super::setting::EnvSetting;
 use crate::algos::method::Method;
 use crate::experiment::metrics::{self, MetricsError};
+use crate::experiment::provenance::Provenance;
 use crate::experiment::runner::FINISHED_MARKER;
 use std::path::{Path, PathBuf};
 
+pub use crate::experiment::config::SHARED_CURVES_FILE;
 pub use crate::experiment::metrics::METRICS_FILE;
 /// The file each run writes its resolved config to.
 pub const CONFIG_FILE: &str = "config.toml";
@@ -30,6 +32,8 @@ pub struct RunData {
     pub wall_seconds: f64,
     /// The domain setting from `config.toml`, when it is present and readable.
     pub setting: Option<EnvSetting>,
+    /// The build and machine that trained the run, when its `config.toml` records them.
+    pub provenance: Option<Provenance>,
 }
 
 /// All runs of one curve (a method, or a method at one sweep point), seeds ascending.
@@ -83,7 +87,7 @@ pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
     let mut experiments = Vec::new();
     for exp_dir in exp_dirs {
         let mut curves = Vec::new();
-        for curve_dir in subdirs_or_note(&exp_dir, &mut notes) {
+        for curve_dir in curve_dirs(results, &exp_dir, &mut notes) {
             let name = file_name(&curve_dir);
             let (method_name, variant) = name.split_once('@').unwrap_or((&name, ""));
             let method = method_name.parse::<Method>().ok();
@@ -137,6 +141,60 @@ pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
         ));
     }
     Ok(Discovery { experiments, notes })
+}
+
+/// The curve directories of an experiment: its own, plus those its `shared_curves.toml` names in
+/// another experiment (which replace an own directory of the same name, with a note).
+fn curve_dirs(results: &Path, exp_dir: &Path, notes: &mut Vec<String>) -> Vec<PathBuf> {
+    let mut dirs = subdirs_or_note(exp_dir, notes);
+    let shared_path = exp_dir.join(SHARED_CURVES_FILE);
+    if !shared_path.is_file() {
+        return dirs;
+    }
+    let shared: std::collections::BTreeMap<String, String> =
+        match std::fs::read_to_string(&shared_path)
+            .map_err(|e| e.to_string())
+            .and_then(|t| toml::from_str(&t).map_err(|e| e.to_string()))
+        {
+            Ok(map) => map,
+            Err(e) => {
+                notes.push(format!("warning: ignoring {}: {e}", shared_path.display()));
+                return dirs;
+            }
+        };
+    let plain = |s: &str| {
+        !s.is_empty()
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "_-@=.,".contains(c))
+            && !s.contains("..")
+    };
+    for (curve, home) in shared {
+        if !plain(&curve) || !plain(&home) {
+            notes.push(format!(
+                "warning: {}: `{curve} = {home:?}` is not a curve and experiment name; ignored",
+                shared_path.display()
+            ));
+            continue;
+        }
+        let target = results.join(&home).join(&curve);
+        if !target.is_dir() {
+            notes.push(format!(
+                "{}: shared curve {curve} has no runs yet in {}",
+                exp_dir.display(),
+                target.display()
+            ));
+            continue;
+        }
+        if let Some(i) = dirs.iter().position(|d| file_name(d) == curve) {
+            notes.push(format!(
+                "{}: {curve} is shared with {home}; its own directory is ignored",
+                exp_dir.display()
+            ));
+            dirs.remove(i);
+        }
+        dirs.push(target);
+    }
+    dirs
 }
 
 /// Paper order of methods (`Method::ALL`), then sweep point; unknown names last.
@@ -202,9 +260,14 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
             row.episode, row.eval_return
         )));
     }
-    let setting = std::fs::read_to_string(dir.join(CONFIG_FILE))
-        .ok()
-        .and_then(|text| EnvSetting::from_config_toml(&text).ok());
+    let config_text = std::fs::read_to_string(dir.join(CONFIG_FILE)).ok();
+    let setting = config_text
+        .as_deref()
+        .and_then(|text| EnvSetting::from_config_toml(text).ok());
+    let provenance = config_text.as_deref().and_then(|text| {
+        let mut table: toml::Table = toml::from_str(text).ok()?;
+        table.remove("provenance")?.try_into().ok()
+    });
     Ok(RunData {
         seed,
         dir: dir.to_path_buf(),
@@ -212,6 +275,7 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
         finished: dir.join(FINISHED_MARKER).exists(),
         wall_seconds: rows.last().map_or(0.0, |r| r.wall_seconds),
         setting,
+        provenance,
     })
 }
 
@@ -336,6 +400,38 @@ pub(crate) mod tests {
             "Our-2 @ l_rate=0.001, trace_len=10"
         );
         assert_eq!(c("mine", None, "").legend(), "mine");
+    }
+
+    #[test]
+    fn shared_curves_are_read_from_the_experiment_they_belong_to() {
+        let t = tempfile::tempdir().unwrap();
+        let bp = (EnvName::BoxPushing, 10);
+        write_run(t.path(), "fig5", "our2", 0, &[(0, 1.0)], bp, true);
+        write_run(t.path(), "fig5", "our2", 1, &[(0, 2.0)], bp, true);
+        write_run(t.path(), "fig6", "our1", 0, &[(0, 3.0)], bp, true);
+        // A stale own copy is replaced by the shared one, with a note.
+        write_run(t.path(), "fig6", "our2", 7, &[(0, 9.0)], bp, true);
+        std::fs::write(
+            t.path().join("fig6").join(SHARED_CURVES_FILE),
+            "our2 = \"fig5\"\nour1-r = \"fig5\"\nbad = \"../x\"\n",
+        )
+        .unwrap();
+        let d = discover(t.path()).unwrap();
+        let fig6 = d.experiments.iter().find(|e| e.name == "fig6").unwrap();
+        let names: Vec<&str> = fig6.curves.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["our1", "our2"]);
+        let seeds: Vec<u64> = fig6.curves[1].runs.iter().map(|r| r.seed).collect();
+        assert_eq!(seeds, [0, 1]);
+        let notes = d.notes.join("\n");
+        assert!(notes.contains("our2 is shared with fig5"), "{notes}");
+        assert!(
+            notes.contains("shared curve our1-r has no runs yet"),
+            "{notes}"
+        );
+        assert!(notes.contains("not a curve and experiment name"), "{notes}");
+        // fig5 itself still has its curve.
+        let fig5 = d.experiments.iter().find(|e| e.name == "fig5").unwrap();
+        assert_eq!(fig5.curves[0].runs.len(), 2);
     }
 
     #[test]

@@ -3,7 +3,10 @@
 //! the summary rows. Decides everything about the figure except pixels (`render` draws it).
 
 use super::discover::{CurveData, ExperimentData};
-use super::stats::{aggregate, smooth, CurvePoint, SMOOTH_HALF_WINDOW};
+use super::stats::{
+    aggregate, final_return, first_reaching, mean_and_se, mean_over_training, smooth, CurvePoint,
+    SMOOTH_HALF_WINDOW,
+};
 use super::summary::CurveSummary;
 use crate::algos::method::Method;
 
@@ -69,11 +72,9 @@ pub fn build(exp: &ExperimentData) -> Built {
             _ => PALETTE[i % PALETTE.len()],
         };
         let runs: Vec<&[(u64, f64)]> = curve.runs.iter().map(|r| r.points.as_slice()).collect();
-        let points = smooth(&aggregate(&runs), SMOOTH_HALF_WINDOW);
-        let last = *points
-            .last()
-            .expect("discover keeps only runs with at least one evaluation");
-        summary.push(summarize(curve, &last, optimal));
+        let mean = aggregate(&runs);
+        let points = smooth(&mean, SMOOTH_HALF_WINDOW);
+        summary.push(summarize(curve, &mean, &points, optimal));
         series.push(Series {
             label: label(curve),
             colour,
@@ -92,11 +93,15 @@ pub fn build(exp: &ExperimentData) -> Built {
         Some(s) => format!("{}: {s}", exp.name),
         None => exp.name.clone(),
     };
-    let caption = format!(
+    let mut caption = format!(
         "Mean over seeds of the greedy discounted return; band: standard error (ddof 1); \
          both smoothed by a centred moving average over {} evaluation points.",
         2 * SMOOTH_HALF_WINDOW + 1
     );
+    if let Some(mix) = provenance_mix(exp) {
+        notes.push(format!("{}: {mix}", exp.name));
+        caption.push_str(&format!(" Note: {mix}."));
+    }
     Built {
         figure: Figure {
             title,
@@ -108,6 +113,47 @@ pub fn build(exp: &ExperimentData) -> Built {
         summary,
         notes,
     }
+}
+
+/// "mixes 2 git commits (abc1234 x 3, def5678 x 1)" and the like when the runs of a figure were
+/// trained by different builds or arithmetic paths, which may round differently.
+fn provenance_mix(exp: &ExperimentData) -> Option<String> {
+    use std::collections::BTreeMap;
+    let runs: Vec<_> = exp.curves.iter().flat_map(|c| &c.runs).collect();
+    let mut commits: BTreeMap<String, usize> = BTreeMap::new();
+    let mut paths: BTreeMap<String, usize> = BTreeMap::new();
+    for p in runs.iter().filter_map(|r| r.provenance.as_ref()) {
+        let short: String = p.git_commit.chars().take(12).collect();
+        let short = if p.git_commit.ends_with("-dirty") {
+            format!("{short}-dirty")
+        } else {
+            short
+        };
+        *commits.entry(short).or_default() += 1;
+        *paths.entry(p.kernel_path.clone()).or_default() += 1;
+    }
+    let unknown = runs.iter().filter(|r| r.provenance.is_none()).count();
+    let list = |m: &BTreeMap<String, usize>| {
+        m.iter()
+            .map(|(k, n)| format!("{k} x {n}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut parts = Vec::new();
+    if commits.len() > 1 {
+        parts.push(format!(
+            "mixes {} git commits ({})",
+            commits.len(),
+            list(&commits)
+        ));
+    }
+    if paths.len() > 1 {
+        parts.push(format!("mixes kernel paths ({})", list(&paths)));
+    }
+    if unknown > 0 && !commits.is_empty() {
+        parts.push(format!("{unknown} run(s) record no provenance"));
+    }
+    (!parts.is_empty()).then(|| parts.join("; "))
 }
 
 fn method_rank(m: Method) -> usize {
@@ -129,7 +175,25 @@ fn label(curve: &CurveData) -> String {
     }
 }
 
-fn summarize(curve: &CurveData, last: &CurvePoint, optimal: Option<f64>) -> CurveSummary {
+/// The row of the table: final returns over the runs that reach the last episode, where the
+/// smoothed mean first reaches 95% of the optimum, the mean over training, and run times.
+fn summarize(
+    curve: &CurveData,
+    mean: &[CurvePoint],
+    smoothed: &[CurvePoint],
+    optimal: Option<f64>,
+) -> CurveSummary {
+    let final_episode = mean
+        .last()
+        .expect("discover keeps only runs with at least one evaluation")
+        .episode;
+    let final_returns: Vec<f64> = curve
+        .runs
+        .iter()
+        .filter(|r| r.points.last().is_some_and(|p| p.0 == final_episode))
+        .filter_map(|r| final_return(&r.points))
+        .collect();
+    let (final_mean, final_se) = mean_and_se(&final_returns).unwrap_or((f64::NAN, f64::NAN));
     let finished: Vec<f64> = curve
         .runs
         .iter()
@@ -141,13 +205,16 @@ fn summarize(curve: &CurveData, last: &CurvePoint, optimal: Option<f64>) -> Curv
         legend: curve.legend(),
         seeds: curve.runs.len(),
         finished: finished.len(),
-        final_episode: last.episode,
-        final_mean: last.mean,
-        final_se: last.se,
-        final_n: last.n,
+        final_episode,
+        final_mean,
+        final_se,
+        final_n: final_returns.len(),
+        reach95_episode: optimal.and_then(|o| first_reaching(smoothed, 0.95 * o)),
+        mean_over_training: mean_over_training(mean).unwrap_or(f64::NAN),
         optimal,
         run_minutes: (!finished.is_empty())
             .then(|| finished.iter().sum::<f64>() / finished.len() as f64 / 60.0),
+        final_returns,
     }
 }
 
@@ -219,13 +286,52 @@ mod tests {
             (s.seeds, s.finished, s.final_episode, s.final_n),
             (2, 1, 40, 1)
         );
-        // Raw means 0, 1, 2, 3, 4 (both runs agree where they overlap); smoothing over the whole
-        // (short) series gives 2 at every point.
-        assert!((s.final_mean - 2.0).abs() < 1e-12);
-        // SE is 0 everywhere (identical runs, then one run).
+        // Returns 0, 1, 2, 3, 4: the final return is the mean of the last ceil(10% of 5) = 1
+        // evaluation of the one run reaching episode 40; one run, so no spread.
+        assert!((s.final_mean - 4.0).abs() < 1e-12);
         assert_eq!(s.final_se, 0.0);
+        // Never within 95% of 80.71; average height of the mean curve 0..4 is 2.
+        assert_eq!(s.reach95_episode, None);
+        assert!((s.mean_over_training - 2.0).abs() < 1e-12);
         // wall_seconds = episode * 0.5 = 20 s for the finished run.
         assert!((s.run_minutes.unwrap() - 20.0 / 60.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn figures_say_when_they_mix_commits_or_kernel_paths() {
+        let t = tempfile::tempdir().unwrap();
+        let stamp = |dir: &std::path::Path, commit: &str, kernel: &str| {
+            let path = dir.join("config.toml");
+            let mut text = std::fs::read_to_string(&path).unwrap();
+            text.push_str(&format!(
+                "\n[provenance]\nmacdec_version = \"0.1.0\"\ngit_commit = \"{commit}\"\n\
+                 kernel_path = \"{kernel}\"\ncpu_model = \"test\"\n"
+            ));
+            std::fs::write(path, text).unwrap();
+        };
+        let a = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        let b = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], BP10, true);
+        stamp(&a, &"a".repeat(40), "avx512");
+        stamp(&b, &"a".repeat(40), "avx512");
+        let built = build(&discover(t.path()).unwrap().experiments[0]);
+        assert!(built.notes.is_empty(), "{:?}", built.notes);
+        assert!(!built.figure.caption.contains("Note:"));
+
+        let b = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], BP10, true);
+        stamp(&b, &"b".repeat(40), "avx2");
+        write_run(t.path(), "e", "our2", 0, &[(0, 1.0)], BP10, true);
+        let built = build(&discover(t.path()).unwrap().experiments[0]);
+        let note = built.notes.join("\n");
+        assert!(
+            note.contains("mixes 2 git commits (aaaaaaaaaaaa x 1, bbbbbbbbbbbb x 1)"),
+            "{note}"
+        );
+        assert!(
+            note.contains("mixes kernel paths (avx2 x 1, avx512 x 1)"),
+            "{note}"
+        );
+        assert!(note.contains("1 run(s) record no provenance"), "{note}");
+        assert!(built.figure.caption.contains("Note: mixes 2 git commits"));
     }
 
     #[test]

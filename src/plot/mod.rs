@@ -12,11 +12,12 @@ pub mod render;
 pub mod setting;
 pub mod stats;
 pub mod summary;
+pub mod welch;
 
 pub use error::PlotError;
 
 use std::path::{Path, PathBuf};
-use summary::CurveSummary;
+use summary::{CurveSummary, PairTest};
 
 /// The files written for one experiment and its summary.
 #[derive(Debug, Clone)]
@@ -28,6 +29,9 @@ pub struct ExperimentPlot {
     pub svg: PathBuf,
     pub summary_csv: PathBuf,
     pub summary: Vec<CurveSummary>,
+    /// `<experiment>_welch.csv`: one-sided Welch tests between every two curves.
+    pub tests_csv: PathBuf,
+    pub tests: Vec<PairTest>,
 }
 
 /// What [`plot_results`] did, and what it skipped (`notes`, for the user to read).
@@ -42,7 +46,7 @@ impl PlotReport {
     pub fn markdown(&self) -> String {
         self.plots
             .iter()
-            .map(|p| summary::markdown_table(&p.title, &p.summary))
+            .map(|p| summary::markdown_table(&p.title, &p.summary, &p.tests))
             .collect::<Vec<_>>()
             .join("\n")
     }
@@ -74,6 +78,9 @@ pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError>
             }
         })?;
         summary::write_csv(&summary_csv, &built.summary)?;
+        let tests = summary::pairwise_tests(&built.summary);
+        let tests_csv = out.join(format!("{}_welch.csv", exp.name));
+        summary::write_csv(&tests_csv, &tests)?;
         plots.push(ExperimentPlot {
             experiment: exp.name.clone(),
             title: built.figure.title.clone(),
@@ -81,6 +88,8 @@ pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError>
             svg,
             summary_csv,
             summary: built.summary,
+            tests_csv,
+            tests,
         });
     }
     Ok(PlotReport { plots, notes })

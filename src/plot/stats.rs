@@ -89,9 +89,75 @@ pub fn smooth(points: &[CurvePoint], half_window: usize) -> Vec<CurvePoint> {
         .collect()
 }
 
+/// Fraction of a run's last evaluations averaged into its final return.
+pub const FINAL_FRACTION: f64 = 0.1;
+
+/// A run's final return: the mean of its last 10% of evaluations (at least one), which is what
+/// the tables and tests compare (one late evaluation is too noisy on its own).
+pub fn final_return(points: &[(u64, f64)]) -> Option<f64> {
+    if points.is_empty() {
+        return None;
+    }
+    let k = ((points.len() as f64 * FINAL_FRACTION).ceil() as usize).clamp(1, points.len());
+    let tail = &points[points.len() - k..];
+    Some(tail.iter().map(|p| p.1).sum::<f64>() / k as f64)
+}
+
+/// The first episode at which a (smoothed) curve's mean reaches `threshold`, if it ever does.
+pub fn first_reaching(points: &[CurvePoint], threshold: f64) -> Option<u64> {
+    points
+        .iter()
+        .find(|p| p.mean >= threshold)
+        .map(|p| p.episode)
+}
+
+/// The area under a mean curve divided by its episode span (trapezoids): the curve's average
+/// height over training, so curves of one length compare directly. A single point is its value.
+pub fn mean_over_training(points: &[CurvePoint]) -> Option<f64> {
+    let (first, last) = (points.first()?, points.last()?);
+    let span = (last.episode - first.episode) as f64;
+    if span == 0.0 {
+        return Some(first.mean);
+    }
+    let area: f64 = points
+        .windows(2)
+        .map(|w| (w[1].episode - w[0].episode) as f64 * (w[0].mean + w[1].mean) / 2.0)
+        .sum();
+    Some(area / span)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn pt(episode: u64, mean: f64) -> CurvePoint {
+        CurvePoint {
+            episode,
+            mean,
+            se: 0.0,
+            n: 1,
+        }
+    }
+
+    #[test]
+    fn final_return_averages_the_last_tenth_of_evaluations() {
+        // 25 points: ceil(2.5) = 3 last points, values 22, 23, 24.
+        let pts: Vec<(u64, f64)> = (0..25).map(|i| (i * 10, i as f64)).collect();
+        assert_eq!(final_return(&pts), Some(23.0));
+        assert_eq!(final_return(&pts[..1]), Some(0.0));
+        assert_eq!(final_return(&[]), None);
+    }
+
+    #[test]
+    fn reaching_and_area_follow_the_curve() {
+        let c = [pt(0, 0.0), pt(10, 50.0), pt(30, 100.0)];
+        assert_eq!(first_reaching(&c, 50.0), Some(10));
+        assert_eq!(first_reaching(&c, 100.5), None);
+        // Trapezoids: 10 * 25 + 20 * 75 = 1750 over 30 episodes.
+        assert!(close(mean_over_training(&c).unwrap(), 1750.0 / 30.0));
+        assert_eq!(mean_over_training(&c[..1]), Some(0.0));
+        assert_eq!(mean_over_training(&[]), None);
+    }
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-12

@@ -3,6 +3,7 @@
 //! printed as a Markdown table for the README.
 
 use super::error::PlotError;
+use super::welch::welch_greater;
 use serde::Serialize;
 use std::path::Path;
 
@@ -19,20 +20,62 @@ pub struct CurveSummary {
     pub finished: usize,
     /// The last evaluation episode of the curve (over all runs).
     pub final_episode: u64,
-    /// The smoothed mean at the last evaluation point (spec 7.2 smoothing, truncated window).
+    /// Mean over the `final_n` runs of their final returns (the mean of a run's last 10% of
+    /// evaluations, [`crate::plot::stats::final_return`]).
     pub final_mean: f64,
-    /// The smoothed standard error at the last evaluation point.
+    /// Standard error (ddof 1) of that mean; 0 for one run.
     pub final_se: f64,
-    /// Runs that reach the last evaluation point (less than `seeds` when some are unfinished).
+    /// Runs that reach the last evaluation episode, over which the final return is taken
+    /// (less than `seeds` when some are unfinished).
     pub final_n: usize,
+    /// The first episode at which the smoothed mean curve reaches 95% of the optimal return
+    /// (empty if it never does or the optimum is unknown).
+    pub reach95_episode: Option<u64>,
+    /// Area under the (unsmoothed) mean curve over its episode span: its average height.
+    pub mean_over_training: f64,
     /// The optimal return drawn as the reference line, if known.
     pub optimal: Option<f64>,
     /// Mean wall-clock minutes of the finished runs (None when none finished).
     pub run_minutes: Option<f64>,
+    /// The `final_n` runs' final returns, for the tests between curves.
+    #[serde(skip)]
+    pub final_returns: Vec<f64>,
 }
 
-/// Write the summary rows as CSV to `path` (atomically).
-pub fn write_csv(path: &Path, rows: &[CurveSummary]) -> Result<(), PlotError> {
+/// One-sided Welch t-test between two curves' final returns: H1 is "A above B".
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairTest {
+    pub curve_a: String,
+    pub curve_b: String,
+    pub t: f64,
+    pub df: f64,
+    pub p_a_greater: f64,
+}
+
+/// Every ordered pair of curves that can be tested (two or more final returns each).
+pub fn pairwise_tests(rows: &[CurveSummary]) -> Vec<PairTest> {
+    let mut tests = Vec::new();
+    for a in rows {
+        for b in rows {
+            if a.curve == b.curve {
+                continue;
+            }
+            if let Some(w) = welch_greater(&a.final_returns, &b.final_returns) {
+                tests.push(PairTest {
+                    curve_a: a.curve.clone(),
+                    curve_b: b.curve.clone(),
+                    t: w.t,
+                    df: w.df,
+                    p_a_greater: w.p_greater,
+                });
+            }
+        }
+    }
+    tests
+}
+
+/// Write rows of any serializable kind as CSV to `path` (atomically), header first.
+pub fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<(), PlotError> {
     let write_err = |source| PlotError::Write {
         path: path.to_path_buf(),
         source,
@@ -48,26 +91,64 @@ pub fn write_csv(path: &Path, rows: &[CurveSummary]) -> Result<(), PlotError> {
     crate::experiment::atomic::write_atomic(path, &bytes).map_err(write_err)
 }
 
-/// A Markdown table of one experiment's curves, headed by its title:
-/// final return as mean ± SE beside the optimal return.
-pub fn markdown_table(title: &str, rows: &[CurveSummary]) -> String {
+/// A Markdown table of one experiment's curves, headed by its title, then the matrix of
+/// one-sided Welch p-values between them.
+pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) -> String {
     let mut s = format!(
-        "### {title}\n\n| method | seeds (finished) | final episode | final return (mean ± SE) | optimal | minutes per run |\n|---|---|---|---|---|---|\n"
+        "### {title}\n\n| method | seeds (finished) | final episode | final return (mean ± SE) | 95% of optimal first at | mean over training | optimal | minutes per run |\n|---|---|---|---|---|---|---|---|\n"
     );
     for r in rows {
         let optimal = r.optimal.map_or("n/a".into(), format_return);
         let minutes = r.run_minutes.map_or("n/a".into(), |m| format!("{m:.1}"));
         let at = if r.final_n < r.seeds {
-            format!(" (n = {} at the end)", r.final_n)
+            format!(" (n = {})", r.final_n)
         } else {
             String::new()
         };
+        let reach = match (r.optimal, r.reach95_episode) {
+            (None, _) => "n/a".to_string(),
+            (Some(_), None) => "never".to_string(),
+            (Some(_), Some(e)) => e.to_string(),
+        };
         s.push_str(&format!(
-            "| {} | {} ({}) | {} | {:.2} ± {:.2}{at} | {optimal} | {minutes} |\n",
-            r.legend, r.seeds, r.finished, r.final_episode, r.final_mean, r.final_se
+            "| {} | {} ({}) | {} | {:.2} ± {:.2}{at} | {reach} | {:.2} | {optimal} | {minutes} |\n",
+            r.legend,
+            r.seeds,
+            r.finished,
+            r.final_episode,
+            r.final_mean,
+            r.final_se,
+            r.mean_over_training
         ));
     }
+    if !tests.is_empty() {
+        s.push_str("\nOne-sided Welch t-tests on final returns: p-value of \"row above column\".\n\n| p(row > column) |");
+        for r in rows {
+            s.push_str(&format!(" {} |", r.legend));
+        }
+        s.push_str(&format!("\n|---|{}\n", "---|".repeat(rows.len())));
+        for a in rows {
+            s.push_str(&format!("| {} |", a.legend));
+            for b in rows {
+                let cell = tests
+                    .iter()
+                    .find(|t| t.curve_a == a.curve && t.curve_b == b.curve)
+                    .map_or("-".to_string(), |t| format_p(t.p_a_greater));
+                s.push_str(&format!(" {cell} |"));
+            }
+            s.push('\n');
+        }
+    }
     s
+}
+
+/// A p-value for display: three significant digits, tiny ones in scientific notation.
+pub fn format_p(p: f64) -> String {
+    if p < 1e-3 {
+        format!("{p:.1e}")
+    } else {
+        format!("{p:.3}")
+    }
 }
 
 /// A return for display: whole numbers without decimals (262), others with two (80.71).
@@ -83,46 +164,66 @@ pub fn format_return(v: f64) -> String {
 mod tests {
     use super::*;
 
-    fn row() -> CurveSummary {
+    fn row(curve: &str, legend: &str, finals: &[f64]) -> CurveSummary {
+        let (mean, se) = crate::plot::stats::mean_and_se(finals).unwrap();
         CurveSummary {
-            curve: "our1".into(),
-            legend: "Our-1".into(),
+            curve: curve.into(),
+            legend: legend.into(),
             seeds: 3,
             finished: 2,
             final_episode: 1500,
-            final_mean: 78.456,
-            final_se: 1.234,
-            final_n: 2,
+            final_mean: mean,
+            final_se: se,
+            final_n: finals.len(),
+            reach95_episode: Some(420),
+            mean_over_training: 55.5,
             optimal: Some(80.71093744250365),
             run_minutes: Some(12.34),
+            final_returns: finals.to_vec(),
         }
     }
 
     #[test]
-    fn markdown_row_shows_mean_se_optimal_and_partial_counts() {
-        let md = markdown_table("fig4a", &[row()]);
+    fn markdown_shows_final_return_reach_area_and_p_values() {
+        let rows = [
+            row("our1", "Our-1", &[80.0, 79.0]),
+            row("dec-hddrqn", "Dec-HDDRQN", &[10.0, 30.0]),
+        ];
+        let tests = pairwise_tests(&rows);
+        assert_eq!(tests.len(), 2);
+        let md = markdown_table("fig4a", &rows, &tests);
         assert!(md.starts_with("### fig4a\n"));
         assert!(
             md.contains(
-                "| Our-1 | 3 (2) | 1500 | 78.46 ± 1.23 (n = 2 at the end) | 80.71 | 12.3 |"
+                "| Our-1 | 3 (2) | 1500 | 79.50 ± 0.50 (n = 2) | 420 | 55.50 | 80.71 | 12.3 |"
             ),
             "{md}"
         );
+        let our1_row = md.lines().find(|l| l.starts_with("| Our-1 | - |")).unwrap();
+        let p: f64 = our1_row.split('|').nth(3).unwrap().trim().parse().unwrap();
+        assert!(p > 0.0 && p < 0.1, "{md}");
+        let dec_row = md
+            .lines()
+            .find(|l| l.starts_with("| Dec-HDDRQN |") && l.ends_with("- |"))
+            .unwrap();
+        let q: f64 = dec_row.split('|').nth(2).unwrap().trim().parse().unwrap();
+        assert!((p + q - 1.0).abs() < 2e-3, "{md}");
     }
 
     #[test]
     fn csv_has_a_header_and_empty_fields_for_unknowns() {
         let t = tempfile::tempdir().unwrap();
         let p = t.path().join("s.csv");
-        let mut r = row();
+        let mut r = row("our1", "Our-1", &[1.0]);
         r.optimal = None;
         r.run_minutes = None;
+        r.reach95_episode = None;
         write_csv(&p, &[r]).unwrap();
         let text = std::fs::read_to_string(&p).unwrap();
         assert_eq!(
             text,
-            "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,optimal,run_minutes\n\
-             our1,Our-1,3,2,1500,78.456,1.234,2,,\n"
+            "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,reach95_episode,mean_over_training,optimal,run_minutes\n\
+             our1,Our-1,3,2,1500,1.0,0.0,1,,55.5,,\n"
         );
     }
 
@@ -130,5 +231,7 @@ mod tests {
     fn whole_returns_print_without_decimals() {
         assert_eq!(format_return(262.0), "262");
         assert_eq!(format_return(41.75397237445474), "41.75");
+        assert_eq!(format_p(0.01234), "0.012");
+        assert_eq!(format_p(2.5e-7), "2.5e-7");
     }
 }
