@@ -5,7 +5,7 @@
 
 use crate::deploy::line_reader::{LineEvent, LineReader};
 use crate::deploy::manifest::Manifest;
-use crate::deploy::protocol::{Ack, Reply, Request};
+use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpStream};
@@ -218,6 +218,13 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
             return Ok(None);
         }
         self.policy.q_values(obs, &mut self.q);
+        // Refused exactly as a robot refuses it (`robot::Session`), so in-process and deployed
+        // runs of a broken policy fail alike.
+        if let Some((action, &value)) = self.q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(LinkError::Refused(
+                ProtocolError::NonFiniteQ { action, value }.to_string(),
+            ));
+        }
         Ok(Some(greedy_action(&self.q)))
     }
 }
