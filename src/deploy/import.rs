@@ -50,11 +50,12 @@ pub enum ImportError {
         lstm: String,
         rnn: String,
     },
-    #[error("{path}: tensor `{name}` is missing (expected shape {expected:?})")]
+    #[error("{path}: tensor `{name}` is missing (expected shape {expected})")]
     Missing {
         path: PathBuf,
         name: String,
-        expected: Vec<usize>,
+        /// The shape, e.g. `[32, 5]`, or `[M, 5]` while M is not known yet.
+        expected: String,
     },
     #[error("{path}: unexpected tensor `{name}`; a DDRQN state_dict has exactly {expected}")]
     Unexpected {
@@ -68,12 +69,13 @@ pub enum ImportError {
         name: String,
         found: String,
     },
-    #[error("{path}: tensor `{name}` has shape {found:?}, expected {expected:?}{hint}")]
+    #[error("{path}: tensor `{name}` has shape {found:?}, expected {expected}{hint}")]
     Shape {
         path: PathBuf,
         name: String,
         found: Vec<usize>,
-        expected: Vec<usize>,
+        /// As in [`ImportError::Missing`].
+        expected: String,
         hint: String,
     },
     #[error("{path}: tensor `{name}` holds {value} at element {index}; weights must be finite")]
@@ -227,11 +229,11 @@ pub fn check_state_dict(
         Naming::Lstm => canonical.to_string(),
     };
     // M and H from the first two layers; their full shapes are checked with the rest below.
-    let width = |name: &str| -> Result<usize, ImportError> {
+    let width = |name: &str, expected: String| -> Result<usize, ImportError> {
         let view = file.tensor(name).map_err(|_| ImportError::Missing {
             path: p(),
             name: name.to_string(),
-            expected: vec![],
+            expected: expected.clone(),
         })?;
         match view.shape() {
             [rows, _] if *rows > 0 => Ok(*rows),
@@ -239,12 +241,13 @@ pub fn check_state_dict(
                 path: p(),
                 name: name.to_string(),
                 found: got.to_vec(),
-                expected: vec![],
-                hint: " (a non-empty [out, in] matrix)".into(),
+                expected,
+                hint: " (M and H are read from the rows of fc1.weight and fc2.weight)".into(),
             }),
         }
     };
-    let (m, h) = (width("fc1.weight")?, width("fc2.weight")?);
+    let m = width("fc1.weight", format!("[M, {obs_len}]"))?;
+    let h = width("fc2.weight", format!("[H, {m}]"))?;
     let arch = Architecture::ddrqn(m, h);
     let expected = arch.tensors(obs_len, n_actions);
     if let Some(extra) = names
@@ -264,7 +267,7 @@ pub fn check_state_dict(
         let view = file.tensor(&name).map_err(|_| ImportError::Missing {
             path: p(),
             name: name.clone(),
-            expected: shape.clone(),
+            expected: format!("{shape:?}"),
         })?;
         if view.dtype() != Dtype::F32 {
             return Err(ImportError::Dtype {
@@ -285,7 +288,7 @@ pub fn check_state_dict(
                 },
                 name,
                 found: view.shape().to_vec(),
-                expected: shape.clone(),
+                expected: format!("{shape:?}"),
             });
         }
         let bad = view
@@ -522,7 +525,19 @@ mod tests {
                 Naming::Rnn,
                 "fc4.bias",
                 None,
-                "tensor `fc4.bias` is missing",
+                "tensor `fc4.bias` is missing (expected shape [8])",
+            ),
+            (
+                Naming::Lstm,
+                "fc1.weight",
+                None,
+                "tensor `fc1.weight` is missing (expected shape [M, 5])",
+            ),
+            (
+                Naming::Lstm,
+                "fc2.weight",
+                Some(("fc2.weight", Dtype::F32, vec![32])),
+                "`fc2.weight` has shape [32], expected [H, 8] (M and H are read",
             ),
             (
                 Naming::Rnn,
