@@ -91,6 +91,13 @@ enum Command {
     /// Retrain committed runs from their recorded config and check their metrics are identical
     /// (wall-clock column aside). Exits non-zero if any differs or cannot be retrained.
     Audit(AuditArgs),
+    /// Build a policy directory (as `export` writes) from PyTorch state_dicts of the reference
+    /// code's DDRQN, one safetensors file per agent (scripts/torch_to_safetensors.py converts
+    /// torch.save'd modules). See README "Bringing policies trained with the reference code".
+    Import(ImportArgs),
+    /// Greedy evaluation of a policy directory in this process (no robot processes): the same
+    /// JSON line per episode as `deploy`, printed as each episode ends.
+    Eval(EvalArgs),
     /// Measure speed.
     Bench {
         /// What to measure.
@@ -273,6 +280,57 @@ struct DeployArgs {
     mock: bool,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum ImportEnv {
+    /// Box Pushing (--grid N, --horizon).
+    BoxPushing,
+    /// Warehouse Tool Delivery (--horizon, --tb-m-noisy).
+    Warehouse,
+}
+
+#[derive(clap::Args)]
+struct ImportArgs {
+    /// The domain the policy was trained on.
+    #[arg(long)]
+    env: ImportEnv,
+    /// Box Pushing grid size N (N x N); the paper uses 10 and 30.
+    #[arg(long)]
+    grid: Option<usize>,
+    /// Episode length in primitive steps (paper: Box Pushing 100 on 10x10, 200 on 30x30;
+    /// Warehouse 150).
+    #[arg(long)]
+    horizon: usize,
+    /// Warehouse: std of the Turtlebots' movement noise (paper 0).
+    #[arg(long, default_value_t = 0.0)]
+    tb_m_noisy: f64,
+    /// Comma-separated state_dict safetensors files, one per agent, in agent order.
+    #[arg(long, value_delimiter = ',', required = true)]
+    agents: Vec<PathBuf>,
+    /// Discount per primitive step of the reported return (default: the paper's, Box Pushing
+    /// 0.98, Warehouse 1.0).
+    #[arg(long)]
+    discount: Option<f64>,
+    /// The policy directory to write.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct EvalArgs {
+    /// Policy directory (from `export` or `import`).
+    #[arg(long)]
+    policy: PathBuf,
+    /// Episodes to run.
+    #[arg(long, default_value_t = 1)]
+    episodes: usize,
+    /// Seed of the environment's random stream (default: the run's seed), as for `deploy`.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Include every step (executed macro-actions, reward, finished flags) in the output.
+    #[arg(long)]
+    trajectories: bool,
+}
+
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Train(args) => train(args),
@@ -280,6 +338,8 @@ fn main() -> Result<()> {
         Command::Export { run, out } => export(&run, &out),
         Command::Robot(args) => robot(args),
         Command::Deploy(args) => deploy(args),
+        Command::Import(args) => import(args),
+        Command::Eval(args) => eval(args),
         Command::Slurm(args) => slurm(args),
         Command::Audit(args) => audit(args),
         Command::Render {
@@ -742,6 +802,69 @@ fn deploy(args: DeployArgs) -> Result<()> {
         traces.len(),
         manifest.env.name(),
         manifest.agents.len()
+    );
+    Ok(())
+}
+
+fn import(args: ImportArgs) -> Result<()> {
+    use macdec::deploy::import::{import_policy, paper_discount, ImportRequest};
+    use macdec::envs::EnvSpec;
+    let env = match (args.env, args.grid) {
+        (ImportEnv::BoxPushing, Some(grid)) => EnvSpec::BoxPushing {
+            grid,
+            horizon: args.horizon,
+        },
+        (ImportEnv::BoxPushing, None) => bail!("--env box-pushing needs --grid N"),
+        (ImportEnv::Warehouse, None) => EnvSpec::Warehouse {
+            horizon: args.horizon,
+            tb_m_noisy: args.tb_m_noisy,
+        },
+        (ImportEnv::Warehouse, Some(_)) => bail!("--grid is for box-pushing; warehouse has none"),
+    };
+    let request = ImportRequest {
+        env,
+        discount: args.discount.unwrap_or_else(|| paper_discount(&env)),
+        agents: args.agents,
+    };
+    let manifest = import_policy(&request, &args.out)
+        .with_context(|| format!("importing into {}", args.out.display()))?;
+    eprintln!(
+        "imported {} agent(s) of {} (DDRQN M = {}, H = {}, discount {}) to {}",
+        manifest.agents.len(),
+        manifest.env.name(),
+        manifest.architecture.mlp_layer_size,
+        manifest.architecture.rnn_h_size,
+        manifest.discount,
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn eval(args: EvalArgs) -> Result<()> {
+    use macdec::deploy::{driver::DeployError, local_eval::eval_policy, manifest::load_all};
+    use macdec::experiment::seeds::{stream, Role};
+    let (manifest, verified) = load_all(&args.policy)
+        .with_context(|| format!("loading policy {}", args.policy.display()))?;
+    let seed = args.seed.unwrap_or(manifest.run.seed);
+    let mut rng = stream(seed, Role::EvalEnv);
+    let mut out = std::io::stdout().lock();
+    let (mut n, mut sum, mut sum_undiscounted) = (0usize, 0.0, 0.0);
+    eval_policy(&manifest, &verified, args.episodes, &mut rng, |trace| {
+        writeln!(out, "{}", trace.json_line(args.trajectories))
+            .and_then(|()| out.flush())
+            .map_err(|e| DeployError::Policy(format!("writing to stdout: {e}")))?;
+        n += 1;
+        sum += trace.discounted_return;
+        sum_undiscounted += trace.undiscounted_return;
+        Ok(())
+    })
+    .with_context(|| format!("evaluating {}", args.policy.display()))?;
+    let count = n.max(1) as f64;
+    eprintln!(
+        "{n} episode(s) of {} in-process, seed {seed}: mean discounted return {:.4}, mean undiscounted {:.4}",
+        manifest.env.name(),
+        sum / count,
+        sum_undiscounted / count
     );
     Ok(())
 }

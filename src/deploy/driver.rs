@@ -124,9 +124,45 @@ pub fn run_episodes<E: MacroEnv + ?Sized, L: RobotLink>(
     episodes: usize,
     rng: &mut EnvRng,
 ) -> Result<Vec<EpisodeTrace>, DeployError> {
-    (0..episodes)
-        .map(|k| run_episode(env, robots, discount, rng, k))
-        .collect()
+    let mut traces = Vec::with_capacity(episodes);
+    run_episodes_with(env, robots, discount, episodes, rng, |trace| {
+        traces.push(trace);
+        Ok(())
+    })?;
+    Ok(traces)
+}
+
+/// [`run_episodes`], handing each episode to `on_episode` as soon as it ends (so a caller can
+/// print it at once) instead of collecting them. An error from `on_episode` stops the run.
+pub fn run_episodes_with<E: MacroEnv + ?Sized, L: RobotLink>(
+    env: &mut E,
+    robots: &mut [L],
+    discount: f64,
+    episodes: usize,
+    rng: &mut EnvRng,
+    mut on_episode: impl FnMut(EpisodeTrace) -> Result<(), DeployError>,
+) -> Result<(), DeployError> {
+    for k in 0..episodes {
+        on_episode(run_episode(env, robots, discount, rng, k)?)?;
+    }
+    Ok(())
+}
+
+impl EpisodeTrace {
+    /// The episode's JSON line as `macdec deploy` and `macdec eval` print it (no newline):
+    /// `{"episode":..,"return":..,"undiscounted_return":..,"steps":..}`, plus `"trajectory"`
+    /// when `with_trajectory`.
+    pub fn json_line(&self, with_trajectory: bool) -> String {
+        let line = if with_trajectory || self.trajectory.is_empty() {
+            serde_json::to_string(self)
+        } else {
+            serde_json::to_string(&EpisodeTrace {
+                trajectory: Vec::new(),
+                ..self.clone()
+            })
+        };
+        line.expect("serializing plain numbers and vectors to a string cannot fail")
+    }
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 
 use crate::deploy::line_reader::{LineEvent, LineReader};
 use crate::deploy::manifest::Manifest;
-use crate::deploy::protocol::{Ack, Reply, Request};
+use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpStream};
@@ -218,6 +218,54 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
             return Ok(None);
         }
         self.policy.q_values(obs, &mut self.q);
+        // Refused exactly as a robot refuses it (`robot::Session`), so in-process and deployed
+        // runs of a broken policy fail alike.
+        if let Some((action, &value)) = self.q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(LinkError::Refused(
+                ProtocolError::NonFiniteQ { action, value }.to_string(),
+            ));
+        }
         Ok(Some(greedy_action(&self.q)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Q = [0, value] whatever the observation.
+    struct Fixed(f32);
+
+    impl AgentPolicy for Fixed {
+        fn obs_len(&self) -> usize {
+            1
+        }
+        fn n_actions(&self) -> usize {
+            2
+        }
+        fn reset(&mut self) {}
+        fn q_values(&mut self, _obs: &[f32], q: &mut [f32]) {
+            q.copy_from_slice(&[0.0, self.0]);
+        }
+    }
+
+    #[test]
+    fn local_link_refuses_non_finite_q_as_a_robot_does() {
+        assert_eq!(
+            LocalLink::new(Fixed(1.0)).observe(&[0.0], true),
+            Ok(Some(1))
+        );
+        let err = LocalLink::new(Fixed(f32::NAN))
+            .observe(&[0.0], true)
+            .unwrap_err();
+        let robot = ProtocolError::NonFiniteQ {
+            action: 1,
+            value: f32::NAN,
+        };
+        assert_eq!(err, LinkError::Refused(robot.to_string()));
+        assert_eq!(
+            LocalLink::new(Fixed(f32::NAN)).observe(&[0.0], false),
+            Ok(None)
+        );
     }
 }

@@ -6,13 +6,17 @@
 //!
 //! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
 //! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
-//! CLI's hidden `--mock` flag). Only [`export`] reads a run's checkpoint.
+//! CLI's hidden `--mock` flag). Only [`export`] reads a run's checkpoint; [`import`] builds the
+//! same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
+//! any policy directory's greedy episodes in-process, exactly as deployment does.
 
 pub mod architecture;
 pub mod driver;
 pub mod export;
+pub mod import;
 pub mod line_reader;
 pub mod link;
+pub mod local_eval;
 pub mod manifest;
 pub mod mock;
 pub mod processes;
@@ -21,7 +25,7 @@ pub mod qnet_policy;
 pub mod robot;
 pub mod server;
 
-pub use driver::{run_episode, run_episodes, EpisodeTrace, StepRecord};
+pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};
 pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
 pub use manifest::{Manifest, ManifestError, VerifiedAgent};
 pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};

@@ -1,0 +1,286 @@
+//! `macdec import` and `macdec eval` as processes (issue 12): state_dicts written here with the
+//! reference's names (both schemes, no torch needed) import into a policy directory that `eval`
+//! runs exactly as `deploy` does on robot processes; bad files are refused with the file and
+//! tensor named, and nothing is written.
+
+use macdec::deploy::architecture::Architecture;
+use macdec::deploy::import::{reference_state_dict, Naming};
+use macdec::deploy::manifest::{load_all, MANIFEST_FILE};
+use macdec::deploy::EpisodeTrace;
+use macdec::envs::{EnvSpec, MacroEnv};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+
+/// Large pseudo-random weights (agent-specific), so greedy actions change along an episode.
+fn weight(agent: usize) -> impl Fn(&str, usize) -> f32 {
+    move |name, k| {
+        let mut h = (k as u64) ^ ((name.len() as u64) << 32) ^ ((agent as u64) << 48);
+        for _ in 0..2 {
+            h = (h ^ (h >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+        ((h >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 3.0
+    }
+}
+
+/// One reference-named state_dict per agent of `env` in `dir`, agent i named as `namings[i]`.
+fn write_agents(dir: &Path, env: EnvSpec, arch: &Architecture, namings: &[Naming]) -> Vec<PathBuf> {
+    let built = env.build().unwrap();
+    (0..built.n_agents())
+        .map(|i| {
+            let bytes = reference_state_dict(
+                arch,
+                built.obs_sizes()[i],
+                built.n_actions()[i],
+                namings[i % namings.len()],
+                weight(i),
+            );
+            let path = dir.join(format!("a{i}.safetensors"));
+            std::fs::write(&path, bytes).unwrap();
+            path
+        })
+        .collect()
+}
+
+fn agents_arg(paths: &[PathBuf]) -> String {
+    paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().unwrap()
+}
+
+fn stdout_lines(out: &Output) -> Vec<String> {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout.clone())
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn imported_policies_evaluate_exactly_as_deployed_on_robot_processes() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(EnvSpec, Vec<&str>, Vec<Naming>); 2] = [
+        (
+            EnvSpec::BoxPushing {
+                grid: 10,
+                horizon: 100,
+            },
+            vec!["--env", "box-pushing", "--grid", "10", "--horizon", "100"],
+            vec![Naming::Rnn, Naming::Lstm],
+        ),
+        (
+            EnvSpec::Warehouse {
+                horizon: 150,
+                tb_m_noisy: 0.3,
+            },
+            vec![
+                "--env",
+                "warehouse",
+                "--horizon",
+                "150",
+                "--tb-m-noisy",
+                "0.3",
+            ],
+            vec![Naming::Lstm],
+        ),
+    ];
+    for (k, (env, env_args, namings)) in cases.into_iter().enumerate() {
+        let sub = dir.path().join(format!("case-{k}"));
+        std::fs::create_dir(&sub).unwrap();
+        let arch = Architecture::ddrqn(16, 8);
+        let agents = write_agents(&sub, env, &arch, &namings);
+        let policy = sub.join("policy");
+        let agents_list = agents_arg(&agents);
+        let mut args = vec!["import"];
+        args.extend(&env_args);
+        args.extend(["--agents", &agents_list, "--out", policy.to_str().unwrap()]);
+        let out = run(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (manifest, _) = load_all(&policy).unwrap();
+        assert_eq!(manifest.env, env);
+        assert_eq!(manifest.architecture, arch);
+        assert_eq!(manifest.run.method, "imported");
+        assert_eq!(
+            manifest.run.config["files"][0]["file"],
+            agents[0].display().to_string()
+        );
+
+        let p = policy.to_str().unwrap();
+        let common = [
+            "--policy",
+            p,
+            "--episodes",
+            "3",
+            "--seed",
+            "5",
+            "--trajectories",
+        ];
+        let eval = stdout_lines(&run(&[&["eval"][..], &common].concat()));
+        let deploy = stdout_lines(&run(&[&["deploy"][..], &common].concat()));
+        assert_eq!(eval.len(), 3);
+        assert_eq!(eval, deploy, "eval and deploy differ on {}", env.name());
+
+        let traces: Vec<EpisodeTrace> = eval
+            .iter()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        let mut actions: Vec<Vec<usize>> = traces[0]
+            .trajectory
+            .iter()
+            .map(|s| s.executed.clone())
+            .collect();
+        actions.sort();
+        actions.dedup();
+        assert!(actions.len() > 1, "{actions:?}");
+
+        // Without --trajectories: the same lines less the steps; another seed, other episodes
+        // when the domain is noisy.
+        let short = stdout_lines(&run(&[
+            "eval",
+            "--policy",
+            p,
+            "--episodes",
+            "3",
+            "--seed",
+            "5",
+        ]));
+        for (line, trace) in short.iter().zip(&traces) {
+            assert_eq!(*line, trace.json_line(false));
+            assert!(!line.contains("trajectory"), "{line}");
+        }
+        if let EnvSpec::Warehouse { .. } = env {
+            let other = stdout_lines(&run(&[
+                "eval",
+                "--policy",
+                p,
+                "--episodes",
+                "1",
+                "--seed",
+                "6",
+                "--trajectories",
+            ]));
+            assert_ne!(other[0], eval[0]);
+        }
+    }
+}
+
+#[test]
+fn the_same_weights_under_either_naming_import_to_identical_policies() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = EnvSpec::BoxPushing {
+        grid: 10,
+        horizon: 100,
+    };
+    let arch = Architecture::ddrqn(8, 4);
+    let mut weights = Vec::new();
+    for naming in [Naming::Lstm, Naming::Rnn] {
+        let sub = dir.path().join(format!("{naming:?}"));
+        std::fs::create_dir(&sub).unwrap();
+        let agents = write_agents(&sub, env, &arch, &[naming]);
+        let out = sub.join("policy");
+        let status = run(&[
+            "import",
+            "--env",
+            "box-pushing",
+            "--grid",
+            "10",
+            "--horizon",
+            "100",
+            "--agents",
+            &agents_arg(&agents),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(status.status.success());
+        weights.push(std::fs::read(out.join("agent-1.safetensors")).unwrap());
+    }
+    assert_eq!(weights[0], weights[1]);
+}
+
+#[test]
+fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = EnvSpec::BoxPushing {
+        grid: 10,
+        horizon: 100,
+    };
+    let arch = Architecture::ddrqn(8, 4);
+    let agents = write_agents(dir.path(), env, &arch, &[Naming::Rnn]);
+    // Agent 1's file written for the wrong observation size.
+    let wrong = dir.path().join("wrong.safetensors");
+    std::fs::write(
+        &wrong,
+        reference_state_dict(&arch, 6, 8, Naming::Rnn, weight(1)),
+    )
+    .unwrap();
+    let out = dir.path().join("policy");
+    let o = out.to_str().unwrap();
+    let bp = [
+        "import",
+        "--env",
+        "box-pushing",
+        "--grid",
+        "10",
+        "--horizon",
+        "100",
+    ];
+    let a0 = agents[0].display().to_string();
+    let cases: Vec<(Vec<String>, String)> = vec![
+        (
+            vec![format!("{a0},{}", wrong.display())],
+            format!(
+                "{}: tensor `fc1.weight` has shape [8, 6], expected [8, 5]",
+                wrong.display()
+            ),
+        ),
+        (vec![a0.clone()], "2 agents, 1 state_dict".into()),
+        (
+            vec![format!("{a0},{}", dir.path().display())],
+            "not a regular file".into(),
+        ),
+        (
+            vec![format!("{a0},{}", dir.path().join("none").display())],
+            "none".into(),
+        ),
+    ];
+    for (agents, needle) in cases {
+        let mut args: Vec<&str> = bp.to_vec();
+        args.extend(["--agents", &agents[0], "--out", o]);
+        let res = run(&args);
+        let err = String::from_utf8_lossy(&res.stderr);
+        assert!(!res.status.success());
+        assert!(err.contains(&needle), "expected `{needle}` in: {err}");
+        assert!(!out.join(MANIFEST_FILE).exists());
+    }
+    let res = run(&[
+        "import",
+        "--env",
+        "box-pushing",
+        "--horizon",
+        "100",
+        "--agents",
+        &a0,
+        "--out",
+        o,
+    ]);
+    assert!(String::from_utf8_lossy(&res.stderr).contains("needs --grid"));
+    let res = run(&["eval", "--policy", dir.path().to_str().unwrap()]);
+    assert!(!res.status.success());
+    assert!(String::from_utf8_lossy(&res.stderr).contains(MANIFEST_FILE));
+}
