@@ -415,14 +415,20 @@ def restore(team, snap):
         o.load_state_dict(os_)
 
 
-def exercised(method, nets, h, q9):
+def exercised(method, nets, h, q9, batches):
     """What an iteration shows; the seed search wants all of a case's items true."""
     ex = {}
     dec = [v for k, v in nets.items() if k.startswith("agent")]
     if q9:
+        # One agent's view is empty, another's is not: the reference returns before any
+        # decentralized optimizer step (the centralized step, if any, was already taken).
+        views = [bool(b["valid"][:, :, i].any()) for b in batches for i in
+                 range(b["valid"].shape[2])]
+        ex["q9_one_agent_view_empty"] = not all(views)
+        ex["q9_another_agent_view_not_empty"] = any(views)
         ex["q9_dec_steps_skipped"] = not any(v.get("stepped") for v in dec)
-        ex["q9_cen_stepped"] = bool(nets.get("cen", {}).get("stepped")) if method != \
-            "dec-hddrqn" else True
+        if method != "dec-hddrqn":
+            ex["q9_cen_stepped"] = bool(nets.get("cen", {}).get("stepped"))
         return ex
     if "cen" in nets:
         c = nets["cen"]
@@ -483,15 +489,16 @@ def run_case(ref, domain, method, out_dir, base_seed):
                 np.random.seed(seed)
                 cap = Capture(learner, team)
                 nets = cap.run(team.train)
-                ex = exercised(method, nets, mth["h"], kind == "q9")
+                batches = [batch_tensors(out[0] if d["sample_epi"] else out,
+                                         len(memories[0].obs_size)) for _, out in seen]
+                ex = exercised(method, nets, mth["h"], kind == "q9", batches)
                 if all(ex.values()) and ex:
                     break
                 restore(team, snap)
             else:
                 raise RuntimeError(f"{domain}_{method} iteration {it}: no seed shows {ex}")
             rec = {"kind": kind, "numpy_seed": seed, "exercised": ex, "nets": {}}
-            batches = [(mem, out) for mem, out in seen]
-            for mem, out in batches:
+            for mem, out in seen:
                 b, t_len = out if d["sample_epi"] else (out, d["trace_len"])
                 role = "batch"
                 if method == "our2":

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use macdec::algos::method::Method;
 use macdec::algos::record::{Episode, Layout, RecordRef};
 use macdec::algos::replay::{Batch, Sequence};
+use macdec::algos::squeeze::squeeze_agent;
 use macdec::algos::update::{train_iteration_traced, IterationParams, NetTrace, Nets};
 use macdec::nn::{Adam, AdamConfig, QNet, QNetParams};
 use safetensors::tensor::Dtype;
@@ -487,6 +488,15 @@ fn run_case(case: &str) -> String {
             check("cen", c, trace.cen.as_ref());
         }
         if iteration.kind == "q9" {
+            // Quirk Q9: one agent has nothing to learn from, another has; the reference returns
+            // before any decentralized optimizer step.
+            let empty: Vec<bool> = (0..layout.n_agents())
+                .map(|i| squeeze_agent(&dec_batch, &layout, i).unwrap().is_empty())
+                .collect();
+            assert!(
+                empty.contains(&true) && empty.contains(&false),
+                "{case} iter {it}: a Q9 golden needs one empty and one non-empty agent view, got {empty:?}"
+            );
             assert!(
                 trace.dec.iter().all(|t| t.is_none()),
                 "{case} iter {it}: quirk Q9 must skip every decentralized step"
