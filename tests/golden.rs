@@ -431,7 +431,7 @@ fn run_case(case: &str) -> String {
             compare_trace(it, name, ours, r, &mut report);
             let after = load_net(&dir, &r.policy_after);
             let before = ref_weights.insert(name.to_string(), after.clone()).unwrap();
-            let Some(file) = (&r.grad).as_ref().filter(|_| r.stepped) else {
+            let Some(file) = r.grad.as_ref().filter(|_| r.stepped) else {
                 if before != after {
                     let _ = writeln!(
                         report,

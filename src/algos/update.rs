@@ -174,8 +174,7 @@ fn run_iteration(
         let qt = cen
             .target
             .forward_nograd_padded(joint.next_inputs.view(), &joint.lengths);
-        let a_star = cond_argmax_rows(qn.view(), n_actions, &joint.cond)?;
-        let y = targets(&joint.rewards, &joint.dones, &qt, &a_star, p.discount);
+        let y = cen_targets(&joint, &qn, &qt, n_actions, p.discount)?;
         let h = if p.method.cen_loss_is_hysteretic() {
             p.h
         } else {
@@ -193,7 +192,8 @@ fn run_iteration(
         loss.steps += 1;
         if let Some(t) = trace.as_deref_mut() {
             t.cen = Some(NetTrace {
-                target_actions: a_star,
+                // The same pure selection `cen_targets` made.
+                target_actions: cond_argmax_rows(qn.view(), n_actions, &joint.cond)?,
                 targets: y,
                 loss: cen_loss,
             });
@@ -504,6 +504,52 @@ mod tests {
             Method::Our2.dec_target_action(),
             Some(DecTargetAction::CenCondArgmax)
         );
+    }
+
+    #[test]
+    fn the_traced_iteration_changes_no_number() {
+        use crate::nn::{QNetConfig, TENSOR_NAMES};
+        use rand::SeedableRng;
+        let (layout, ep) = two_step_episode();
+        let b = batch(&ep);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let net = |input, output, rng: &mut rand_chacha::ChaCha8Rng| {
+            let cfg = QNetConfig {
+                input,
+                mlp: 4,
+                hidden: 3,
+                output,
+            };
+            Nets::new(QNet::new(cfg, rng), 0.01)
+        };
+        let dec: Vec<Nets> = (0..2).map(|_| net(1, 2, &mut rng)).collect();
+        let cen = net(2, 4, &mut rng);
+        for method in Method::ALL {
+            let p = IterationParams {
+                method,
+                discount: 0.9,
+                h: 0.5,
+                early_return_skips_all: true,
+            };
+            let (mut d1, mut c1) = (dec.clone(), cen.clone());
+            let (mut d2, mut c2) = (dec.clone(), cen.clone());
+            let use_cen = method.has_cen_net();
+            let plain =
+                train_iteration(p, &layout, &mut d1, use_cen.then_some(&mut c1), &b, &b).unwrap();
+            let (traced, trace) =
+                train_iteration_traced(p, &layout, &mut d2, use_cen.then_some(&mut c2), &b, &b)
+                    .unwrap();
+            assert_eq!(plain, traced, "{method}");
+            assert_eq!(trace.cen.is_some(), use_cen, "{method}");
+            for (x, y) in d1.iter().chain([&c1]).zip(d2.iter().chain([&c2])) {
+                for name in TENSOR_NAMES {
+                    let (a, b) = (x.policy.params.get(name), y.policy.params.get(name));
+                    assert_eq!(a, b, "{method} {name}");
+                }
+            }
+            let stepped = trace.dec.iter().flatten().count() + usize::from(trace.cen.is_some());
+            assert_eq!(stepped, plain.steps, "{method}");
+        }
     }
 
     #[test]
