@@ -267,6 +267,7 @@ fn compare_trace(
     name: &str,
     ours: Option<&NetTrace>,
     reference: &NetGolden,
+    worst: &mut (f64, f64),
     report: &mut String,
 ) {
     match (ours, reference.stepped) {
@@ -318,7 +319,11 @@ fn compare_trace(
                     t.target_actions
                 );
             }
+            for (&a, &b) in t.targets.iter().zip(y) {
+                worst.0 = worst.0.max((a as f64 - b).abs() / b.abs().max(1e-30));
+            }
             let loss = reference.loss.expect("stepped net has a loss");
+            worst.1 = worst.1.max((t.loss - loss).abs() / loss.abs().max(1e-30));
             if !close(t.loss, loss, TARGET_REL) {
                 let _ = writeln!(
                     report,
@@ -381,6 +386,8 @@ fn run_case(case: &str) -> String {
     }
     let mut report = String::new();
     let mut loose = 0usize;
+    // Largest strictly relative differences of targets and of losses, for the log.
+    let mut worst = (0.0f64, 0.0f64);
     for (it, iteration) in g.iterations.iter().enumerate() {
         assert!(
             iteration.exercised.values().all(|&v| v),
@@ -428,7 +435,7 @@ fn run_case(case: &str) -> String {
         }
         let mut check = |name: &str, nets: &Nets, ours: Option<&NetTrace>| {
             let r = &iteration.nets[name];
-            compare_trace(it, name, ours, r, &mut report);
+            compare_trace(it, name, ours, r, &mut worst, &mut report);
             let after = load_net(&dir, &r.policy_after);
             let before = ref_weights.insert(name.to_string(), after.clone()).unwrap();
             let Some(file) = r.grad.as_ref().filter(|_| r.stepped) else {
@@ -503,6 +510,10 @@ fn run_case(case: &str) -> String {
             );
         }
     }
+    eprintln!(
+        "{case}: largest relative difference of targets {:.1e}, of losses {:.1e}",
+        worst.0, worst.1
+    );
     if loose > 0 {
         eprintln!(
             "{case}: {loose} updated weights with |gradient| < {GRAD_FLOOR:e} compared to 2 lr"
