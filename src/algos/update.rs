@@ -14,7 +14,7 @@ use crate::algos::squeeze::{
 };
 use crate::algos::ReplayError;
 use crate::autograd::SeqPacking;
-use crate::nn::{flatten_padded, Adam, AdamConfig, QNet, TdBatch, Updater};
+use crate::nn::{flatten_padded, Adam, AdamConfig, QNet, QNetParams, TdBatch, Updater};
 use ndarray::{Array1, Array2, Array3};
 use serde::{Deserialize, Serialize};
 
@@ -57,6 +57,13 @@ impl Nets {
         self.target.copy_from(&self.policy);
     }
 
+    /// The gradient of the last [`train_iteration`] step of this net, if it took one since it
+    /// was built or resumed (for differential tests against the reference, `tests/golden.rs`).
+    #[doc(hidden)]
+    pub fn last_gradient(&self) -> Option<&QNetParams> {
+        self.updater.as_ref().map(|u| &u.grads)
+    }
+
     /// Whether every parameter is a finite number.
     pub fn is_finite(&self) -> bool {
         use crate::nn::Params;
@@ -88,6 +95,32 @@ pub struct IterationLoss {
     pub steps: usize,
 }
 
+/// What one iteration computed, net by net: the numbers a differential test compares with the
+/// reference's learner (`tests/golden.rs`). Filled only by [`train_iteration_traced`].
+#[doc(hidden)]
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IterationTrace {
+    /// The centralized net's step (Step A), if it took one.
+    pub cen: Option<NetTrace>,
+    /// Step B's joint indices (Our-1, Our-2): the conditional argmax of the just-updated
+    /// centralized net over the joint view of the decentralized batch, one per joint record.
+    pub joint_star: Option<Vec<usize>>,
+    /// Agent i's step (Step C), `None` where it took none; empty if Step C was not reached.
+    pub dec: Vec<Option<NetTrace>>,
+}
+
+/// One net's TD step inside an iteration.
+#[doc(hidden)]
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NetTrace {
+    /// The action each kept record bootstraps from (joint index for the centralized net).
+    pub target_actions: Vec<usize>,
+    /// The detached targets y_k, in flat (sequence, time) order.
+    pub targets: Vec<f32>,
+    /// The loss before the step.
+    pub loss: f64,
+}
+
 /// One training iteration. `dec_batch` feeds the decentralized nets; `cen_batch` the centralized
 /// net (the same batch except in Our-2, spec 5.5).
 pub fn train_iteration(
@@ -97,6 +130,34 @@ pub fn train_iteration(
     cen: Option<&mut Nets>,
     dec_batch: &Batch<'_>,
     cen_batch: &Batch<'_>,
+) -> Result<IterationLoss, UpdateError> {
+    run_iteration(p, layout, dec, cen, dec_batch, cen_batch, None)
+}
+
+/// [`train_iteration`], also returning what each net's step computed. The same arithmetic in
+/// the same order: the trace only copies values out.
+#[doc(hidden)]
+pub fn train_iteration_traced(
+    p: IterationParams,
+    layout: &Layout,
+    dec: &mut [Nets],
+    cen: Option<&mut Nets>,
+    dec_batch: &Batch<'_>,
+    cen_batch: &Batch<'_>,
+) -> Result<(IterationLoss, IterationTrace), UpdateError> {
+    let mut trace = IterationTrace::default();
+    let loss = run_iteration(p, layout, dec, cen, dec_batch, cen_batch, Some(&mut trace))?;
+    Ok((loss, trace))
+}
+
+fn run_iteration(
+    p: IterationParams,
+    layout: &Layout,
+    dec: &mut [Nets],
+    cen: Option<&mut Nets>,
+    dec_batch: &Batch<'_>,
+    cen_batch: &Batch<'_>,
+    mut trace: Option<&mut IterationTrace>,
 ) -> Result<IterationLoss, UpdateError> {
     let mut loss = IterationLoss::default();
     let n_actions = layout.n_actions();
@@ -119,7 +180,7 @@ pub fn train_iteration(
         } else {
             1.0
         };
-        loss.total += td_step(
+        let cen_loss = td_step(
             cen,
             &joint.inputs,
             &joint.lengths,
@@ -127,7 +188,16 @@ pub fn train_iteration(
             &y,
             h,
         );
+        loss.total += cen_loss;
         loss.steps += 1;
+        if let Some(t) = trace.as_deref_mut() {
+            t.cen = Some(NetTrace {
+                // The same pure selection `cen_targets` made.
+                target_actions: cond_argmax_rows(qn.view(), n_actions, &joint.cond)?,
+                targets: y,
+                loss: cen_loss,
+            });
+        }
         if p.method.dec_target_action() == Some(DecTargetAction::CenCondArgmax) {
             let view = if p.method == Method::Our2 {
                 squeeze_joint(dec_batch, layout)?
@@ -142,6 +212,9 @@ pub fn train_iteration(
                 .policy
                 .forward_nograd_padded(view.next_inputs.view(), &view.lengths);
             let star = cond_argmax_rows(qn2.view(), n_actions, &view.cond)?;
+            if let Some(t) = trace.as_deref_mut() {
+                t.joint_star = Some(star.clone());
+            }
             joint_star = Some((view, star));
         }
     }
@@ -154,6 +227,9 @@ pub fn train_iteration(
         .collect::<Result<_, _>>()?;
     if p.early_return_skips_all && views.iter().any(|v| v.is_empty()) {
         return Ok(loss); // Q9 (faithful): one empty view skips every agent's step.
+    }
+    if let Some(t) = trace.as_deref_mut() {
+        t.dec = vec![None; dec.len()];
     }
     for (agent, (nets, view)) in dec.iter_mut().zip(&views).enumerate() {
         if view.is_empty() {
@@ -169,8 +245,16 @@ pub fn train_iteration(
             .target
             .forward_nograd_padded(view.next_inputs.view(), &view.lengths);
         let y = targets(&view.rewards, &view.dones, &qt, &a_star, p.discount);
-        loss.total += td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, p.h);
+        let agent_loss = td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, p.h);
+        loss.total += agent_loss;
         loss.steps += 1;
+        if let Some(t) = trace.as_deref_mut() {
+            t.dec[agent] = Some(NetTrace {
+                target_actions: a_star,
+                targets: y,
+                loss: agent_loss,
+            });
+        }
     }
     Ok(loss)
 }
@@ -420,6 +504,52 @@ mod tests {
             Method::Our2.dec_target_action(),
             Some(DecTargetAction::CenCondArgmax)
         );
+    }
+
+    #[test]
+    fn the_traced_iteration_changes_no_number() {
+        use crate::nn::{QNetConfig, TENSOR_NAMES};
+        use rand::SeedableRng;
+        let (layout, ep) = two_step_episode();
+        let b = batch(&ep);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let net = |input, output, rng: &mut rand_chacha::ChaCha8Rng| {
+            let cfg = QNetConfig {
+                input,
+                mlp: 4,
+                hidden: 3,
+                output,
+            };
+            Nets::new(QNet::new(cfg, rng), 0.01)
+        };
+        let dec: Vec<Nets> = (0..2).map(|_| net(1, 2, &mut rng)).collect();
+        let cen = net(2, 4, &mut rng);
+        for method in Method::ALL {
+            let p = IterationParams {
+                method,
+                discount: 0.9,
+                h: 0.5,
+                early_return_skips_all: true,
+            };
+            let (mut d1, mut c1) = (dec.clone(), cen.clone());
+            let (mut d2, mut c2) = (dec.clone(), cen.clone());
+            let use_cen = method.has_cen_net();
+            let plain =
+                train_iteration(p, &layout, &mut d1, use_cen.then_some(&mut c1), &b, &b).unwrap();
+            let (traced, trace) =
+                train_iteration_traced(p, &layout, &mut d2, use_cen.then_some(&mut c2), &b, &b)
+                    .unwrap();
+            assert_eq!(plain, traced, "{method}");
+            assert_eq!(trace.cen.is_some(), use_cen, "{method}");
+            for (x, y) in d1.iter().chain([&c1]).zip(d2.iter().chain([&c2])) {
+                for name in TENSOR_NAMES {
+                    let (a, b) = (x.policy.params.get(name), y.policy.params.get(name));
+                    assert_eq!(a, b, "{method} {name}");
+                }
+            }
+            let stepped = trace.dec.iter().flatten().count() + usize::from(trace.cen.is_some());
+            assert_eq!(stepped, plain.steps, "{method}");
+        }
     }
 
     #[test]
