@@ -7,7 +7,7 @@ use macdec::bench::nets;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
-use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
+use macdec::experiment::slurm::{job_script, SlurmOptions};
 use macdec::experiment::train_run::train_run;
 use macdec::nn::demo;
 use std::io::Write;
@@ -393,13 +393,13 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     let sel = args.select;
     let mut train_args = Vec::new();
     if let Some(m) = &sel.methods {
-        train_args.extend(["--methods".to_string(), shell_quote(&m.join(","))]);
+        train_args.extend(["--methods".to_string(), m.join(",")]);
     }
     if let Some(s) = &sel.seeds {
-        train_args.extend(["--seeds".to_string(), shell_quote(s)]);
+        train_args.extend(["--seeds".to_string(), s.clone()]);
     }
     for item in &sel.set {
-        train_args.extend(["--set".to_string(), shell_quote(item)]);
+        train_args.extend(["--set".to_string(), item.clone()]);
     }
     let config = sel
         .config
@@ -427,7 +427,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
             mem: &args.mem,
             extra_sbatch: args.sbatch,
         },
-    );
+    )?;
     print!("{script}");
     Ok(())
 }

@@ -2,7 +2,9 @@
 
 pub mod atomic;
 pub mod config;
+pub mod limits;
 pub mod metrics;
+pub mod names;
 pub mod provenance;
 pub mod report;
 pub mod rollout;
