@@ -61,7 +61,7 @@ enum Command {
         #[arg(long)]
         run: PathBuf,
         /// Episodes to show, one after another.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = at_least_one)]
         episodes: usize,
         /// The GIF to write.
         #[arg(long, default_value = "rollout.gif")]
@@ -119,8 +119,8 @@ enum BenchTarget {
 struct TrainArgs {
     #[command(flatten)]
     select: Selection,
-    /// Runs in parallel (default: the number of cores).
-    #[arg(long)]
+    /// Runs in parallel (default: the number of cores; never more than the runs).
+    #[arg(long, value_parser = at_least_one)]
     jobs: Option<usize>,
     /// Results root: runs go to <out>/<experiment>/<method>/seed-<k>/.
     #[arg(long, default_value = "results")]
@@ -131,9 +131,10 @@ struct TrainArgs {
     /// No progress bars; one line per finished run.
     #[arg(long)]
     quiet: bool,
-    /// Where the learning-curve figures go after training.
-    #[arg(long, default_value = "plots")]
-    plots: PathBuf,
+    /// Where the learning-curve figures go after training (default: the results root --out, as
+    /// <out>/<experiment>.png, so side runs never overwrite committed figures).
+    #[arg(long)]
+    plots: Option<PathBuf>,
     /// Do not draw figures after training.
     #[arg(long)]
     no_plot: bool,
@@ -212,10 +213,10 @@ struct RobotArgs {
     #[arg(long)]
     listen: Option<std::net::SocketAddr>,
     /// With --listen: connections served at once (one more is refused with an error line).
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = at_least_one)]
     max_connections: usize,
     /// Longest request line in bytes; a longer one gets an error reply and is discarded.
-    #[arg(long, default_value_t = macdec::deploy::line_reader::MAX_LINE_BYTES)]
+    #[arg(long, default_value_t = macdec::deploy::line_reader::MAX_LINE_BYTES, value_parser = at_least_one)]
     max_line_bytes: usize,
     /// With --listen: close a connection idle for this many seconds (default: never).
     #[arg(long)]
@@ -234,7 +235,7 @@ struct DeployArgs {
     #[arg(long)]
     policy: PathBuf,
     /// Episodes to run.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
     episodes: usize,
     /// Seed of the environment's random stream (default: the run's seed); the stream is the
     /// evaluation env's stream of that seed.
@@ -251,7 +252,42 @@ struct DeployArgs {
     mock: bool,
 }
 
-fn main() -> Result<()> {
+/// A count flag that must be at least 1 (0 would do nothing useful, silently).
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("expected a positive integer: {e}")),
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{}", error_report(&e));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes, one per line, leaving out a cause whose text the line above already
+/// includes (library errors print their source inline, so anyhow's chain would repeat it).
+fn error_report(e: &anyhow::Error) -> String {
+    let mut lines = vec![format!("Error: {e}")];
+    let mut shown = e.to_string();
+    for cause in e.chain().skip(1) {
+        let text = cause.to_string();
+        if !shown.contains(&text) {
+            lines.push(format!("  caused by: {text}"));
+            shown.push('\n');
+            shown.push_str(&text);
+        }
+    }
+    lines.join("\n")
+}
+
+fn run() -> Result<()> {
     match Cli::parse().command {
         Command::Train(args) => train(args),
         Command::Replay { actions, verbose } => replay(&actions, verbose),
@@ -310,9 +346,11 @@ fn train(args: TrainArgs) -> Result<()> {
         }
         runs = vec![runs.swap_remove(i)];
     }
-    let jobs = args
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let jobs = macdec::experiment::limits::worker_threads(
+        args.jobs
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        runs.len(),
+    );
     let opts = RunnerOptions {
         out: args.out.clone(),
         jobs,
@@ -345,7 +383,8 @@ fn train(args: TrainArgs) -> Result<()> {
     }
     macdec::experiment::report::print_curves(&args.out, &runs)?;
     if !args.no_plot {
-        match macdec::plot::plot_results(&args.out, &args.plots) {
+        let plots = args.plots.as_deref().unwrap_or(&args.out);
+        match macdec::plot::plot_results(&args.out, plots) {
             Ok(report) => {
                 for p in report
                     .plots
