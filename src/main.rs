@@ -545,26 +545,25 @@ fn plot(results: &Path, out: &Path) -> Result<()> {
 }
 
 fn replay(path: &Path, verbose: bool) -> Result<()> {
-    use macdec::envs::replay::{parse_replay, run_replay};
+    use macdec::envs::replay::{parse_replay, stream_replay};
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading replay file {}", path.display()))?;
     let file = parse_replay(&text).with_context(|| format!("parsing {}", path.display()))?;
-    let replay =
-        run_replay(&file, verbose).with_context(|| format!("replaying {}", path.display()))?;
-    let mut out = std::io::stdout().lock();
-    for frame in &replay.frames {
-        serde_json::to_writer(&mut out, &frame.line)?;
+    drop(text);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let unused = stream_replay(&file, verbose, &mut |frame| {
+        serde_json::to_writer(&mut out, &frame.line).map_err(std::io::Error::from)?;
         writeln!(out)?;
         if let Some(picture) = &frame.picture {
             out.flush()?;
             eprintln!("{picture}");
         }
-    }
-    if replay.unused_steps > 0 {
-        eprintln!(
-            "note: the episode ended with {} rows of `steps` unused",
-            replay.unused_steps
-        );
+        Ok(())
+    })
+    .with_context(|| format!("replaying {}", path.display()))?;
+    out.flush()?;
+    if unused > 0 {
+        eprintln!("note: the episode ended with {unused} rows of `steps` unused");
     }
     Ok(())
 }
@@ -656,7 +655,7 @@ fn robot(args: RobotArgs) -> Result<()> {
 }
 
 fn deploy(args: DeployArgs) -> Result<()> {
-    use macdec::deploy::{manifest::load_all, processes::deploy_with_processes};
+    use macdec::deploy::{manifest::load_all, processes::deploy_streaming};
     use macdec::experiment::seeds::{stream, Role};
     let (manifest, _) = load_all(&args.policy)
         .with_context(|| format!("loading policy {}", args.policy.display()))?;
@@ -668,7 +667,10 @@ fn deploy(args: DeployArgs) -> Result<()> {
     } else {
         vec![]
     };
-    let traces = deploy_with_processes(
+    // Each episode's line is printed and flushed as it ends.
+    let (mut count, mut sum) = (0usize, 0.0f64);
+    let mut out = std::io::stdout().lock();
+    deploy_streaming(
         &exe,
         &args.policy,
         &manifest,
@@ -676,20 +678,22 @@ fn deploy(args: DeployArgs) -> Result<()> {
         args.episodes,
         &mut rng,
         std::time::Duration::from_secs(args.timeout_secs),
+        |mut trace| {
+            if !args.trajectories {
+                trace.trajectory.clear();
+            }
+            serde_json::to_writer(&mut out, &trace).map_err(std::io::Error::from)?;
+            writeln!(out)?;
+            out.flush()?;
+            count += 1;
+            sum += trace.discounted_return;
+            Ok(())
+        },
     )
     .with_context(|| format!("deploying {}", args.policy.display()))?;
-    let mut out = std::io::stdout().lock();
-    for mut trace in traces.iter().cloned() {
-        if !args.trajectories {
-            trace.trajectory.clear();
-        }
-        serde_json::to_writer(&mut out, &trace)?;
-        writeln!(out)?;
-    }
-    let mean = traces.iter().map(|t| t.discounted_return).sum::<f64>() / traces.len().max(1) as f64;
+    let mean = sum / count.max(1) as f64;
     eprintln!(
-        "{} episode(s) of {} with {} robot process(es), seed {seed}: mean discounted return {mean:.4}",
-        traces.len(),
+        "{count} episode(s) of {} with {} robot process(es), seed {seed}: mean discounted return {mean:.4}",
         manifest.env.name(),
         manifest.agents.len()
     );

@@ -338,13 +338,29 @@ mod tests {
         ];
         for (mean, se) in cases {
             let fig = figure_of(vec![
-                CurvePoint { episode: 0, mean: 1.0, se: 0.0, n: 2 },
-                CurvePoint { episode: 10, mean, se, n: 2 },
+                CurvePoint {
+                    episode: 0,
+                    mean: 1.0,
+                    se: 0.0,
+                    n: 2,
+                },
+                CurvePoint {
+                    episode: 10,
+                    mean,
+                    se,
+                    n: 2,
+                },
             ]);
             let (x, y) = ranges(&fig);
             assert!(x.start.is_finite() && x.end.is_finite() && x.start < x.end);
-            assert!(y.start.is_finite() && y.end.is_finite() && y.start < y.end, "{y:?}");
-            assert!(y.end - y.start > y.end.abs() * 1e-6, "{y:?}: too narrow for f64 steps");
+            assert!(
+                y.start.is_finite() && y.end.is_finite() && y.start < y.end,
+                "{y:?}"
+            );
+            assert!(
+                y.end - y.start > y.end.abs() * 1e-6,
+                "{y:?}: too narrow for f64 steps"
+            );
             // Rendering must finish: run it on a thread and give it a generous deadline.
             let (tx, rx) = std::sync::mpsc::channel();
             let dir = tempfile::tempdir().unwrap();
