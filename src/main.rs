@@ -218,9 +218,10 @@ struct RobotArgs {
     /// Longest request line in bytes; a longer one gets an error reply and is discarded.
     #[arg(long, default_value_t = macdec::deploy::line_reader::MAX_LINE_BYTES, value_parser = at_least_one)]
     max_line_bytes: usize,
-    /// With --listen: close a connection idle for this many seconds (default: never).
-    #[arg(long)]
-    idle_timeout_secs: Option<u64>,
+    /// With --listen: close a connection silent between requests for this many seconds.
+    #[arg(long, default_value_t = macdec::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS,
+          value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    idle_timeout_secs: u64,
     /// Run a deterministic stand-in policy instead of the weights (tests).
     #[arg(long, hide = true)]
     mock: bool,
@@ -645,7 +646,7 @@ fn robot(args: RobotArgs) -> Result<()> {
             let limits = macdec::deploy::Limits {
                 max_line_bytes: args.max_line_bytes,
                 max_connections: args.max_connections,
-                idle_timeout: args.idle_timeout_secs.map(std::time::Duration::from_secs),
+                idle_timeout: Some(std::time::Duration::from_secs(args.idle_timeout_secs)),
                 ..Default::default()
             };
             macdec::deploy::serve_tcp(listener, factory, spec, limits)?;

@@ -1,6 +1,7 @@
 //! Experiments: configs, seeds, the parallel runner, metrics and checkpoints.
 
 pub mod atomic;
+pub mod bounded_read;
 pub mod checkpoint;
 pub mod config;
 pub mod limits;
