@@ -604,6 +604,16 @@ fn policy_factory(
 fn export(run: &Path, out: &Path) -> Result<()> {
     let manifest = macdec::deploy::export::export_run(run, out)
         .with_context(|| format!("exporting {} to {}", run.display(), out.display()))?;
+    if !run
+        .join(macdec::experiment::runner::FINISHED_MARKER)
+        .exists()
+    {
+        eprintln!(
+            "warning: {} has not finished training: exported its nets after {} episodes",
+            run.display(),
+            manifest.run.episodes_trained
+        );
+    }
     eprintln!(
         "exported {} agent(s) of {} ({} seed {}, {} episodes trained) to {}",
         manifest.agents.len(),
