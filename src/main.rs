@@ -382,7 +382,14 @@ fn train(args: TrainArgs) -> Result<()> {
     if skipped > 0 {
         eprintln!("{skipped} run(s) already finished, skipped (use --force to recompute)");
     }
-    macdec::experiment::report::print_curves(&args.out, &runs)?;
+    // A refused run's directory holds another run's curve: do not show it as this one's.
+    let shown: Vec<_> = runs
+        .iter()
+        .zip(&statuses)
+        .filter(|(_, s)| !matches!(s, RunStatus::Failed(_)))
+        .map(|(r, _)| r.clone())
+        .collect();
+    macdec::experiment::report::print_curves(&args.out, &shown)?;
     if !args.no_plot {
         let plots = args.plots.as_deref().unwrap_or(&args.out);
         match macdec::plot::plot_results(&args.out, plots) {
