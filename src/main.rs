@@ -7,7 +7,7 @@ use macdec::bench::nets;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
-use macdec::experiment::slurm::{job_script, shell_quote, SlurmOptions};
+use macdec::experiment::slurm::{job_script, SlurmOptions};
 use macdec::experiment::train_run::train_run;
 use macdec::nn::demo;
 use std::io::Write;
@@ -61,7 +61,7 @@ enum Command {
         #[arg(long)]
         run: PathBuf,
         /// Episodes to show, one after another.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = at_least_one)]
         episodes: usize,
         /// The GIF to write.
         #[arg(long, default_value = "rollout.gif")]
@@ -148,8 +148,8 @@ struct AuditArgs {
 struct TrainArgs {
     #[command(flatten)]
     select: Selection,
-    /// Runs in parallel (default: the number of cores).
-    #[arg(long)]
+    /// Runs in parallel (default: the number of cores; never more than the runs).
+    #[arg(long, value_parser = at_least_one)]
     jobs: Option<usize>,
     /// Results root: runs go to <out>/<experiment>/<method>/seed-<k>/.
     #[arg(long, default_value = "results")]
@@ -160,9 +160,10 @@ struct TrainArgs {
     /// No progress bars; one line per finished run.
     #[arg(long)]
     quiet: bool,
-    /// Where the learning-curve figures go after training.
-    #[arg(long, default_value = "plots")]
-    plots: PathBuf,
+    /// Where the learning-curve figures go after training (default: the results root --out, as
+    /// <out>/<experiment>.png, so side runs never overwrite committed figures).
+    #[arg(long)]
+    plots: Option<PathBuf>,
     /// Do not draw figures after training.
     #[arg(long)]
     no_plot: bool,
@@ -241,14 +242,15 @@ struct RobotArgs {
     #[arg(long)]
     listen: Option<std::net::SocketAddr>,
     /// With --listen: connections served at once (one more is refused with an error line).
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = at_least_one)]
     max_connections: usize,
     /// Longest request line in bytes; a longer one gets an error reply and is discarded.
-    #[arg(long, default_value_t = macdec::deploy::line_reader::MAX_LINE_BYTES)]
+    #[arg(long, default_value_t = macdec::deploy::line_reader::MAX_LINE_BYTES, value_parser = at_least_one)]
     max_line_bytes: usize,
-    /// With --listen: close a connection idle for this many seconds (default: never).
-    #[arg(long)]
-    idle_timeout_secs: Option<u64>,
+    /// With --listen: close a connection silent between requests for this many seconds.
+    #[arg(long, default_value_t = macdec::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS,
+          value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    idle_timeout_secs: u64,
     /// Run a deterministic stand-in policy instead of the weights (tests).
     #[arg(long, hide = true)]
     mock: bool,
@@ -263,7 +265,7 @@ struct DeployArgs {
     #[arg(long)]
     policy: PathBuf,
     /// Episodes to run.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
     episodes: usize,
     /// Seed of the environment's random stream (default: the run's seed); the stream is the
     /// evaluation env's stream of that seed.
@@ -331,7 +333,42 @@ struct EvalArgs {
     trajectories: bool,
 }
 
-fn main() -> Result<()> {
+/// A count flag that must be at least 1 (0 would do nothing useful, silently).
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("expected a positive integer: {e}")),
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{}", error_report(&e));
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes, one per line, leaving out a cause whose text the line above already
+/// includes (library errors print their source inline, so anyhow's chain would repeat it).
+fn error_report(e: &anyhow::Error) -> String {
+    let mut lines = vec![format!("Error: {e}")];
+    let mut shown = e.to_string();
+    for cause in e.chain().skip(1) {
+        let text = cause.to_string();
+        if !shown.contains(&text) {
+            lines.push(format!("  caused by: {text}"));
+            shown.push('\n');
+            shown.push_str(&text);
+        }
+    }
+    lines.join("\n")
+}
+
+fn run() -> Result<()> {
     match Cli::parse().command {
         Command::Train(args) => train(args),
         Command::Replay { actions, verbose } => replay(&actions, verbose),
@@ -393,9 +430,11 @@ fn train(args: TrainArgs) -> Result<()> {
         }
         runs = vec![runs.swap_remove(i)];
     }
-    let jobs = args
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let jobs = macdec::experiment::limits::worker_threads(
+        args.jobs
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        runs.len(),
+    );
     let opts = RunnerOptions {
         out: args.out.clone(),
         jobs,
@@ -435,9 +474,17 @@ fn train(args: TrainArgs) -> Result<()> {
     if skipped > 0 {
         eprintln!("{skipped} run(s) already finished, skipped (use --force to recompute)");
     }
-    macdec::experiment::report::print_curves(&args.out, &runs)?;
+    // A refused run's directory holds another run's curve: do not show it as this one's.
+    let shown: Vec<_> = runs
+        .iter()
+        .zip(&statuses)
+        .filter(|(_, s)| !matches!(s, RunStatus::Failed(_)))
+        .map(|(r, _)| r.clone())
+        .collect();
+    macdec::experiment::report::print_curves(&args.out, &shown)?;
     if !args.no_plot {
-        match macdec::plot::plot_results(&args.out, &args.plots) {
+        let plots = args.plots.as_deref().unwrap_or(&args.out);
+        match macdec::plot::plot_results(&args.out, plots) {
             Ok(report) => {
                 for p in report
                     .plots
@@ -485,13 +532,13 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     let sel = args.select;
     let mut train_args = Vec::new();
     if let Some(m) = &sel.methods {
-        train_args.extend(["--methods".to_string(), shell_quote(&m.join(","))]);
+        train_args.extend(["--methods".to_string(), m.join(",")]);
     }
     if let Some(s) = &sel.seeds {
-        train_args.extend(["--seeds".to_string(), shell_quote(s)]);
+        train_args.extend(["--seeds".to_string(), s.clone()]);
     }
     for item in &sel.set {
-        train_args.extend(["--set".to_string(), shell_quote(item)]);
+        train_args.extend(["--set".to_string(), item.clone()]);
     }
     let config = sel
         .config
@@ -519,7 +566,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
             mem: &args.mem,
             extra_sbatch: args.sbatch,
         },
-    );
+    )?;
     print!("{script}");
     Ok(())
 }
@@ -655,26 +702,25 @@ fn plot(results: &Path, out: &Path) -> Result<()> {
 }
 
 fn replay(path: &Path, verbose: bool) -> Result<()> {
-    use macdec::envs::replay::{parse_replay, run_replay};
+    use macdec::envs::replay::{parse_replay, stream_replay};
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading replay file {}", path.display()))?;
     let file = parse_replay(&text).with_context(|| format!("parsing {}", path.display()))?;
-    let replay =
-        run_replay(&file, verbose).with_context(|| format!("replaying {}", path.display()))?;
-    let mut out = std::io::stdout().lock();
-    for frame in &replay.frames {
-        serde_json::to_writer(&mut out, &frame.line)?;
+    drop(text);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let unused = stream_replay(&file, verbose, &mut |frame| {
+        serde_json::to_writer(&mut out, &frame.line).map_err(std::io::Error::from)?;
         writeln!(out)?;
         if let Some(picture) = &frame.picture {
             out.flush()?;
             eprintln!("{picture}");
         }
-    }
-    if replay.unused_steps > 0 {
-        eprintln!(
-            "note: the episode ended with {} rows of `steps` unused",
-            replay.unused_steps
-        );
+        Ok(())
+    })
+    .with_context(|| format!("replaying {}", path.display()))?;
+    out.flush()?;
+    if unused > 0 {
+        eprintln!("note: the episode ended with {unused} rows of `steps` unused");
     }
     Ok(())
 }
@@ -714,6 +760,16 @@ fn policy_factory(
 fn export(run: &Path, out: &Path) -> Result<()> {
     let manifest = macdec::deploy::export::export_run(run, out)
         .with_context(|| format!("exporting {} to {}", run.display(), out.display()))?;
+    if !run
+        .join(macdec::experiment::runner::FINISHED_MARKER)
+        .exists()
+    {
+        eprintln!(
+            "warning: {} has not finished training: exported its nets after {} episodes",
+            run.display(),
+            manifest.run.episodes_trained
+        );
+    }
     eprintln!(
         "exported {} agent(s) of {} ({} seed {}, {} episodes trained) to {}",
         manifest.agents.len(),
@@ -756,7 +812,7 @@ fn robot(args: RobotArgs) -> Result<()> {
             let limits = macdec::deploy::Limits {
                 max_line_bytes: args.max_line_bytes,
                 max_connections: args.max_connections,
-                idle_timeout: args.idle_timeout_secs.map(std::time::Duration::from_secs),
+                idle_timeout: Some(std::time::Duration::from_secs(args.idle_timeout_secs)),
                 ..Default::default()
             };
             macdec::deploy::serve_tcp(listener, factory, spec, limits)?;
@@ -766,7 +822,7 @@ fn robot(args: RobotArgs) -> Result<()> {
 }
 
 fn deploy(args: DeployArgs) -> Result<()> {
-    use macdec::deploy::{manifest::load_all, processes::deploy_with_processes};
+    use macdec::deploy::{manifest::load_all, processes::deploy_streaming};
     use macdec::experiment::seeds::{stream, Role};
     let (manifest, _) = load_all(&args.policy)
         .with_context(|| format!("loading policy {}", args.policy.display()))?;
@@ -778,7 +834,10 @@ fn deploy(args: DeployArgs) -> Result<()> {
     } else {
         vec![]
     };
-    let traces = deploy_with_processes(
+    // Each episode's line is printed and flushed as it ends.
+    let (mut count, mut sum) = (0usize, 0.0f64);
+    let mut out = std::io::stdout().lock();
+    deploy_streaming(
         &exe,
         &args.policy,
         &manifest,
@@ -786,20 +845,22 @@ fn deploy(args: DeployArgs) -> Result<()> {
         args.episodes,
         &mut rng,
         std::time::Duration::from_secs(args.timeout_secs),
+        |mut trace| {
+            if !args.trajectories {
+                trace.trajectory.clear();
+            }
+            serde_json::to_writer(&mut out, &trace).map_err(std::io::Error::from)?;
+            writeln!(out)?;
+            out.flush()?;
+            count += 1;
+            sum += trace.discounted_return;
+            Ok(())
+        },
     )
     .with_context(|| format!("deploying {}", args.policy.display()))?;
-    let mut out = std::io::stdout().lock();
-    for mut trace in traces.iter().cloned() {
-        if !args.trajectories {
-            trace.trajectory.clear();
-        }
-        serde_json::to_writer(&mut out, &trace)?;
-        writeln!(out)?;
-    }
-    let mean = traces.iter().map(|t| t.discounted_return).sum::<f64>() / traces.len().max(1) as f64;
+    let mean = sum / count.max(1) as f64;
     eprintln!(
-        "{} episode(s) of {} with {} robot process(es), seed {seed}: mean discounted return {mean:.4}",
-        traces.len(),
+        "{count} episode(s) of {} with {} robot process(es), seed {seed}: mean discounted return {mean:.4}",
         manifest.env.name(),
         manifest.agents.len()
     );

@@ -353,3 +353,31 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         assert_eq!(got, steps);
     }
 }
+
+#[test]
+fn deploy_prints_each_episode_as_it_ends() {
+    // A million episodes would take hours: the first line must still arrive within seconds, so
+    // results are streamed, not kept until the end.
+    let dir = tempfile::tempdir().unwrap();
+    write_mock_policy(dir.path(), BP10).unwrap();
+    let mut child = Command::new(BIN)
+        .args(["deploy", "--mock", "--episodes", "1000000", "--policy"])
+        .arg(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = BufReader::new(stdout).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let line = rx.recv_timeout(std::time::Duration::from_secs(60));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let line = line.expect("no episode line within 60 s");
+    let trace: EpisodeTrace = serde_json::from_str(&line).unwrap();
+    assert_eq!(trace.episode, 0);
+}

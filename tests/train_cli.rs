@@ -183,3 +183,128 @@ fn a_diverging_run_fails_clearly_and_the_others_finish() {
         assert!(!out.join(format!("tiny/our1/seed-{seed}/finished")).exists());
     }
 }
+
+#[test]
+fn names_that_climb_out_of_out_are_refused_before_anything_is_touched() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a/b/out");
+    let victim = dir.path().join("a/escape");
+    std::fs::create_dir_all(victim.join("our1/seed-0")).unwrap();
+    std::fs::write(victim.join("our1/seed-0/precious"), b"keep").unwrap();
+    for name in ["../escape", "/tmp/abs", "", "x\ny"] {
+        let config = dir.path().join("bad.toml");
+        let text = TINY.replace("name = \"tiny\"", &format!("name = {}", toml_string(name)));
+        std::fs::write(&config, text).unwrap();
+        let o = train(&config, &out, &["--force", "--no-plot"]);
+        assert!(!o.status.success(), "{name:?} accepted");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("experiment name"), "{name:?}: {err}");
+        assert!(!out.exists(), "{name:?}: something was written");
+    }
+    assert!(victim.join("our1/seed-0/precious").exists());
+}
+
+fn toml_string(s: &str) -> String {
+    format!(
+        "\"{}\"",
+        s.replace('\\', "\\\\")
+            .replace('"', "\\\"")
+            .replace('\n', "\\n")
+    )
+}
+
+#[test]
+fn a_finished_run_whose_config_differs_is_refused_naming_the_key_and_the_figure_stays_in_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY.replace("total_epi = 60", "total_epi = 10")).unwrap();
+    let out = dir.path().join("out");
+    let args = ["--methods", "our1", "--seeds", "0"];
+    // No --plots: the figure goes into the results root, not ./plots of the working directory.
+    let o = Command::new(BIN)
+        .args(["train", "--quiet", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .args(args)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("tiny.png").exists());
+    assert!(!dir.path().join("plots").exists());
+
+    let run_config = out.join("tiny/our1/seed-0/config.toml");
+    let text = std::fs::read_to_string(&run_config).unwrap();
+    std::fs::write(
+        &run_config,
+        text.replace("batch_size = 16", "batch_size = 8"),
+    )
+    .unwrap();
+    let o = train(&config, &out, &args);
+    assert!(!o.status.success(), "a stale run was reused");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("batch_size (on disk 8, requested 16)") && err.contains("--force"),
+        "{err}"
+    );
+    assert!(train(&config, &out, &[&args[..], &["--force"]].concat())
+        .status
+        .success());
+}
+
+#[test]
+fn slurm_refuses_values_that_would_break_the_script() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    for extra in [
+        vec!["--time", "01:00:00\necho pwned"],
+        vec!["--sbatch=--partition=cpu\necho pwned"],
+        vec!["--set", "total_epi=60\necho pwned"],
+    ] {
+        let o = Command::new(BIN)
+            .args(["slurm", "--config"])
+            .arg(&config)
+            .args(&extra)
+            .output()
+            .unwrap();
+        assert!(!o.status.success(), "{extra:?} accepted");
+        assert!(o.stdout.is_empty(), "{extra:?}: a script was printed");
+    }
+}
+
+#[test]
+fn another_runs_or_a_damaged_checkpoint_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY.replace("total_epi = 60", "total_epi = 20")).unwrap();
+    let out = dir.path().join("out");
+    let args = ["--methods", "our1", "--no-plot"];
+    assert!(train(&config, &out, &args).status.success());
+    let seed = |k: u32| out.join(format!("tiny/our1/seed-{k}"));
+    std::fs::remove_file(seed(0).join("finished")).unwrap();
+    std::fs::copy(
+        seed(1).join("checkpoint.bin"),
+        seed(0).join("checkpoint.bin"),
+    )
+    .unwrap();
+    let o = train(&config, &out, &args);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("belongs to another run: seed \"1\""), "{err}");
+
+    let mut bytes = std::fs::read(seed(1).join("checkpoint.bin")).unwrap();
+    bytes.extend_from_slice(b"garbage");
+    std::fs::write(seed(0).join("checkpoint.bin"), &bytes).unwrap();
+    let err = String::from_utf8_lossy(&train(&config, &out, &args).stderr).into_owned();
+    assert!(err.contains("trailing bytes"), "{err}");
+    // A dead writer's temp file is cleaned up when the run resumes (no --force: nothing else
+    // would remove it).
+    std::fs::remove_file(seed(0).join("checkpoint.bin")).unwrap();
+    let stale = seed(0).join(".checkpoint.bin.4294967.tmp");
+    std::fs::write(&stale, b"half").unwrap();
+    assert!(train(&config, &out, &args).status.success());
+    assert!(!stale.exists());
+    assert!(seed(0).join("finished").exists());
+}

@@ -58,6 +58,8 @@ pub enum DeployError {
     Spawn { agent: usize, reason: String },
     #[error("policy: {0}")]
     Policy(String),
+    #[error("writing an episode's result: {0}")]
+    Output(#[from] std::io::Error),
 }
 
 /// Run one episode from reset to done. Every primitive step, each agent's robot gets that agent's

@@ -3,7 +3,7 @@
 //! manifest naming the domain, layout, architecture and run.
 
 use crate::deploy::architecture::Architecture;
-use crate::deploy::manifest::{Manifest, ManifestError, RunInfo};
+use crate::deploy::manifest::{Manifest, ManifestError, RunInfo, MANIFEST_FILE};
 use crate::experiment::train_run::{load_checkpoint, RunError, RunManifest, CHECKPOINT, CONFIG};
 use crate::nn::safetensors_io::to_safetensors_bytes;
 use std::path::{Path, PathBuf};
@@ -26,12 +26,54 @@ pub enum ExportError {
     },
     #[error(transparent)]
     Manifest(#[from] ManifestError),
+    #[error("{dir}: holds {file}, which is not part of a policy export; choose an empty or new --out directory")]
+    NotAPolicyDir { dir: PathBuf, file: String },
+    #[error("{path}: {message}")]
+    Io { path: PathBuf, message: String },
+}
+
+/// Whether `name` is a file an export writes (or its atomic-write temp file).
+fn is_export_file(name: &str) -> bool {
+    let name = name.strip_prefix('.').unwrap_or(name);
+    let base = name.split(".safetensors").next().unwrap_or(name);
+    name == MANIFEST_FILE
+        || name.starts_with(&format!("{MANIFEST_FILE}."))
+        || (base.starts_with("agent-")
+            && base[6..].chars().all(|c| c.is_ascii_digit())
+            && name.contains(".safetensors"))
+}
+
+/// Check that `out` is new, empty, or an earlier export (only its files), so exporting over it
+/// never mixes with or deletes someone else's files. Returns the earlier export's files.
+fn previous_export_files(out: &Path) -> Result<Vec<PathBuf>, ExportError> {
+    let io = |e: std::io::Error| ExportError::Io {
+        path: out.to_path_buf(),
+        message: e.to_string(),
+    };
+    let entries = match std::fs::read_dir(out) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        other => other.map_err(io)?,
+    };
+    let mut files = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(io)?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !is_export_file(&name) || !entry.file_type().map_err(io)?.is_file() {
+            return Err(ExportError::NotAPolicyDir {
+                dir: out.to_path_buf(),
+                file: name,
+            });
+        }
+        files.push(entry.path());
+    }
+    Ok(files)
 }
 
 /// Export the run in `run_dir` (its `config.toml` and `checkpoint.bin`) to the policy directory
 /// `out`. The checkpoint's nets are exported as they are: a run still training exports its
 /// current nets (`episodes_trained` in the manifest says how far it got).
 pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
+    let previous = previous_export_files(out)?;
     let config_path = run_dir.join(CONFIG);
     let run_config = |message: String| ExportError::RunConfig {
         path: config_path.clone(),
@@ -73,12 +115,50 @@ pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
         episodes_trained: trainer.episodes(),
         config: serde_json::to_value(config).map_err(|e| run_config(e.to_string()))?,
     };
-    Ok(Manifest::write_policy(
+    let manifest = Manifest::write_policy(
         out,
         crate::algos::trainer::env_spec(config),
         config.discount,
         Architecture::ddrqn(mlp, hidden),
         info,
         &weights,
-    )?)
+    )?;
+    // An earlier export with more agents would leave weight files the manifest no longer names.
+    let current: Vec<PathBuf> = std::iter::once(out.join(MANIFEST_FILE))
+        .chain(manifest.agents.iter().map(|a| out.join(&a.weights)))
+        .collect();
+    for stale in previous.iter().filter(|p| !current.contains(p)) {
+        std::fs::remove_file(stale).map_err(|e| ExportError::Io {
+            path: stale.clone(),
+            message: e.to_string(),
+        })?;
+    }
+    Ok(manifest)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_new_empty_or_earlier_export_directories_are_written_over() {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(previous_export_files(&dir.path().join("new"))
+            .unwrap()
+            .is_empty());
+        assert!(previous_export_files(dir.path()).unwrap().is_empty());
+        for f in [
+            "manifest.json",
+            "agent-0.safetensors",
+            "agent-2.safetensors",
+        ] {
+            std::fs::write(dir.path().join(f), b"x").unwrap();
+        }
+        assert_eq!(previous_export_files(dir.path()).unwrap().len(), 3);
+        std::fs::write(dir.path().join("notes.txt"), b"mine").unwrap();
+        let err = previous_export_files(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("notes.txt"), "{err}");
+        assert!(is_export_file(".agent-1.safetensors.123.tmp"));
+        assert!(!is_export_file("agent-x.safetensors"));
+    }
 }

@@ -15,9 +15,11 @@
 //!              "obs_size": 5, "obs_names": [...], "n_actions": 8, "action_names": [...]}, ...]}
 //! ```
 
+use crate::deploy::architecture::LEAKY_RELU_SLOPE;
 use crate::deploy::architecture::{Architecture, WeightsError};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::experiment::atomic::write_atomic;
+use crate::experiment::bounded_read::read_regular_file;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -166,6 +168,11 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
+/// Largest manifest.json read (a manifest is a few kilobytes).
+const MAX_MANIFEST_BYTES: u64 = 1 << 20;
+/// Room for a weight file's JSON header beyond its tensor data.
+const MAX_SAFETENSORS_HEADER_BYTES: u64 = 1 << 16;
+
 fn io_err(path: &Path, e: impl std::fmt::Display) -> ManifestError {
     ManifestError::Io {
         path: path.to_path_buf(),
@@ -259,7 +266,8 @@ impl Manifest {
     /// [`Self::verify_agent`]).
     pub fn read(dir: &Path) -> Result<Manifest, ManifestError> {
         let path = dir.join(MANIFEST_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| io_err(&path, e))?;
+        let bytes = read_regular_file(&path, MAX_MANIFEST_BYTES).map_err(|e| io_err(&path, e))?;
+        let text = String::from_utf8(bytes).map_err(|e| io_err(&path, e))?;
         let manifest: Manifest = serde_json::from_str(&text).map_err(|e| ManifestError::Parse {
             path: path.clone(),
             message: e.to_string(),
@@ -286,6 +294,15 @@ impl Manifest {
             return Err(ManifestError::InvalidValue {
                 key: "discount",
                 reason: format!("must be in (0, 1], got {}", self.discount),
+            });
+        }
+        if self.architecture.leaky_relu_slope != LEAKY_RELU_SLOPE {
+            return Err(ManifestError::InvalidValue {
+                key: "architecture.leaky_relu_slope",
+                reason: format!(
+                    "the nets here use {LEAKY_RELU_SLOPE}, the manifest says {}",
+                    self.architecture.leaky_relu_slope
+                ),
             });
         }
         for (key, value) in [
@@ -390,7 +407,16 @@ impl Manifest {
                 n_agents: self.agents.len(),
             })?;
         let path = dir.join(&entry.weights);
-        let bytes = std::fs::read(&path).map_err(|e| io_err(&path, e))?;
+        // Refuse a FIFO, a device or an oversized file before reading it: the architecture says
+        // how big the file can be.
+        let floats: usize = self
+            .architecture
+            .tensors(entry.obs_size, entry.n_actions)
+            .iter()
+            .map(|(_, shape)| shape.iter().product::<usize>())
+            .sum();
+        let max = floats as u64 * 4 + MAX_SAFETENSORS_HEADER_BYTES;
+        let bytes = read_regular_file(&path, max).map_err(|e| io_err(&path, e))?;
         let got = sha256_hex(&bytes);
         if got != entry.sha256 {
             return Err(ManifestError::Checksum {
@@ -676,5 +702,41 @@ mod tests {
             ),
             "{err}"
         );
+    }
+
+    #[test]
+    fn weight_files_that_are_not_regular_or_too_big_are_refused_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        export(dir.path());
+        let manifest = Manifest::read(dir.path()).unwrap();
+        let weights = dir.path().join("agent-0.safetensors");
+        let mut bytes = std::fs::read(&weights).unwrap();
+        bytes.resize(bytes.len() + (1 << 20), 0);
+        std::fs::write(&weights, &bytes).unwrap();
+        let err = manifest
+            .verify_agent(dir.path(), 0)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("at most"), "{err}");
+        std::fs::remove_file(&weights).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(&weights).status();
+        if made.is_ok_and(|s| s.success()) {
+            let err = manifest
+                .verify_agent(dir.path(), 0)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("not a regular file"), "{err}");
+        }
+    }
+
+    #[test]
+    fn a_leaky_relu_slope_other_than_the_nets_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        export(dir.path());
+        rewrite_manifest(dir.path(), |v| {
+            v["architecture"]["leaky_relu_slope"] = 0.2.into()
+        });
+        let err = Manifest::read(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("leaky_relu_slope"), "{err}");
     }
 }

@@ -65,15 +65,19 @@ impl AgentPolicy for MockPolicy {
             "mock policy: wrong observation length"
         );
         assert_eq!(q.len(), self.n_actions, "mock policy: wrong Q length");
-        self.calls += 1;
-        for (k, (state, q)) in self.state.iter_mut().zip(q.iter_mut()).enumerate() {
+        let calls = self.calls + 1;
+        for (k, (state, q)) in self.state.iter().zip(q.iter_mut()).enumerate() {
             let mut drive = weight(self.salt, k, 0);
             for (j, &x) in obs.iter().enumerate() {
                 drive += weight(self.salt, k, j + 1) * x;
             }
-            let beat = 2.0 * ((self.calls * (k as u64 + 1)) % 5) as f32;
-            *state = 0.5 * *state + drive + beat;
-            *q = *state;
+            let beat = 2.0 * ((calls * (k as u64 + 1)) % 5) as f32;
+            *q = 0.5 * *state + drive + beat;
+        }
+        // As the trait asks: a non-finite step leaves the state as it was.
+        if q.iter().all(|v| v.is_finite()) {
+            self.calls = calls;
+            self.state.copy_from_slice(q);
         }
     }
 }

@@ -11,6 +11,7 @@
 //! any policy directory's greedy episodes in-process, exactly as deployment does.
 
 pub mod architecture;
+pub mod deadline;
 pub mod driver;
 pub mod export;
 pub mod import;
@@ -44,8 +45,10 @@ pub trait AgentPolicy: Send {
     /// Zero the hidden state, as at the start of an episode.
     fn reset(&mut self);
     /// Q-values of every macro-action for `obs` (length [`Self::obs_len`]) written into `q`
-    /// (length [`Self::n_actions`]); advances the hidden state by one macro-step. Callers check
-    /// both lengths first; an implementation may panic on wrong lengths.
+    /// (length [`Self::n_actions`]); advances the hidden state by one macro-step, but only when
+    /// every Q-value (and the new state) is finite: a non-finite answer is refused by the robot,
+    /// and the refused step must leave the hidden state exactly as it was. Callers check both
+    /// lengths first; an implementation may panic on wrong lengths.
     fn q_values(&mut self, obs: &[f32], q: &mut [f32]);
 }
 

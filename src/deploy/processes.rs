@@ -6,7 +6,7 @@
 //! Started with `--exit-on-stdin-close`, it exits when its stdin closes, so robots never outlive
 //! a deployment that was killed.
 
-use crate::deploy::driver::{run_episodes, DeployError, EpisodeTrace};
+use crate::deploy::driver::{run_episode, DeployError, EpisodeTrace};
 use crate::deploy::link::JsonLink;
 use crate::deploy::manifest::Manifest;
 use crate::envs::EnvRng;
@@ -167,6 +167,40 @@ pub fn deploy_with_processes(
     rng: &mut EnvRng,
     timeout: Duration,
 ) -> Result<Vec<EpisodeTrace>, DeployError> {
+    let mut traces = Vec::with_capacity(episodes.min(4096));
+    deploy_streaming(
+        exe,
+        policy_dir,
+        manifest,
+        extra_args,
+        episodes,
+        rng,
+        timeout,
+        |trace| {
+            traces.push(trace);
+            Ok(())
+        },
+    )?;
+    Ok(traces)
+}
+
+/// [`deploy_with_processes`], handing each episode to `on_episode` as soon as it ends instead of
+/// keeping them all: memory stays one episode's worth, and a killed deployment has already
+/// reported every finished episode.
+#[allow(clippy::too_many_arguments)]
+pub fn deploy_streaming<F>(
+    exe: &Path,
+    policy_dir: &Path,
+    manifest: &Manifest,
+    extra_args: &[String],
+    episodes: usize,
+    rng: &mut EnvRng,
+    timeout: Duration,
+    mut on_episode: F,
+) -> Result<(), DeployError>
+where
+    F: FnMut(EpisodeTrace) -> Result<(), DeployError>,
+{
     let mut env = manifest
         .env
         .build()
@@ -188,10 +222,18 @@ pub fn deploy_with_processes(
                 .map_err(|source| DeployError::Link { agent, source })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let traces = run_episodes(&mut env, &mut links, manifest.discount, episodes, rng);
+    let result = (0..episodes).try_for_each(|k| {
+        on_episode(run_episode(
+            &mut env,
+            &mut links,
+            manifest.discount,
+            rng,
+            k,
+        )?)
+    });
     drop(links);
     drop(processes);
-    traces
+    result
 }
 
 #[cfg(test)]

@@ -89,7 +89,7 @@ pub enum ProtocolError {
     },
     #[error("obs[{index}] = {value} is not a finite 32-bit number")]
     NonFiniteObs { index: usize, value: f64 },
-    #[error("the policy produced a non-finite Q-value ({value} for macro-action {action}); its weights are broken")]
+    #[error("the policy produced a non-finite Q-value ({value} for macro-action {action}) for this observation (values too large for the net?); the hidden state is unchanged")]
     NonFiniteQ { action: usize, value: f32 },
 }
 

@@ -13,13 +13,20 @@ use std::sync::Arc;
 pub struct QNetPolicy {
     net: Arc<QNet>,
     state: LstmState,
+    /// Where a step is computed; it becomes the state only if everything came out finite.
+    candidate: LstmState,
 }
 
 impl QNetPolicy {
     /// The net with a zero hidden state.
     pub fn new(net: Arc<QNet>) -> Self {
         let state = net.zero_state();
-        QNetPolicy { net, state }
+        let candidate = net.zero_state();
+        QNetPolicy {
+            net,
+            state,
+            candidate,
+        }
     }
 }
 
@@ -34,7 +41,14 @@ impl AgentPolicy for QNetPolicy {
         self.state.reset();
     }
     fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
-        q.copy_from_slice(self.net.act_step(obs, &mut self.state));
+        // A huge but finite observation can overflow the LSTM: keep the old state then, so one
+        // bad message does not break the rest of the session.
+        self.candidate.copy_from(&self.state);
+        q.copy_from_slice(self.net.act_step(obs, &mut self.candidate));
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        if finite(q) && finite(self.candidate.h()) && finite(self.candidate.c()) {
+            std::mem::swap(&mut self.state, &mut self.candidate);
+        }
     }
 }
 
@@ -226,5 +240,33 @@ mod tests {
             distinct_actions.extend(steps.iter().map(|(a, _)| a.clone()));
         }
         assert!(distinct_actions.len() > 1, "{distinct_actions:?}");
+    }
+
+    #[test]
+    fn an_overflowing_observation_leaves_the_hidden_state_exactly_as_it_was() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let cfg = QNetConfig {
+            input: 5,
+            mlp: 8,
+            hidden: 6,
+            output: 4,
+        };
+        let net = Arc::new(QNet::new(cfg, &mut rng));
+        let (a, b) = ([0.5, -1.0, 0.0, 1.0, 0.25], [1.0, 0.0, 1.0, 0.0, -0.5]);
+        let mut q = [0.0; 4];
+        let mut reference = QNetPolicy::new(net.clone());
+        reference.q_values(&a, &mut q);
+        reference.q_values(&b, &mut q);
+        let expected = q;
+
+        let mut policy = QNetPolicy::new(net);
+        policy.q_values(&a, &mut q);
+        policy.q_values(&[3.4e38; 5], &mut q);
+        assert!(
+            q.iter().any(|v| !v.is_finite()),
+            "the probe must overflow: {q:?}"
+        );
+        policy.q_values(&b, &mut q);
+        assert_eq!(q, expected);
     }
 }

@@ -2,6 +2,7 @@
 //! hidden state) per connection, a bounded number of connections, bounded lines. A client that
 //! misbehaves or vanishes affects only its own connection.
 
+use crate::deploy::deadline::DeadlineStream;
 use crate::deploy::line_reader::MAX_LINE_BYTES;
 use crate::deploy::protocol::Reply;
 use crate::deploy::robot::{serve_stream, RobotError, RobotSpec, Session};
@@ -18,6 +19,9 @@ use std::time::Duration;
 /// net.
 pub type PolicyFactory = Arc<dyn Fn() -> Box<dyn AgentPolicy> + Send + Sync>;
 
+/// Default idle timeout of a TCP robot connection, in seconds.
+pub const DEFAULT_IDLE_TIMEOUT_SECS: u64 = 300;
+
 /// Resource bounds of a robot server.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Limits {
@@ -25,8 +29,12 @@ pub struct Limits {
     pub max_line_bytes: usize,
     /// Connections served at once; one more gets an error reply and is closed (default 16).
     pub max_connections: usize,
-    /// Close a connection that sends nothing for this long (default: never; a robot may idle).
+    /// Close a connection that sends nothing between lines for this long (default 300 s, so
+    /// silent clients cannot hold every slot; `None`: never).
     pub idle_timeout: Option<Duration>,
+    /// Close a connection whose request line, once started, takes longer than this to arrive
+    /// (default 10 s), so a trickling client cannot hold a slot either.
+    pub line_timeout: Duration,
     /// Close a connection whose client stops reading replies for this long (default 10 s).
     pub write_timeout: Option<Duration>,
 }
@@ -36,7 +44,8 @@ impl Default for Limits {
         Limits {
             max_line_bytes: MAX_LINE_BYTES,
             max_connections: 16,
-            idle_timeout: None,
+            idle_timeout: Some(Duration::from_secs(DEFAULT_IDLE_TIMEOUT_SECS)),
+            line_timeout: Duration::from_secs(10),
             write_timeout: Some(Duration::from_secs(10)),
         }
     }
@@ -202,10 +211,13 @@ fn serve_connection(
 ) {
     // Replies are small and awaited one by one: send them at once (no Nagle delay).
     let _ = stream.set_nodelay(true);
-    let _ = stream.set_read_timeout(limits.idle_timeout);
     let _ = stream.set_write_timeout(limits.write_timeout);
     let reader = match stream.try_clone() {
-        Ok(s) => BufReader::new(s),
+        Ok(s) => BufReader::new(DeadlineStream::new(
+            s,
+            limits.idle_timeout,
+            limits.line_timeout,
+        )),
         Err(e) => return refuse(stream, &format!("robot cannot serve this connection: {e}")),
     };
     let mut session = match Session::new(factory(), spec) {
@@ -234,7 +246,7 @@ mod tests {
     use crate::envs::EnvSpec;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-    use std::io::{BufRead, BufReader};
+    use std::io::{BufRead, BufReader, Read};
     use std::time::Instant;
 
     const OBS: usize = 5;
@@ -591,6 +603,43 @@ mod tests {
             std::thread::sleep(Duration::from_millis(10));
         }
         assert!(matches!(b.ask(r#"{"type":"info"}"#), Reply::Info { .. }));
+    }
+
+    #[test]
+    fn a_client_trickling_one_line_byte_by_byte_is_closed_at_the_line_deadline() {
+        let server = start(Limits {
+            idle_timeout: Some(Duration::from_secs(5)),
+            line_timeout: Duration::from_millis(300),
+            ..Limits::default()
+        });
+        let mut slow = TcpStream::connect(server.local_addr()).unwrap();
+        let t0 = Instant::now();
+        let mut closed = false;
+        // One byte every 50 ms, never a newline: each byte resets an idle timer, not the line's.
+        for _ in 0..100 {
+            if slow.write_all(b" ").is_err() {
+                closed = true;
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        if !closed {
+            slow.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+            let mut buf = [0u8; 64];
+            closed = matches!(slow.read(&mut buf), Ok(0) | Err(_));
+        }
+        assert!(closed, "the trickling client kept its connection");
+        assert!(t0.elapsed() < Duration::from_secs(10));
+    }
+
+    #[test]
+    fn limits_have_finite_default_timeouts() {
+        let l = Limits::default();
+        assert_eq!(
+            l.idle_timeout,
+            Some(Duration::from_secs(DEFAULT_IDLE_TIMEOUT_SECS))
+        );
+        assert!(l.line_timeout > Duration::ZERO);
     }
 
     #[test]

@@ -57,6 +57,8 @@ pub enum ReplayError {
         #[source]
         source: EnvError,
     },
+    #[error("writing the replay: {0}")]
+    Output(#[from] std::io::Error),
 }
 
 /// Parse a replay file's text. Only the shape is checked here; actions are checked while
@@ -124,6 +126,35 @@ fn all_obs<E: MacroEnv>(env: &E) -> Vec<Vec<f32>> {
 /// whole file is checked (row lengths up front, free agents' entries as they are reached) before
 /// anything is returned, so a bad file yields an error and no partial output.
 pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayError> {
+    let mut frames = Vec::new();
+    let unused_steps = walk(file, pictures, &mut |f| {
+        frames.push(f);
+        Ok(())
+    })?;
+    Ok(Replay {
+        frames,
+        unused_steps,
+    })
+}
+
+/// [`run_replay`] without keeping the frames: each is handed to `on_frame` in order, so memory
+/// stays one frame's worth however long the log. The file is first replayed once without output,
+/// so a bad file still yields an error and no partial output. Returns the unused rows of `steps`.
+pub fn stream_replay(
+    file: &ReplayFile,
+    pictures: bool,
+    on_frame: &mut dyn FnMut(ReplayFrame) -> Result<(), ReplayError>,
+) -> Result<usize, ReplayError> {
+    walk(file, false, &mut |_| Ok(()))?;
+    walk(file, pictures, on_frame)
+}
+
+/// The replay loop: every frame to `on_frame`; returns the unused rows of `steps`.
+fn walk(
+    file: &ReplayFile,
+    pictures: bool,
+    on_frame: &mut dyn FnMut(ReplayFrame) -> Result<(), ReplayError>,
+) -> Result<usize, ReplayError> {
     let mut env = file.spec.build().map_err(ReplayError::Build)?;
     let n_agents = env.n_agents();
     if let Some((k, row)) = file
@@ -141,7 +172,7 @@ pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayErr
     let mut rng = EnvRng::seed_from_u64(REPLAY_SEED);
     env.reset(&mut rng);
     let picture = |env: &super::AnyEnv| pictures.then(|| env.render_ascii());
-    let mut frames = vec![ReplayFrame {
+    on_frame(ReplayFrame {
         line: ReplayLine {
             t: 0,
             executed: None,
@@ -151,7 +182,7 @@ pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayErr
             mac_done: None,
         },
         picture: picture(&env),
-    }];
+    })?;
     let mut actions = vec![0usize; n_agents];
     let mut used = 0;
     for (k, row) in file.steps.iter().enumerate() {
@@ -176,7 +207,7 @@ pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayErr
             .step(&actions, &mut rng)
             .map_err(|source| ReplayError::Step { step, source })?;
         used += 1;
-        frames.push(ReplayFrame {
+        on_frame(ReplayFrame {
             line: ReplayLine {
                 t: env.t(),
                 executed: Some(env.executed().to_vec()),
@@ -186,15 +217,12 @@ pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayErr
                 mac_done: Some(env.mac_done().iter().map(|&d| u8::from(d)).collect()),
             },
             picture: picture(&env),
-        });
+        })?;
         if out.done {
             break;
         }
     }
-    Ok(Replay {
-        frames,
-        unused_steps: file.steps.len() - used,
-    })
+    Ok(file.steps.len() - used)
 }
 
 #[cfg(test)]
@@ -288,5 +316,31 @@ mod tests {
         let replay = run_replay(&file, false).unwrap();
         assert_eq!(replay.frames.len(), 4);
         assert_eq!(replay.frames[3].line.executed, Some(vec![2, 7]));
+    }
+
+    #[test]
+    fn streaming_gives_the_frames_of_run_replay_and_nothing_for_a_bad_file() {
+        let text = r#"{"env": "box-pushing", "grid": 10, "horizon": 30, "steps": [[0, 1], [2, 3], [4, 4], [1, 1]]}"#;
+        let file = parse_replay(text).unwrap();
+        let whole = run_replay(&file, true).unwrap();
+        let mut streamed = Vec::new();
+        let unused = stream_replay(&file, true, &mut |f| {
+            streamed.push(f);
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(streamed, whole.frames);
+        assert_eq!(unused, whole.unused_steps);
+        // A bad action (checked only once the t = 0 frame exists): no frame is emitted at all.
+        let bad =
+            r#"{"env": "box-pushing", "grid": 10, "horizon": 30, "steps": [[99, 99], [0, 0]]}"#;
+        let file = parse_replay(bad).unwrap();
+        let mut n = 0;
+        assert!(stream_replay(&file, false, &mut |_| {
+            n += 1;
+            Ok(())
+        })
+        .is_err());
+        assert_eq!(n, 0);
     }
 }

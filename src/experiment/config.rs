@@ -8,7 +8,9 @@
 
 use crate::algos::hyper::{paper_defaults, EnvName, RunConfig};
 use crate::algos::method::Method;
-use crate::experiment::seeds::{parse_seeds, SeedsError};
+use crate::experiment::limits;
+use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
+use crate::experiment::seeds::{check_seed_list, parse_seeds, SeedsError};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -35,8 +37,31 @@ pub enum ConfigError {
     Seeds { path: PathBuf, source: SeedsError },
     #[error("--set `{0}`: expected key=value, e.g. total_epi=300 or dec-hddrqn.init_h=0.3")]
     BadSet(String),
+    #[error("--set `{item}`: {message}")]
+    BadSetValue { item: String, message: String },
     #[error("{path}: no methods to run")]
     NoMethods { path: PathBuf },
+    #[error("{path}: {source} (set `name = \"...\"` in the file)")]
+    BadName { path: PathBuf, source: NameError },
+    #[error("{path}: {what} `{value}` is listed twice; each run must appear once")]
+    Duplicate {
+        path: PathBuf,
+        what: &'static str,
+        value: String,
+    },
+    #[error("{path}: {method} sweep points `{a}` and `{b}` resolve to the same config; list each value once")]
+    DuplicatePoint {
+        path: PathBuf,
+        method: &'static str,
+        a: String,
+        b: String,
+    },
+    #[error("{path}: the experiment expands to {count} runs, at most {max} allowed (fewer seeds or sweep values)")]
+    TooManyRuns {
+        path: PathBuf,
+        count: String,
+        max: usize,
+    },
 }
 
 /// The experiment file as written: name, methods, seeds, shared params, per-method overrides.
@@ -176,17 +201,26 @@ impl Experiment {
         if methods.is_empty() {
             return Err(ConfigError::NoMethods { path: p() });
         }
+        for (i, m) in methods.iter().enumerate() {
+            if methods[..i].contains(m) {
+                return Err(ConfigError::Duplicate {
+                    path: p(),
+                    what: "method",
+                    value: m.name().to_string(),
+                });
+            }
+        }
+        let name = file.name.unwrap_or_else(|| default_name.to_string());
+        check_experiment_name(&name)
+            .map_err(|source| ConfigError::BadName { path: p(), source })?;
         let seeds = match (&overrides.seeds, file.seeds) {
             (Some(s), _) => s.clone(),
             (None, Some(SeedsField::Text(t))) => {
                 parse_seeds(&t).map_err(|source| ConfigError::Seeds { path: p(), source })?
             }
-            (None, Some(SeedsField::List(l))) if !l.is_empty() => l,
-            (None, Some(SeedsField::List(_))) => {
-                return Err(ConfigError::Seeds {
-                    path: p(),
-                    source: SeedsError::Empty("[]".into()),
-                })
+            (None, Some(SeedsField::List(l))) => {
+                check_seed_list(&l).map_err(|source| ConfigError::Seeds { path: p(), source })?;
+                l
             }
             (None, None) => vec![0],
         };
@@ -204,9 +238,10 @@ impl Experiment {
             let (key, value) = parse_set(item)?;
             match key.split_once('.') {
                 Some((m, k)) => {
-                    let m = m
-                        .parse::<Method>()
-                        .map_err(|_| ConfigError::BadSet(item.clone()))?;
+                    let m = m.parse::<Method>().map_err(|e| ConfigError::BadSetValue {
+                        item: item.clone(),
+                        message: e.to_string(),
+                    })?;
                     per_method
                         .entry(m)
                         .or_default()
@@ -232,18 +267,12 @@ impl Experiment {
                     "`{curve}` is not one of this experiment's methods"
                 )));
             }
-            let plain = !home.is_empty()
-                && home
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
-            if !plain {
-                return Err(bad(format!(
-                    "expected an experiment name (letters, digits, `_`, `-`), got {home:?}"
-                )));
+            if let Err(e) = check_experiment_name(home) {
+                return Err(bad(format!("expected an experiment name: {e}")));
             }
         }
         let exp = Experiment {
-            name: file.name.unwrap_or_else(|| default_name.to_string()),
+            name,
             methods,
             seeds,
             shared_curves: file.shared_curves,
@@ -251,31 +280,76 @@ impl Experiment {
             params,
             per_method,
         };
-        // Resolve every run once now, so a typo fails before any run starts.
+        // Resolve every run once now, so a typo fails before any run starts; sections of methods
+        // not selected are checked too, so a typo there is not silently kept for a later run.
         exp.runs()?;
+        for &method in exp.per_method.keys() {
+            if !exp.methods.contains(&method) {
+                exp.method_points(method)?;
+            }
+        }
         Ok(exp)
+    }
+
+    /// One method's sweep points: (variant name, resolved config), checked and deduplicated.
+    fn method_points(&self, method: Method) -> Result<Vec<(String, RunConfig)>, ConfigError> {
+        let mut table = self.params.clone();
+        if let Some(extra) = self.per_method.get(&method) {
+            for (k, v) in extra {
+                table.insert(k.clone(), v.clone());
+            }
+        }
+        let mut points: Vec<(String, RunConfig)> = Vec::new();
+        // Keyed by the resolved config's TOML text: `1e-3` and `0.001`, or `1` and `1.0`, are
+        // one point and would race in one directory's worth of work twice.
+        let mut seen: std::collections::HashMap<String, String> = Default::default();
+        for (variant, point) in expand_grid(&self.path, &table)? {
+            let config = resolve(&self.path, method, &point)?;
+            let key = toml::to_string(&config).expect("RunConfig serializes to TOML");
+            if let Some(other) = seen.insert(key, variant.clone()) {
+                return Err(ConfigError::DuplicatePoint {
+                    path: self.path.clone(),
+                    method: method.name(),
+                    a: other,
+                    b: variant,
+                });
+            }
+            points.push((variant, config));
+        }
+        Ok(points)
     }
 
     /// Every (method, sweep point, seed) run, methods outermost, seeds innermost.
     pub fn runs(&self) -> Result<Vec<RunSpec>, ConfigError> {
         let mut runs = Vec::new();
         for &method in &self.methods {
-            let mut table = self.params.clone();
-            if let Some(extra) = self.per_method.get(&method) {
-                for (k, v) in extra {
-                    table.insert(k.clone(), v.clone());
-                }
+            let points = self.method_points(method)?;
+            let count = runs.len() as u128 + points.len() as u128 * self.seeds.len() as u128;
+            if count > limits::MAX_RUNS as u128 {
+                return Err(ConfigError::TooManyRuns {
+                    path: self.path.clone(),
+                    count: format!("at least {count}"),
+                    max: limits::MAX_RUNS,
+                });
             }
-            for (variant, point) in expand_grid(&table) {
-                let config = resolve(&self.path, method, &point)?;
-                // A shared curve's runs live (and are identified) under the experiment they
-                // belong to; their resolved config must match that experiment's, or the run
-                // directory refuses them.
-                let experiment = self
-                    .shared_curves
-                    .get(method.name())
-                    .unwrap_or(&self.name)
-                    .clone();
+            // A shared curve's runs live (and are identified) under the experiment they belong
+            // to; their resolved config must match that experiment's, or the run directory
+            // refuses them.
+            let experiment = self
+                .shared_curves
+                .get(method.name())
+                .unwrap_or(&self.name)
+                .clone();
+            for (variant, config) in points {
+                let curve = if variant.is_empty() {
+                    method.name().to_string()
+                } else {
+                    format!("{}@{variant}", method.name())
+                };
+                check_curve_name(&curve).map_err(|source| ConfigError::BadName {
+                    path: self.path.clone(),
+                    source,
+                })?;
                 for &seed in &self.seeds {
                     runs.push(RunSpec {
                         experiment: experiment.clone(),
@@ -315,16 +389,62 @@ fn parse_set(item: &str) -> Result<(String, toml::Value), ConfigError> {
         return Err(ConfigError::BadSet(item.to_string()));
     }
     // Read the value as TOML (numbers, booleans, lists); a bare word is a string.
-    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
+    let parsed = toml::from_str::<toml::Table>(&format!("v = {raw}"))
         .ok()
-        .and_then(|mut t| t.remove("v"))
-        .unwrap_or_else(|| toml::Value::String(raw.trim().to_string()));
+        .and_then(|mut t| t.remove("v"));
+    let word = raw.trim();
+    let value = match parsed {
+        Some(v) => v,
+        // A number TOML cannot hold is not a string the user meant.
+        None if looks_numeric(word) => {
+            return Err(ConfigError::BadSetValue {
+                item: item.to_string(),
+                message: format!(
+                    "`{word}` is not a number this config can hold (integers are at most {})",
+                    i64::MAX
+                ),
+            })
+        }
+        None => toml::Value::String(word.to_string()),
+    };
     Ok((key.to_string(), value))
 }
 
+/// Whether `word` is written like a number (digits with an optional sign, point or exponent).
+fn looks_numeric(word: &str) -> bool {
+    let w = word.trim_start_matches(['+', '-']);
+    w.starts_with(|c: char| c.is_ascii_digit())
+        && w.chars()
+            .all(|c| c.is_ascii_digit() || "._eE+-".contains(c))
+}
+
 /// Expand list-valued keys into the grid of their combinations (keys sorted by
-/// name, so variant names are stable). Each point is named by its swept keys.
-fn expand_grid(table: &toml::Table) -> Vec<(String, toml::Table)> {
+/// name, so variant names are stable). Each point is named by its swept keys. An empty list and
+/// a grid beyond [`limits::MAX_RUNS`] points are refused before anything is expanded.
+fn expand_grid(
+    path: &Path,
+    table: &toml::Table,
+) -> Result<Vec<(String, toml::Table)>, ConfigError> {
+    let mut size: u128 = 1;
+    for (key, value) in table {
+        if let toml::Value::Array(items) = value {
+            if items.is_empty() {
+                return Err(ConfigError::BadValue {
+                    path: path.to_path_buf(),
+                    key: key.clone(),
+                    message: "an empty list sweeps nothing; give at least one value".into(),
+                });
+            }
+            size = size.saturating_mul(items.len() as u128);
+        }
+    }
+    if size > limits::MAX_RUNS as u128 {
+        return Err(ConfigError::TooManyRuns {
+            path: path.to_path_buf(),
+            count: format!("{size} sweep points, so at least {size}"),
+            max: limits::MAX_RUNS,
+        });
+    }
     let mut points = vec![(String::new(), toml::Table::new())];
     for (key, value) in table {
         let choices: Vec<toml::Value> = match value {
@@ -352,7 +472,7 @@ fn expand_grid(table: &toml::Table) -> Vec<(String, toml::Table)> {
         }
         points = next;
     }
-    points
+    Ok(points)
 }
 
 fn value_label(v: &toml::Value) -> String {
@@ -380,7 +500,15 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
         None => EnvName::BoxPushing,
     };
     let grid_dim = match point.get("grid_dim") {
-        Some(toml::Value::Integer(n)) if *n > 0 => *n as usize,
+        Some(toml::Value::Integer(n)) if *n > 0 && *n as u64 <= limits::MAX_GRID_DIM as u64 => {
+            *n as usize
+        }
+        Some(toml::Value::Integer(n)) if *n > 0 => {
+            return Err(bad(
+                "grid_dim",
+                format!("must be at most {}, got {n}", limits::MAX_GRID_DIM),
+            ))
+        }
         Some(v) => {
             return Err(bad(
                 "grid_dim",
@@ -408,6 +536,13 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
                 key,
                 format!("expected {}, got {value}", table[key].type_str()),
             ));
+        }
+        // Every integer key is a count or a size: name the key instead of failing the whole
+        // table's conversion below.
+        if let toml::Value::Integer(i) = value {
+            if i < 0 {
+                return Err(bad(key, format!("must be >= 0, got {i}")));
+            }
         }
         table.insert(key.clone(), value);
     }
@@ -450,6 +585,33 @@ fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)>
             format!("Box Pushing needs a grid of at least 8, got {}", c.grid_dim),
         ));
     }
+    if c.env_name == EnvName::BoxPushing && !c.grid_dim.is_multiple_of(2) {
+        return Err((
+            "grid_dim",
+            format!(
+                "Box Pushing needs an even grid (an odd one puts the big box off the cell centres), got {}",
+                c.grid_dim
+            ),
+        ));
+    }
+    if c.start_train == 0 {
+        return Err((
+            "start_train",
+            "must be >= 1: training starts once an episode has been collected".into(),
+        ));
+    }
+    if !c.total_epi.is_multiple_of(c.eval_freq) {
+        return Err((
+            "total_epi",
+            format!(
+                "must be a multiple of eval_freq ({}), got {}: the last {} episodes would never be evaluated",
+                c.eval_freq,
+                c.total_epi,
+                c.total_epi % c.eval_freq
+            ),
+        ));
+    }
+    limits::check_sizes(c)?;
     let unit = [
         ("eps_end", c.eps_end),
         ("discount", c.discount),
@@ -460,6 +622,10 @@ fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)>
         if !(0.0..=1.0).contains(&value) {
             return Err((key, format!("must be in [0, 1], got {value}")));
         }
+    }
+    if c.discount == 0.0 {
+        // Evaluation returns and exported policies need a positive discount.
+        return Err(("discount", "must be in (0, 1], got 0".into()));
     }
     if !(c.l_rate > 0.0 && c.l_rate.is_finite()) {
         return Err((
@@ -599,5 +765,133 @@ mod tests {
         let c = e.runs().unwrap()[0].config.clone();
         let text = toml::to_string(&c).unwrap();
         assert_eq!(toml::from_str::<RunConfig>(&text).unwrap(), c);
+    }
+
+    #[test]
+    fn names_that_are_not_one_safe_path_component_are_refused() {
+        for name in ["../../x", "/abs", "", "a\nb", "..", "a/b", "$(id)"] {
+            let text = format!("name = {}", toml::Value::String(name.into()));
+            let err = parse(&text, &[]).unwrap_err();
+            assert!(
+                matches!(err, ConfigError::BadName { .. }),
+                "{name:?}: {err}"
+            );
+        }
+        // The default name comes from the file name: a name with a space is refused too.
+        let o = Overrides::default();
+        let err = Experiment::parse("", Path::new("my exp.toml"), "my exp", &o).unwrap_err();
+        assert!(err.to_string().contains("name = "), "{err}");
+    }
+
+    #[test]
+    fn duplicate_runs_are_refused_naming_the_duplicate() {
+        let err = parse("methods = [\"our1\", \"our1\"]", &[]).unwrap_err();
+        assert!(err.to_string().contains("`our1` is listed twice"), "{err}");
+        let err = parse("seeds = [1, 1]", &[]).unwrap_err();
+        assert!(err.to_string().contains("seed 1 appears twice"), "{err}");
+        for sweep in [
+            "trace_len = [5, 5]",
+            "l_rate = [0.001, 1e-3]",
+            "l_rate = [1, 1.0]",
+        ] {
+            let err = parse(&format!("[params]\n{sweep}"), &[]).unwrap_err();
+            assert!(
+                matches!(err, ConfigError::DuplicatePoint { .. }),
+                "{sweep}: {err}"
+            );
+        }
+        let o = Overrides {
+            methods: Some(vec![Method::Our1, Method::Our1]),
+            ..Default::default()
+        };
+        assert!(Experiment::parse("", Path::new("t.toml"), "t", &o).is_err());
+    }
+
+    #[test]
+    fn sweeps_are_bounded_and_never_empty() {
+        let err = parse("[params]\ntrace_len = []", &[]).unwrap_err();
+        assert!(
+            err.to_string().contains("`trace_len`: an empty list"),
+            "{err}"
+        );
+        // 10^12 points: refused from the list lengths alone, at once.
+        let keys = [
+            "trace_len",
+            "batch_size",
+            "train_freq",
+            "eval_num_epi",
+            "dec_mlp_layer_size",
+            "dec_rnn_h_size",
+            "cen_mlp_layer_size",
+            "cen_rnn_h_size",
+            "h_stable_at",
+            "eps_l_d_steps",
+            "target_update_freq",
+            "sub_trace_len",
+        ];
+        let mut text = String::from("[params]\n");
+        for k in keys {
+            text.push_str(&format!("{k} = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n"));
+        }
+        let t0 = std::time::Instant::now();
+        let err = parse(&text, &[]).unwrap_err();
+        assert!(matches!(err, ConfigError::TooManyRuns { .. }), "{err}");
+        assert!(t0.elapsed().as_secs() < 5);
+    }
+
+    #[test]
+    fn sizes_beyond_their_bounds_name_the_key() {
+        for (set, key) in [
+            ("batch_size=100000000", "batch_size"),
+            ("dec_rnn_h_size=1000000", "dec_rnn_h_size"),
+            ("env_terminate_step=10000000000", "env_terminate_step"),
+            ("grid_dim=100000", "grid_dim"),
+        ] {
+            let err = parse("", &[set]).unwrap_err();
+            assert!(
+                err.to_string().contains(&format!("`{key}`")),
+                "{set}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn messages_name_the_real_problem() {
+        let err = parse("[params]\ntotal_epi = -5", &[]).unwrap_err();
+        assert!(
+            err.to_string().contains("`total_epi`: must be >= 0"),
+            "{err}"
+        );
+        let err = parse("", &["total_epi=99999999999999999999999"]).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("not a number this config can hold"),
+            "{err}"
+        );
+        let err = parse("", &["our9.l_rate=1"]).unwrap_err();
+        assert!(err.to_string().contains("our9"), "{err}");
+        assert!(!err.to_string().contains("expected key=value"), "{err}");
+        for (set, key) in [
+            ("grid_dim=11", "grid_dim"),
+            ("start_train=0", "start_train"),
+            ("discount=0", "discount"),
+            ("total_epi=105", "total_epi"),
+        ] {
+            let err = parse("", &[set]).unwrap_err();
+            assert!(
+                err.to_string().contains(&format!("`{key}`")),
+                "{set}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_typo_in_an_unselected_methods_section_is_an_error() {
+        let err = parse(
+            "methods = [\"our1\"]\n[method.dec-hddrqn]\ninit_hh = 0.2",
+            &[],
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("`init_hh`"), "{err}");
     }
 }

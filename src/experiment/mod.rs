@@ -2,8 +2,12 @@
 
 pub mod atomic;
 pub mod audit;
+pub mod bounded_read;
+pub mod checkpoint;
 pub mod config;
+pub mod limits;
 pub mod metrics;
+pub mod names;
 pub mod provenance;
 pub mod report;
 pub mod rollout;

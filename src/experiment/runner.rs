@@ -1,10 +1,14 @@
 //! Runs every (method, variant, seed) of an experiment as its own job, in parallel with rayon.
 //!
 //! Parallelism is across runs only, never inside one run's arithmetic, so `--jobs` never changes
-//! a number. A run that fails (bad numbers, I/O) reports its error and the others carry on; a
-//! finished run is skipped unless `force` is set.
+//! a number. A run that fails (bad numbers, I/O, even a panic) reports its error and the others
+//! carry on. A finished run is skipped unless `force` is set, but only if its `config.toml`
+//! describes the run asked for (provenance aside); a different run in its directory fails that
+//! run, naming the keys that differ.
 
 use crate::experiment::config::RunSpec;
+use crate::experiment::limits::worker_threads;
+use crate::experiment::train_run::{existing_run, Existing};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -18,7 +22,7 @@ pub const FINISHED_MARKER: &str = "finished";
 pub struct RunnerOptions {
     /// Root of the results tree (`results/` by default).
     pub out: PathBuf,
-    /// Worker threads; each runs one training run at a time.
+    /// Worker threads; each runs one training run at a time (never more than there are runs).
     pub jobs: usize,
     /// Recompute finished runs instead of skipping them.
     pub force: bool,
@@ -72,14 +76,25 @@ where
     } else {
         ProgressDrawTarget::stderr()
     });
-    let todo: Vec<bool> = runs
+    // What to do with each run: `Ok(true)` train, `Ok(false)` skip (finished, same identity),
+    // `Err` fail at once (another run's results are in its directory).
+    let todo: Vec<Result<bool, String>> = runs
         .iter()
-        .map(|r| opts.force || !r.dir(&opts.out).join(FINISHED_MARKER).exists())
+        .map(|r| {
+            if opts.force {
+                return Ok(true);
+            }
+            match existing_run(r, &r.dir(&opts.out)) {
+                Ok(Existing::Finished) => Ok(false),
+                Ok(_) => Ok(true),
+                Err(e) => Err(e.to_string()),
+            }
+        })
         .collect();
     let total_episodes: u64 = runs
         .iter()
         .zip(&todo)
-        .filter(|(_, &t)| t)
+        .filter(|(_, t)| matches!(t, Ok(true)))
         .map(|(r, _)| r.config.total_epi as u64)
         .sum();
     let total = multi.add(ProgressBar::new(total_episodes));
@@ -90,15 +105,29 @@ where
         .expect("valid template"),
     );
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.jobs.max(1))
+        .num_threads(worker_threads(opts.jobs, runs.len()))
         .build()
         .expect("a rayon pool with at least one thread");
     let statuses = pool.install(|| {
         runs.par_iter()
             .zip(todo.par_iter())
-            .map(|(spec, &todo)| {
-                if !todo {
-                    return RunStatus::Skipped;
+            .map(|(spec, todo)| {
+                let name = format!(
+                    "{}/{}/seed-{}",
+                    spec.experiment,
+                    spec.curve_name(),
+                    spec.seed
+                );
+                match todo {
+                    Ok(true) => {}
+                    Ok(false) => return RunStatus::Skipped,
+                    Err(e) => {
+                        let _ = multi.println(format!("FAILED {name}: {e}"));
+                        if opts.quiet {
+                            eprintln!("FAILED {name}: {e}");
+                        }
+                        return RunStatus::Failed(e.clone());
+                    }
                 }
                 let dir = spec.dir(&opts.out);
                 let bar =
@@ -114,16 +143,21 @@ where
                     last: Arc::default(),
                 };
                 let start = std::time::Instant::now();
-                let result = run_one(spec, &dir, &progress);
+                // A panic is a bug, but it fails this run only, not its neighbours.
+                let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    run_one(spec, &dir, &progress)
+                }))
+                .unwrap_or_else(|panic| {
+                    let what = panic
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                        .unwrap_or_else(|| "unknown".into());
+                    Err(format!("internal error (panic: {what})"))
+                });
                 bar.finish_and_clear();
                 multi.remove(&bar);
                 let seconds = start.elapsed().as_secs_f64();
-                let name = format!(
-                    "{}/{}/seed-{}",
-                    spec.experiment,
-                    spec.curve_name(),
-                    spec.seed
-                );
                 match result {
                     Ok(()) => {
                         if opts.quiet {
@@ -176,18 +210,89 @@ mod tests {
             if spec.seed == 1 {
                 return Err("boom".to_string());
             }
-            std::fs::create_dir_all(dir).unwrap();
-            std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();
+            if spec.seed == 2 {
+                panic!("kaboom");
+            }
+            finish(spec, dir);
             Ok(())
         };
         let first = run_all(&runs, &opts, work);
         assert!(matches!(first[1], RunStatus::Failed(ref e) if e == "boom"));
+        assert!(matches!(first[2], RunStatus::Failed(ref e) if e.contains("kaboom")));
         assert!(first
             .iter()
             .enumerate()
-            .all(|(i, s)| i == 1 || matches!(s, RunStatus::Finished { .. })));
+            .all(|(i, s)| i == 1 || i == 2 || matches!(s, RunStatus::Finished { .. })));
         let second = run_all(&runs, &opts, work);
         assert!(matches!(second[0], RunStatus::Skipped));
         assert!(matches!(second[1], RunStatus::Failed(_)));
+    }
+
+    /// What a finished run leaves: its config.toml and the marker.
+    fn finish(spec: &RunSpec, dir: &Path) {
+        use crate::experiment::train_run::{RunManifest, CONFIG};
+        std::fs::create_dir_all(dir).unwrap();
+        let text = toml::to_string(&RunManifest::for_spec(spec)).unwrap();
+        std::fs::write(dir.join(CONFIG), text).unwrap();
+        std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();
+    }
+
+    #[test]
+    fn a_finished_run_of_another_config_is_refused_naming_the_keys_but_provenance_is_ignored() {
+        use crate::experiment::train_run::CONFIG;
+        let dir = tempfile::tempdir().unwrap();
+        let opts = RunnerOptions {
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            force: false,
+            quiet: true,
+        };
+        let runs = runs(1);
+        let ran = std::sync::atomic::AtomicUsize::new(0);
+        let work = |spec: &RunSpec, dir: &Path, _: &Progress| {
+            ran.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            finish(spec, dir);
+            Ok(())
+        };
+        run_all(&runs, &opts, work);
+        let config = runs[0].dir(dir.path()).join(CONFIG);
+        let text = std::fs::read_to_string(&config).unwrap();
+
+        // Another build and machine: still the same run, skipped.
+        let other_build = text.replace(
+            &format!("git_commit = \"{}\"", env!("MACDEC_GIT_COMMIT")),
+            "git_commit = \"0000000\"",
+        );
+        assert_ne!(other_build, text);
+        std::fs::write(&config, other_build).unwrap();
+        assert!(matches!(run_all(&runs, &opts, work)[0], RunStatus::Skipped));
+
+        // An edited hyperparameter: refused, naming the key, nothing run.
+        let edited = text.replace("trace_len = 15", "trace_len = 10");
+        assert_ne!(edited, text);
+        std::fs::write(&config, edited).unwrap();
+        let before = ran.load(std::sync::atomic::Ordering::Relaxed);
+        let status = run_all(&runs, &opts, work);
+        assert!(
+            matches!(&status[0], RunStatus::Failed(e) if e.contains("trace_len (on disk 10, requested 15)") && e.contains("--force")),
+            "{status:?}"
+        );
+        assert_eq!(ran.load(std::sync::atomic::Ordering::Relaxed), before);
+
+        // Garbage in config.toml: refused too.
+        std::fs::write(&config, "not toml [").unwrap();
+        assert!(matches!(
+            run_all(&runs, &opts, work)[0],
+            RunStatus::Failed(_)
+        ));
+        // --force recomputes.
+        let forced = RunnerOptions {
+            force: true,
+            ..opts.clone()
+        };
+        assert!(matches!(
+            run_all(&runs, &forced, work)[0],
+            RunStatus::Finished { .. }
+        ));
     }
 }

@@ -1,5 +1,6 @@
 //! Run seeds: the `--seeds` syntax, and one random stream per role derived from a run's seed.
 
+use crate::experiment::limits::MAX_SEEDS;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -38,6 +39,8 @@ pub enum SeedsError {
     Empty(String),
     #[error("seeds `{0}`: seed {1} appears twice")]
     Duplicate(String, u64),
+    #[error("seeds `{0}`: {1} seeds, at most {max} allowed", max = crate::experiment::limits::MAX_SEEDS)]
+    TooMany(String, u128),
 }
 
 /// Parse `a..b` (Rust range, end exclusive), `a..=b`, a single seed, or a comma list.
@@ -48,22 +51,54 @@ pub fn parse_seeds(text: &str) -> Result<Vec<u64>, SeedsError> {
             .parse::<u64>()
             .map_err(|_| SeedsError::Syntax(text.to_string()))
     };
-    let seeds: Vec<u64> = if let Some((a, b)) = t.split_once("..=") {
-        (num(a)?..=num(b)?).collect()
-    } else if let Some((a, b)) = t.split_once("..") {
-        (num(a)?..num(b)?).collect()
-    } else {
-        t.split(',').map(num).collect::<Result<_, _>>()?
+    // Ranges are counted (in u128, so `0..=u64::MAX` cannot overflow) before anything is built.
+    let range = |a: u64, end_exclusive: u128| -> Result<Vec<u64>, SeedsError> {
+        let count = end_exclusive.saturating_sub(a as u128);
+        if count > MAX_SEEDS as u128 {
+            return Err(SeedsError::TooMany(text.to_string(), count));
+        }
+        Ok((0..count as u64).map(|i| a + i).collect())
     };
+    let seeds: Vec<u64> = if let Some((a, b)) = t.split_once("..=") {
+        range(num(a)?, num(b)? as u128 + 1)?
+    } else if let Some((a, b)) = t.split_once("..") {
+        range(num(a)?, num(b)? as u128)?
+    } else {
+        let items: Vec<&str> = t.split(',').collect();
+        if items.len() > MAX_SEEDS {
+            return Err(SeedsError::TooMany(text.to_string(), items.len() as u128));
+        }
+        items.into_iter().map(num).collect::<Result<_, _>>()?
+    };
+    check_seed_list_named(&seeds, text)?;
+    Ok(seeds)
+}
+
+/// Check a seed list given as a TOML array: not empty, no repeats, at most
+/// [`MAX_SEEDS`].
+pub fn check_seed_list(seeds: &[u64]) -> Result<(), SeedsError> {
+    let shown = format!("{seeds:?}");
+    let shown = if shown.len() > 60 {
+        format!("{}...]", &shown[..56])
+    } else {
+        shown
+    };
+    check_seed_list_named(seeds, &shown)
+}
+
+fn check_seed_list_named(seeds: &[u64], text: &str) -> Result<(), SeedsError> {
     if seeds.is_empty() {
         return Err(SeedsError::Empty(text.to_string()));
     }
-    let mut sorted = seeds.clone();
+    if seeds.len() > MAX_SEEDS {
+        return Err(SeedsError::TooMany(text.to_string(), seeds.len() as u128));
+    }
+    let mut sorted = seeds.to_vec();
     sorted.sort_unstable();
     if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
         return Err(SeedsError::Duplicate(text.to_string(), w[0]));
     }
-    Ok(seeds)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -88,6 +123,63 @@ mod tests {
             parse_seeds("1,2,1"),
             Err(SeedsError::Duplicate(_, 1))
         ));
+    }
+
+    #[test]
+    fn huge_ranges_are_refused_before_anything_is_allocated() {
+        for t in [
+            "0..100000000",
+            "0..=18446744073709551615",
+            "18446744073709551615..=18446744073709551615x",
+        ] {
+            let r = parse_seeds(t);
+            assert!(
+                matches!(r, Err(SeedsError::TooMany(..) | SeedsError::Syntax(_))),
+                "{t}: {r:?}"
+            );
+        }
+        assert_eq!(
+            parse_seeds("18446744073709551615..=18446744073709551615").unwrap(),
+            vec![u64::MAX]
+        );
+        assert_eq!(
+            parse_seeds(&format!("0..{MAX_SEEDS}")).unwrap().len(),
+            MAX_SEEDS
+        );
+        assert!(parse_seeds(&format!("0..={MAX_SEEDS}")).is_err());
+        assert!(matches!(parse_seeds("5..2"), Err(SeedsError::Empty(_))));
+        assert!(matches!(
+            check_seed_list(&[1, 1]),
+            Err(SeedsError::Duplicate(_, 1))
+        ));
+        assert!(matches!(check_seed_list(&[]), Err(SeedsError::Empty(_))));
+    }
+
+    #[test]
+    fn any_short_text_parses_or_errors_without_panicking() {
+        let alphabet = [
+            "0",
+            "9",
+            ".",
+            "=",
+            ",",
+            " ",
+            "-",
+            "18446744073709551615",
+            "x",
+        ];
+        let mut words = vec![String::new()];
+        for _ in 0..4 {
+            words = words
+                .iter()
+                .flat_map(|w| alphabet.iter().map(move |c| format!("{w}{c}")))
+                .collect();
+            for w in &words {
+                if let Ok(seeds) = parse_seeds(w) {
+                    assert!(!seeds.is_empty() && seeds.len() <= MAX_SEEDS, "{w}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -9,7 +9,8 @@
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
-use crate::experiment::atomic::write_atomic;
+use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
+use crate::experiment::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics::{self, METRICS_FILE};
 use crate::experiment::provenance::Provenance;
@@ -38,6 +39,18 @@ pub struct RunManifest {
 }
 
 impl RunManifest {
+    /// The manifest of `spec` as run by this build on this machine.
+    pub fn for_spec(spec: &RunSpec) -> Self {
+        RunManifest {
+            experiment: spec.experiment.clone(),
+            method: spec.method,
+            variant: spec.variant.clone(),
+            seed: spec.seed,
+            config: spec.config.clone(),
+            provenance: Some(Provenance::current()),
+        }
+    }
+
     /// Whether two manifests describe the same run (provenance aside: a run may resume on
     /// another build or machine).
     pub fn same_run(&self, other: &RunManifest) -> bool {
@@ -47,16 +60,109 @@ impl RunManifest {
             && self.seed == other.seed
             && self.config == other.config
     }
+
+    /// The identity keys (config keys by name, then `experiment`, `method`, `variant`, `seed`)
+    /// whose values differ, each as `key (on disk X, requested Y)`. Provenance is not compared.
+    pub fn differences(&self, requested: &RunManifest) -> Vec<String> {
+        let table = |m: &RunManifest| {
+            let mut t = toml::Table::try_from(m).expect("a manifest serializes to a table");
+            t.remove("provenance");
+            let config = match t.remove("config") {
+                Some(toml::Value::Table(c)) => c,
+                _ => toml::Table::new(),
+            };
+            (t, config)
+        };
+        let (a_top, a_cfg) = table(self);
+        let (b_top, b_cfg) = table(requested);
+        let mut out = Vec::new();
+        for (a, b) in [(&a_cfg, &b_cfg), (&a_top, &b_top)] {
+            let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+            for key in keys {
+                let show =
+                    |v: Option<&toml::Value>| v.map_or("absent".to_string(), |v| v.to_string());
+                if a.get(key) != b.get(key) {
+                    out.push(format!(
+                        "{key} (on disk {}, requested {})",
+                        show(a.get(key)),
+                        show(b.get(key))
+                    ));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// What a run directory already holds, checked against the run asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Existing {
+    /// Nothing (or a directory without `config.toml`): the run starts fresh.
+    Nothing,
+    /// The same run, unfinished: it resumes.
+    Unfinished,
+    /// The same run, finished: nothing to do.
+    Finished,
+}
+
+/// Check what `dir` holds against `spec` without changing anything. A different run (any
+/// identity key differs, provenance aside), an unreadable `config.toml`, or a `finished` marker
+/// without a config is an error naming the problem and pointing at `--force`.
+pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
+    let config_path = dir.join(CONFIG);
+    let finished = dir.join(FINISHED_MARKER).exists();
+    if !config_path.exists() {
+        if finished {
+            return Err(RunError::UnreadableRun {
+                path: config_path,
+                message: "the run is marked finished but has no config.toml".into(),
+            });
+        }
+        return Ok(Existing::Nothing);
+    }
+    let text = std::fs::read_to_string(&config_path).map_err(|e| io(&config_path, e))?;
+    let existing: RunManifest = toml::from_str(&text).map_err(|e| RunError::UnreadableRun {
+        path: config_path.clone(),
+        message: e.message().to_string(),
+    })?;
+    let requested = RunManifest::for_spec(spec);
+    if !existing.same_run(&requested) {
+        return Err(RunError::ConfigMismatch {
+            dir: dir.to_path_buf(),
+            keys: existing.differences(&requested).join(", "),
+        });
+    }
+    Ok(if finished {
+        Existing::Finished
+    } else {
+        Existing::Unfinished
+    })
+}
+
+/// Delete a run directory for `--force`: only a real directory (a symlink is refused, so the
+/// deletion cannot reach outside the results root through it).
+fn remove_run_dir(dir: &Path) -> Result<(), RunError> {
+    match std::fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(io(dir, e)),
+        Ok(m) if m.is_dir() => std::fs::remove_dir_all(dir).map_err(|e| io(dir, e)),
+        Ok(_) => Err(io(
+            dir,
+            "is not a directory (a symlink or a file); --force only replaces real run directories",
+        )),
+    }
 }
 
 /// Why a run could not proceed.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    #[error("{dir}: holds a run with a different config; rerun with --force to replace it")]
-    ConfigMismatch { dir: PathBuf },
+    #[error("{dir}: holds a different run (differs in {keys}); rerun with --force to replace it")]
+    ConfigMismatch { dir: PathBuf, keys: String },
+    #[error("{path}: {message}; rerun with --force to replace the run")]
+    UnreadableRun { path: PathBuf, message: String },
     #[error("{path}: {message}")]
     Io { path: PathBuf, message: String },
-    #[error("{path}: unreadable checkpoint ({message}); delete it or rerun with --force")]
+    #[error("{path}: refused checkpoint: {message} (or rerun with --force)")]
     BadCheckpoint { path: PathBuf, message: String },
     #[error(transparent)]
     Train(#[from] TrainError),
@@ -81,18 +187,58 @@ pub fn run_rngs(seed: u64) -> RunRngs {
     }
 }
 
-/// Load a run's trainer from its checkpoint.
+/// The checkpoint identity of the run a `config.toml` describes.
+fn identity_of(m: &RunManifest) -> CheckpointIdentity {
+    CheckpointIdentity::new(&m.experiment, m.method, &m.variant, m.seed, &m.config)
+}
+
+/// Read a checkpoint file's bytes: a regular file only (a FIFO or a device is refused).
+fn read_checkpoint_bytes(path: &Path) -> Result<Vec<u8>, RunError> {
+    let meta = std::fs::metadata(path).map_err(|e| io(path, e))?;
+    if !meta.is_file() {
+        return Err(RunError::BadCheckpoint {
+            path: path.to_path_buf(),
+            message: "not a regular file".into(),
+        });
+    }
+    std::fs::read(path).map_err(|e| io(path, e))
+}
+
+/// Load a run's trainer from its checkpoint, verified (format, checksum, exact length) and, when
+/// the run's `config.toml` sits beside it, checked to be that run's.
 pub fn load_checkpoint(path: &Path) -> Result<Trainer, RunError> {
-    let bytes = std::fs::read(path).map_err(|e| io(path, e))?;
-    bincode::deserialize(&bytes).map_err(|e| RunError::BadCheckpoint {
+    let expected = match path.parent().map(|d| d.join(CONFIG)) {
+        Some(config) if config.exists() => {
+            let text = std::fs::read_to_string(&config).map_err(|e| io(&config, e))?;
+            let m: RunManifest = toml::from_str(&text).map_err(|e| RunError::UnreadableRun {
+                path: config.clone(),
+                message: e.message().to_string(),
+            })?;
+            Some(identity_of(&m))
+        }
+        _ => None,
+    };
+    load_checkpoint_of(path, expected.as_ref())
+}
+
+fn load_checkpoint_of(
+    path: &Path,
+    expected: Option<&CheckpointIdentity>,
+) -> Result<Trainer, RunError> {
+    let bytes = read_checkpoint_bytes(path)?;
+    checkpoint::decode(&bytes, expected).map_err(|e| RunError::BadCheckpoint {
         path: path.to_path_buf(),
         message: e.to_string(),
     })
 }
 
-fn save_checkpoint(path: &Path, trainer: &mut Trainer) -> Result<(), RunError> {
+fn save_checkpoint(
+    path: &Path,
+    identity: &CheckpointIdentity,
+    trainer: &mut Trainer,
+) -> Result<(), RunError> {
     trainer.mark_time();
-    let bytes = bincode::serialize(trainer).map_err(|e| io(path, e))?;
+    let bytes = checkpoint::encode(identity, trainer).map_err(|e| io(path, e))?;
     write_atomic(path, &bytes).map_err(|e| io(path, e))
 }
 
@@ -110,34 +256,26 @@ pub fn train_run(
     progress: &Progress,
     force: bool,
 ) -> Result<(), RunError> {
-    if force && dir.exists() {
-        std::fs::remove_dir_all(dir).map_err(|e| io(dir, e))?;
+    if force {
+        remove_run_dir(dir)?;
+    }
+    let existing = existing_run(spec, dir)?;
+    if existing == Existing::Finished {
+        return Ok(());
     }
     std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
-    let manifest = RunManifest {
-        experiment: spec.experiment.clone(),
-        method: spec.method,
-        variant: spec.variant.clone(),
-        seed: spec.seed,
-        config: spec.config.clone(),
-        provenance: Some(Provenance::current()),
-    };
+    // Temp files of writers killed mid-write (this run's earlier processes) would pile up.
+    remove_stale_temp_files(dir).map_err(|e| io(dir, e))?;
     let config_path = dir.join(CONFIG);
-    if config_path.exists() {
-        let text = std::fs::read_to_string(&config_path).map_err(|e| io(&config_path, e))?;
-        let existing: Result<RunManifest, _> = toml::from_str(&text);
-        if !existing.is_ok_and(|m| m.same_run(&manifest)) {
-            return Err(RunError::ConfigMismatch {
-                dir: dir.to_path_buf(),
-            });
-        }
-    } else {
+    if existing == Existing::Nothing {
+        let manifest = RunManifest::for_spec(spec);
         let text = toml::to_string(&manifest).map_err(|e| io(&config_path, e))?;
         write_atomic(&config_path, text.as_bytes()).map_err(|e| io(&config_path, e))?;
     }
     let checkpoint = dir.join(CHECKPOINT);
+    let identity = identity_of(&RunManifest::for_spec(spec));
     let mut trainer = if checkpoint.exists() {
-        load_checkpoint(&checkpoint)?
+        load_checkpoint_of(&checkpoint, Some(&identity))?
     } else {
         Trainer::new(
             spec.config.clone(),
@@ -157,11 +295,11 @@ pub fn train_run(
         );
         if checkpoint_due {
             save_metrics(dir, &trainer)?;
-            save_checkpoint(&checkpoint, &mut trainer)?;
+            save_checkpoint(&checkpoint, &identity, &mut trainer)?;
         }
     }
     save_metrics(dir, &trainer)?;
-    save_checkpoint(&checkpoint, &mut trainer)?;
+    save_checkpoint(&checkpoint, &identity, &mut trainer)?;
     let marker = dir.join(FINISHED_MARKER);
     write_atomic(&marker, b"").map_err(|e| io(&marker, e))?;
     Ok(())

@@ -66,30 +66,50 @@ fn rgb((r, g, b): Rgb) -> RGBColor {
 
 /// The data ranges shown: every curve's band and the optimal line, padded by 6% so nothing touches
 /// the frame. Never empty, even for a single point.
+/// Returns beyond +-[`MAX_AXIS`] are drawn clipped at the frame: the axis must stay finite and
+/// wide enough for f64 steps, or the tick search never ends.
 fn ranges(fig: &Figure) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
     let points = fig.series.iter().flat_map(|s| &s.points);
     let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
     let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut see_y = |v: f64| {
+        if v.is_finite() {
+            let v = v.clamp(-MAX_AXIS, MAX_AXIS);
+            y0 = y0.min(v);
+            y1 = y1.max(v);
+        }
+    };
     for p in points {
         x0 = x0.min(p.episode as f64);
         x1 = x1.max(p.episode as f64);
-        y0 = y0.min(p.mean - p.se);
-        y1 = y1.max(p.mean + p.se);
+        // An infinite band (one huge return makes the SE overflow) still shows its mean.
+        see_y(p.mean);
+        see_y(p.mean - p.se);
+        see_y(p.mean + p.se);
     }
     if let Some(opt) = fig.optimal {
-        y0 = y0.min(opt);
-        y1 = y1.max(opt);
+        see_y(opt);
     }
     if !x0.is_finite() {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+        (x0, x1) = (0.0, 1.0);
+    }
+    if !y0.is_finite() {
+        (y0, y1) = (0.0, 1.0);
     }
     x0 = x0.min(0.0);
     if x1 <= x0 {
         x1 = x0 + 1.0;
     }
-    let pad = if y1 > y0 { 0.06 * (y1 - y0) } else { 1.0 };
+    let pad = if y1 > y0 {
+        0.06 * (y1 - y0)
+    } else {
+        (0.06 * y0.abs()).max(1.0)
+    };
     (x0..x1, (y0 - pad)..(y1 + pad))
 }
+
+/// Largest magnitude shown on the return axis.
+const MAX_AXIS: f64 = 1e12;
 
 /// The on-segments of a dash-dot pattern along [x0, x1], in data units, given data units per
 /// pixel: a 16 px dash, 6 px gap, 3 px dot, 6 px gap, repeated.
@@ -291,5 +311,65 @@ mod tests {
         assert_eq!(trim_number(80.0), "80");
         assert_eq!(trim_number(2.5), "2.5");
         assert_eq!(trim_number(-0.001), "0");
+    }
+
+    fn figure_of(points: Vec<CurvePoint>) -> Figure {
+        Figure {
+            title: "t".into(),
+            series: vec![crate::plot::figure::Series {
+                label: "a".into(),
+                colour: (0, 0, 0),
+                points,
+            }],
+            optimal: Some(80.0),
+            partial: None,
+            caption: String::new(),
+        }
+    }
+
+    #[test]
+    fn huge_and_infinite_values_give_finite_axes_and_render_at_once() {
+        let cases = [
+            (1e200, f64::INFINITY),
+            (1e200, 0.0),
+            (-1e300, 1e300),
+            (f64::NAN, f64::NAN),
+            (5e15, 1.0),
+        ];
+        for (mean, se) in cases {
+            let fig = figure_of(vec![
+                CurvePoint {
+                    episode: 0,
+                    mean: 1.0,
+                    se: 0.0,
+                    n: 2,
+                },
+                CurvePoint {
+                    episode: 10,
+                    mean,
+                    se,
+                    n: 2,
+                },
+            ]);
+            let (x, y) = ranges(&fig);
+            assert!(x.start.is_finite() && x.end.is_finite() && x.start < x.end);
+            assert!(
+                y.start.is_finite() && y.end.is_finite() && y.start < y.end,
+                "{y:?}"
+            );
+            assert!(
+                y.end - y.start > y.end.abs() * 1e-6,
+                "{y:?}: too narrow for f64 steps"
+            );
+            // Rendering must finish: run it on a thread and give it a generous deadline.
+            let (tx, rx) = std::sync::mpsc::channel();
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("f.svg");
+            std::thread::spawn(move || {
+                let _ = tx.send(render_svg(&fig, &path).is_ok());
+            });
+            let done = rx.recv_timeout(std::time::Duration::from_secs(60));
+            assert_eq!(done, Ok(true), "mean {mean}, se {se}");
+        }
     }
 }
