@@ -12,7 +12,8 @@
 #
 # Needs Debian's ROS 1: apt-get install ros-core python3-rospy python3-rostopic (std_srvs and
 # diagnostic_msgs come with them). Environment: MACDEC (default target/release/macdec, built if
-# missing), ROS_PORT (default 11311; must be free), EPISODES (3), SEED (0).
+# missing), ROS_PORT (default 11311; must be free), EPISODES (3), SEED (0); EVAL_SEED (default
+# SEED) seeds only the `macdec eval` side, so a test can show that a real difference is reported.
 # Everything it starts (roscore, roslaunch and the nodes) is stopped when it exits.
 set -euo pipefail
 
@@ -20,6 +21,7 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 port=${ROS_PORT:-11311}
 episodes=${EPISODES:-3}
 seed=${SEED:-0}
+eval_seed=${EVAL_SEED:-$seed}
 macdec=${MACDEC:-$repo/target/release/macdec}
 py=/usr/bin/python3
 
@@ -89,7 +91,7 @@ for policy in "$@"; do
     "$py" "$repo/ros/team_launch.py" --policy "$policy" --macdec "$macdec" >"$work/team.launch"
     setsid roslaunch --no-summary "$work/team.launch" >"$work/roslaunch.log" 2>&1 &
     team_pid=$!
-    "$macdec" eval --policy "$policy" --episodes "$episodes" --seed "$seed" --trajectories \
+    "$macdec" eval --policy "$policy" --episodes "$episodes" --seed "$eval_seed" --trajectories \
         >"$work/eval.jsonl" 2>/dev/null
     if ! "$py" "$repo/ros/macdec_domain_node.py" --policy "$policy" --episodes "$episodes" \
         --seed "$seed" --trajectories --macdec "$macdec" --check-diagnostics \
