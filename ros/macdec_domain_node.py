@@ -224,8 +224,11 @@ def main():
         "/diagnostics", DiagnosticArray, on_diagnostics, queue_size=None, tcp_nodelay=True
     )
     deadline = time.time() + 60
-    for b in bridges:
-        b.wait_ready(deadline)
+    try:
+        for b in bridges:
+            b.wait_ready(deadline)
+    except (rospy.ROSException, TimeoutError) as e:
+        raise SystemExit("macdec_domain_node: the team is not up: %s" % e)
     # Errors travel on /diagnostics: be connected to every robot node's publisher first.
     while diagnostics.get_num_connections() < len(bridges):
         if time.time() > deadline:
@@ -234,14 +237,14 @@ def main():
     if args.check_diagnostics:
         check_diagnostics(bridges[0], agents[0]["obs_size"])
 
-    listeners = []
+    addresses = []
     for b in bridges:
         listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         listener.bind(("127.0.0.1", 0))
         listener.listen(1)
-        listeners.append(listener)
+        addresses.append("127.0.0.1:%d" % listener.getsockname()[1])
         threading.Thread(target=b.serve, args=(listener,), daemon=True).start()
-    robots = ",".join("127.0.0.1:%d" % l.getsockname()[1] for l in listeners)
+    robots = ",".join(addresses)
     command = [args.macdec, "domain", "--policy", policy, "--robots", robots]
     command += ["--episodes", str(args.episodes)]
     if args.seed is not None:

@@ -59,9 +59,9 @@ class PolicyProcess:
             bufsize=1,
         )
 
-    def request(self, message):
-        """The reply (a dict) to `message` (a dict). If the child is gone it is restarted (its
-        hidden state is then zero) and a RuntimeError says so."""
+    def request(self, message, restart=True):
+        """The reply (a dict) to `message` (a dict). If the child is gone a RuntimeError says so,
+        and with `restart` the child is started again (its hidden state is then zero)."""
         line = json.dumps(message, allow_nan=True) + "\n"
         with self.lock:
             try:
@@ -71,13 +71,18 @@ class PolicyProcess:
             except (BrokenPipeError, OSError, ValueError):
                 reply = ""
             if not reply:
-                code = self.child.poll()
                 self.stop()
+                code = self.child.returncode
+                if not restart:
+                    raise RuntimeError("macdec robot exited (status %s)" % code)
                 self.start()
                 raise RuntimeError(
                     "macdec robot exited (status %s); restarted it, its hidden state is zero" % code
                 )
-        return json.loads(reply)
+        try:
+            return json.loads(reply)
+        except ValueError:
+            raise RuntimeError("macdec robot sent an unreadable reply: %r" % reply[:200])
 
     def stop(self):
         if self.child is None:
@@ -98,9 +103,15 @@ class RobotNode:
         self.agent = agent
         self.name = "macdec robot %d" % agent
         self.policy = PolicyProcess([macdec, "robot", "--policy", policy_dir, "--agent", str(agent)])
-        info = self.policy.request({"type": "info"})
+        try:
+            info = self.policy.request({"type": "info"}, restart=False)
+        except RuntimeError as e:  # e.g. a bad policy directory: macdec said why on stderr
+            rospy.logfatal("%s: cannot serve %s: %s", self.name, policy_dir, e)
+            self.policy.stop()
+            raise SystemExit(1)
         if "error" in info:
-            raise SystemExit("macdec robot refused info: %s" % info["error"])
+            rospy.logfatal("%s: macdec robot refused info: %s", self.name, info["error"])
+            raise SystemExit(1)
 
         self.diagnostics = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=100)
         self.action_pub = rospy.Publisher("macro_action", Int32, queue_size=100)
