@@ -48,23 +48,47 @@ work=$(mktemp -d /tmp/macdec-ros-smoke.XXXXXX)
 export ROS_MASTER_URI=http://127.0.0.1:$port ROS_IP=127.0.0.1 ROS_HOME=$work/ros_home
 export ROS_LOG_DIR=$work/ros_home/log ROS_PACKAGE_PATH=$repo/ros PYTHONUNBUFFERED=1
 unset ROS_HOSTNAME
-core_pid="" team_pid=""
+core_pid="" team_pid="" fg_pid=""
 
-# Stop a process group this script started (its leader is $1): SIGINT, then SIGKILL after 20 s.
-stop_group() {
-    local pid=$1 i
+# Every process below $1 (roscore and roslaunch put their children in new process groups).
+descendants() {
+    local child
+    for child in $(pgrep -P "$1" 2>/dev/null); do
+        echo "$child"
+        descendants "$child"
+    done
+}
+# Stop a process this script started and everything it started: SIGINT to its process group
+# (roslaunch and roscore then stop their nodes), SIGKILL after 20 s, then any descendant left.
+stop_tree() {
+    local pid=$1 i rest
     [ -n "$pid" ] || return 0
-    kill -INT -- "-$pid" 2>/dev/null || return 0
+    rest=$(descendants "$pid")
+    kill -INT -- "-$pid" 2>/dev/null || kill -INT "$pid" 2>/dev/null || true
     for i in $(seq 200); do
-        kill -0 -- "-$pid" 2>/dev/null || { wait "$pid" 2>/dev/null || true; return 0; }
+        kill -0 "$pid" 2>/dev/null || break
         sleep 0.1
     done
     kill -KILL -- "-$pid" 2>/dev/null || true
     wait "$pid" 2>/dev/null || true
+    for i in $rest; do kill -TERM "$i" 2>/dev/null || true; done
+    sleep 0.2
+    for i in $rest; do kill -KILL "$i" 2>/dev/null || true; done
+}
+# Run a command in its own process group and wait for it, so a signal to this script stops it
+# at once (bash runs traps only between commands, and `wait` is interruptible).
+run() {
+    setsid "$@" &
+    fg_pid=$!
+    local code=0
+    wait "$fg_pid" || code=$?
+    fg_pid=""
+    return $code
 }
 cleanup() {
-    stop_group "$team_pid"
-    stop_group "$core_pid"
+    stop_tree "$fg_pid"
+    stop_tree "$team_pid"
+    stop_tree "$core_pid"
     rm -rf "$work"
 }
 trap cleanup EXIT
@@ -72,8 +96,8 @@ trap 'exit 130' INT TERM
 
 if [ $# -eq 0 ]; then
     echo "ros-smoke: training a tiny Box Pushing run to get a policy" >&2
-    "$macdec" train --set total_epi=200 --seeds 0..1 --out "$work/run" --no-plot --quiet >&2
-    "$macdec" export --run "$work/run/quickstart_bp10/our1/seed-0" --out "$work/policy-bp10" >&2
+    run "$macdec" train --set total_epi=200 --seeds 0..1 --out "$work/run" --no-plot --quiet >&2
+    run "$macdec" export --run "$work/run/quickstart_bp10/our1/seed-0" --out "$work/policy-bp10" >&2
     set -- "$work/policy-bp10"
 fi
 
@@ -91,13 +115,13 @@ for policy in "$@"; do
     "$py" "$repo/ros/team_launch.py" --policy "$policy" --macdec "$macdec" >"$work/team.launch"
     setsid roslaunch --no-summary "$work/team.launch" >"$work/roslaunch.log" 2>&1 &
     team_pid=$!
-    "$macdec" eval --policy "$policy" --episodes "$episodes" --seed "$eval_seed" --trajectories \
+    run "$macdec" eval --policy "$policy" --episodes "$episodes" --seed "$eval_seed" --trajectories \
         >"$work/eval.jsonl" 2>/dev/null
-    if ! "$py" "$repo/ros/macdec_domain_node.py" --policy "$policy" --episodes "$episodes" \
+    if ! run "$py" "$repo/ros/macdec_domain_node.py" --policy "$policy" --episodes "$episodes" \
         --seed "$seed" --trajectories --macdec "$macdec" --check-diagnostics \
         >"$work/ros.jsonl" 2>"$work/domain.log"; then
         cat "$work/domain.log" >&2
-        echo "ros-smoke: $policy: the domain node failed (roslaunch log: see above)" >&2
+        echo "ros-smoke: $policy: the domain node failed; the end of the roslaunch log follows" >&2
         tail -20 "$work/roslaunch.log" >&2
         status=1
     else
@@ -105,7 +129,7 @@ for policy in "$@"; do
         "$py" "$repo/ros/compare_episodes.py" "$work/eval.jsonl" "$work/ros.jsonl" \
             | sed "s|^ROS smoke: |ROS smoke ($(basename "$policy")): |" || status=1
     fi
-    stop_group "$team_pid"
+    stop_tree "$team_pid"
     team_pid=""
 done
 exit $status
