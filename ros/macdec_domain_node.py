@@ -164,17 +164,25 @@ class RobotBridge:
 
 
 def check_diagnostics(bridge, obs_size):
-    """A wrong-length macro-observation must come back as an ERROR on /diagnostics, with no
-    macro-action, and the node must keep serving (the episodes that follow need it)."""
-    bridge.drain()
-    bridge.done_pub.publish(Float32MultiArray(data=[0.0] * (obs_size + 1)))
-    try:
-        kind, value = bridge.events.get(timeout=bridge.timeout)
-    except queue.Empty:
-        raise SystemExit("diagnostics check: no answer from %s to a bad observation" % bridge.ns)
-    if kind != "error":
-        raise SystemExit("diagnostics check: %s answered a bad observation with %s" % (bridge.ns, kind))
-    print("diagnostics check: %s reported: %s" % (bridge.ns, value), file=sys.stderr)
+    """Bad macro-observations (one value too many; a NaN) must each come back as an ERROR on
+    /diagnostics naming the problem, with no macro-action, and the node must keep serving (the
+    episodes that follow need it)."""
+    bad = [
+        ([0.0] * (obs_size + 1), "expects %d" % obs_size),
+        ([float("nan")] + [0.0] * (obs_size - 1), "finite"),
+    ]
+    for obs, needle in bad:
+        bridge.drain()
+        bridge.done_pub.publish(Float32MultiArray(data=obs))
+        try:
+            kind, value = bridge.events.get(timeout=bridge.timeout)
+        except queue.Empty:
+            raise SystemExit("diagnostics check: %s did not answer a bad observation" % bridge.ns)
+        if kind != "error" or needle not in value:
+            raise SystemExit(
+                "diagnostics check: %s answered a bad observation with %s %r" % (bridge.ns, kind, value)
+            )
+        print("diagnostics check: %s reported: %s" % (bridge.ns, value), file=sys.stderr)
 
 
 def summary(seconds):
