@@ -98,6 +98,10 @@ enum Command {
     /// Greedy evaluation of a policy directory in this process (no robot processes): the same
     /// JSON line per episode as `deploy`, printed as each episode ends.
     Eval(EvalArgs),
+    /// Run the policy's domain here against robots already listening elsewhere (`macdec robot
+    /// --listen` on each robot, or the ROS bridge `ros/macdec_domain_node.py`); the same JSON
+    /// line per episode as `deploy`. See README "Running on robots with ROS".
+    Domain(DomainArgs),
     /// Measure speed.
     Bench {
         /// What to measure.
@@ -323,7 +327,7 @@ struct EvalArgs {
     #[arg(long)]
     policy: PathBuf,
     /// Episodes to run.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
     episodes: usize,
     /// Seed of the environment's random stream (default: the run's seed), as for `deploy`.
     #[arg(long)]
@@ -332,6 +336,29 @@ struct EvalArgs {
     #[arg(long)]
     trajectories: bool,
 }
+
+#[derive(clap::Args)]
+struct DomainArgs {
+    /// Policy directory the robots run (their `info` must report its manifest).
+    #[arg(long)]
+    policy: PathBuf,
+    /// Comma-separated robot addresses in agent order, e.g. 127.0.0.1:7000,127.0.0.1:7001.
+    #[arg(long, value_delimiter = ',', required = true)]
+    robots: Vec<std::net::SocketAddr>,
+    /// Episodes to run.
+    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
+    episodes: usize,
+    /// Seed of the environment's random stream (default: the run's seed), as for `deploy`.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Include every step (executed macro-actions, reward, finished flags) in the output.
+    #[arg(long)]
+    trajectories: bool,
+    /// Seconds to wait for a robot to accept the connection or to answer one message.
+    #[arg(long, default_value_t = 30)]
+    timeout_secs: u64,
+}
+
 
 /// A count flag that must be at least 1 (0 would do nothing useful, silently).
 fn at_least_one(text: &str) -> Result<usize, String> {
@@ -377,6 +404,7 @@ fn run() -> Result<()> {
         Command::Deploy(args) => deploy(args),
         Command::Import(args) => import(args),
         Command::Eval(args) => eval(args),
+        Command::Domain(args) => domain(args),
         Command::Slurm(args) => slurm(args),
         Command::Audit(args) => audit(args),
         Command::Render {
@@ -926,6 +954,40 @@ fn eval(args: EvalArgs) -> Result<()> {
         manifest.env.name(),
         sum / count,
         sum_undiscounted / count
+    );
+    Ok(())
+}
+
+fn domain(args: DomainArgs) -> Result<()> {
+    use macdec::deploy::{driver::DeployError, manifest::load_all, remote::run_with_robots_at};
+    use macdec::experiment::seeds::{stream, Role};
+    let (manifest, _) = load_all(&args.policy)
+        .with_context(|| format!("loading policy {}", args.policy.display()))?;
+    let seed = args.seed.unwrap_or(manifest.run.seed);
+    let mut rng = stream(seed, Role::EvalEnv);
+    let mut out = std::io::stdout().lock();
+    let (mut n, mut sum) = (0usize, 0.0);
+    run_with_robots_at(
+        &manifest,
+        &args.robots,
+        args.episodes,
+        &mut rng,
+        std::time::Duration::from_secs(args.timeout_secs),
+        |trace| {
+            writeln!(out, "{}", trace.json_line(args.trajectories))
+                .and_then(|()| out.flush())
+                .map_err(|e| DeployError::Policy(format!("writing to stdout: {e}")))?;
+            n += 1;
+            sum += trace.discounted_return;
+            Ok(())
+        },
+    )
+    .with_context(|| format!("running {} against its robots", args.policy.display()))?;
+    eprintln!(
+        "{n} episode(s) of {} with {} remote robot(s), seed {seed}: mean discounted return {:.4}",
+        manifest.env.name(),
+        manifest.agents.len(),
+        sum / n.max(1) as f64
     );
     Ok(())
 }

@@ -6,7 +6,8 @@
 //!
 //! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
 //! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
-//! CLI's hidden `--mock` flag). Only [`export`] reads a run's checkpoint; [`import`] builds the
+//! CLI's hidden `--mock` flag). [`remote`] drives robots that already run elsewhere (`macdec
+//! domain`, the ROS bridge of issue 14). Only [`export`] reads a run's checkpoint; [`import`] builds the
 //! same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
 //! any policy directory's greedy episodes in-process, exactly as deployment does.
 
@@ -23,6 +24,7 @@ pub mod mock;
 pub mod processes;
 pub mod protocol;
 pub mod qnet_policy;
+pub mod remote;
 pub mod robot;
 pub mod server;
 
