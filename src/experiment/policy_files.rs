@@ -266,9 +266,11 @@ impl PolicyDescription {
             }
             match (net.role, net.agent) {
                 (NetRole::Dec, Some(a)) if a == n_dec && n_cen == 0 => n_dec += 1,
-                (NetRole::Dec, _) => return Err(invalid(format!(
+                (NetRole::Dec, _) => {
+                    return Err(invalid(format!(
                     "nets[{i}]: decentralized nets must come first, for agents 0, 1, ... in order"
-                ))),
+                )))
+                }
                 (NetRole::Cen, None) if n_cen == 0 => n_cen += 1,
                 (NetRole::Cen, _) => {
                     return Err(invalid(format!(
