@@ -284,3 +284,46 @@ fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
     assert!(!res.status.success());
     assert!(String::from_utf8_lossy(&res.stderr).contains(MANIFEST_FILE));
 }
+
+/// Deploy's own table of the paper's discounts (it knows no learner) agrees with the learner's
+/// paper defaults for every domain and size.
+#[test]
+fn deploys_paper_discounts_are_the_learners() {
+    use macdec::algos::hyper::{paper_defaults, EnvName};
+    use macdec::algos::method::Method;
+    use macdec::deploy::import::paper_discount;
+    for (spec, name, grid) in [
+        (
+            EnvSpec::BoxPushing {
+                grid: 10,
+                horizon: 100,
+            },
+            EnvName::BoxPushing,
+            10,
+        ),
+        (
+            EnvSpec::BoxPushing {
+                grid: 30,
+                horizon: 200,
+            },
+            EnvName::BoxPushing,
+            30,
+        ),
+        (
+            EnvSpec::Warehouse {
+                horizon: 150,
+                tb_m_noisy: 0.0,
+            },
+            EnvName::Warehouse,
+            10,
+        ),
+    ] {
+        for method in [Method::Our1, Method::CenDdrqn, Method::DecHddrqn] {
+            assert_eq!(
+                paper_discount(&spec),
+                paper_defaults(name, grid, method).discount,
+                "{spec:?} {method:?}"
+            );
+        }
+    }
+}

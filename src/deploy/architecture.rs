@@ -7,8 +7,11 @@
 //!             -> fc4 -> Q (output)
 //! ```
 
-use safetensors::{Dtype, SafeTensors};
+use crate::nn::safetensors_io::{from_safetensors_bytes, WeightsError as NnWeightsError};
+use crate::nn::{QNetConfig, TENSOR_NAMES};
+use safetensors::Dtype;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// The one architecture exported so far: the reference's `DDRQN` (fc1, fc2, one LSTM layer, fc3,
 /// fc4), whose sizes are the run's `dec_mlp_layer_size` (M) and `dec_rnn_h_size` (H).
@@ -43,28 +46,29 @@ impl Architecture {
         }
     }
 
-    /// Every tensor of one agent's file, in `state_dict` order, with its PyTorch shape
-    /// (`nn.Linear.weight` is `[out, in]`; the LSTM stacks its four gates i, f, g, o in `4H` rows).
-    pub fn tensors(&self, obs_len: usize, n_actions: usize) -> Vec<(&'static str, Vec<usize>)> {
-        let (m, h) = (self.mlp_layer_size, self.rnn_h_size);
-        vec![
-            ("fc1.weight", vec![m, obs_len]),
-            ("fc1.bias", vec![m]),
-            ("fc2.weight", vec![h, m]),
-            ("fc2.bias", vec![h]),
-            ("lstm.weight_ih_l0", vec![4 * h, h]),
-            ("lstm.weight_hh_l0", vec![4 * h, h]),
-            ("lstm.bias_ih_l0", vec![4 * h]),
-            ("lstm.bias_hh_l0", vec![4 * h]),
-            ("fc3.weight", vec![m, h]),
-            ("fc3.bias", vec![m]),
-            ("fc4.weight", vec![n_actions, m]),
-            ("fc4.bias", vec![n_actions]),
-        ]
+    /// The Q-net sizes of one agent's net.
+    pub fn qnet_config(&self, obs_len: usize, n_actions: usize) -> QNetConfig {
+        QNetConfig {
+            input: obs_len,
+            mlp: self.mlp_layer_size,
+            hidden: self.rnn_h_size,
+            output: n_actions,
+        }
     }
 
-    /// Check a safetensors file against this architecture: exactly the expected tensor names,
-    /// each f32 with the expected shape. Errors name the first offending tensor.
+    /// Every tensor of one agent's file, in `state_dict` order, with its PyTorch shape
+    /// (`nn.Linear.weight` is `[out, in]`; the LSTM stacks its four gates i, f, g, o in `4H` rows):
+    /// nn's one table of the Q-net's tensors ([`crate::nn::TENSORS`]).
+    pub fn tensors(&self, obs_len: usize, n_actions: usize) -> Vec<(&'static str, Vec<usize>)> {
+        TENSOR_NAMES
+            .into_iter()
+            .zip(self.qnet_config(obs_len, n_actions).tensor_shapes())
+            .collect()
+    }
+
+    /// Check a safetensors file against this architecture with nn's loader (the one that builds
+    /// the net): exactly the expected tensor names, each f32 with the expected shape. Errors name
+    /// the first offending tensor.
     pub fn check_weights(
         &self,
         bytes: &[u8],
@@ -74,36 +78,29 @@ impl Architecture {
         if self.kind != DDRQN {
             return Err(WeightsError::UnknownKind(self.kind.clone()));
         }
-        let file =
-            SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Unreadable(e.to_string()))?;
-        let expected = self.tensors(obs_len, n_actions);
-        for (name, shape) in &expected {
-            let view = file
-                .tensor(name)
-                .map_err(|_| WeightsError::Missing(name.to_string()))?;
-            if view.dtype() != Dtype::F32 {
-                return Err(WeightsError::Dtype {
-                    name: name.to_string(),
-                    dtype: format!("{:?}", view.dtype()),
-                });
-            }
-            if view.shape() != shape.as_slice() {
-                return Err(WeightsError::Shape {
-                    name: name.to_string(),
-                    expected: shape.clone(),
-                    got: view.shape().to_vec(),
-                });
-            }
+        let cfg = self.qnet_config(obs_len, n_actions);
+        match from_safetensors_bytes(bytes, cfg, Path::new("")) {
+            Ok(_) => Ok(()),
+            Err(e) => Err(match e {
+                NnWeightsError::Io { source, .. } => WeightsError::Unreadable(source.to_string()),
+                NnWeightsError::Format { reason, .. } => WeightsError::Unreadable(reason),
+                NnWeightsError::Missing { name, .. } => WeightsError::Missing(name.to_string()),
+                NnWeightsError::Unexpected { name, .. } => WeightsError::Unexpected(name),
+                NnWeightsError::Dtype { name, found, .. } => {
+                    WeightsError::Dtype { name, dtype: found }
+                }
+                NnWeightsError::Shape {
+                    name,
+                    found,
+                    expected,
+                    ..
+                } => WeightsError::Shape {
+                    name,
+                    expected,
+                    got: found,
+                },
+            }),
         }
-        let mut names = file.names();
-        names.sort();
-        if let Some(extra) = names
-            .into_iter()
-            .find(|n| !expected.iter().any(|(e, _)| e == n))
-        {
-            return Err(WeightsError::Unexpected(extra.clone()));
-        }
-        Ok(())
     }
 }
 

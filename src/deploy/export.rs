@@ -1,22 +1,21 @@
 //! `macdec export`: turn a trained run directory into a policy directory (issue 7): each
-//! agent's decentralized Q-net from the run's last checkpoint as a safetensors file, and the
-//! manifest naming the domain, layout, architecture and run.
+//! agent's decentralized Q-net from the run's policy files (issue 11; written with every
+//! checkpoint) as a safetensors file, and the manifest naming the domain, layout, architecture
+//! and run. Reads nothing of the trainer: no checkpoint, no learner types.
 
 use crate::deploy::architecture::Architecture;
 use crate::deploy::manifest::{Manifest, ManifestError, RunInfo, MANIFEST_FILE};
-use crate::experiment::train_run::{load_checkpoint, RunError, RunManifest, CHECKPOINT, CONFIG};
+use crate::experiment::policy_files::{read_description, NetRole, PolicyFilesError};
 use crate::nn::safetensors_io::to_safetensors_bytes;
 use std::path::{Path, PathBuf};
 
 /// Why a run could not be exported.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
-    #[error("{path}: {message}")]
-    RunConfig { path: PathBuf, message: String },
     #[error(transparent)]
-    Checkpoint(#[from] RunError),
+    PolicyFiles(#[from] PolicyFilesError),
     #[error("{dir}: the run trained {method}, which has no decentralized Q-nets to put on robots (export a dec-hddrqn, our1, our1-r or our2 run)")]
-    NotDecentralized { dir: PathBuf, method: &'static str },
+    NotDecentralized { dir: PathBuf, method: String },
     #[error("{dir}: agent {agent}'s net has sizes {found}, the run config says {expected}")]
     NetSize {
         dir: PathBuf,
@@ -69,56 +68,52 @@ fn previous_export_files(out: &Path) -> Result<Vec<PathBuf>, ExportError> {
     Ok(files)
 }
 
-/// Export the run in `run_dir` (its `config.toml` and `checkpoint.bin`) to the policy directory
-/// `out`. The checkpoint's nets are exported as they are: a run still training exports its
-/// current nets (`episodes_trained` in the manifest says how far it got).
+/// Export the run in `run_dir` (its `policy/` files, see [`crate::experiment::policy_files`];
+/// never its checkpoint) to the policy directory `out`. The nets are exported as the last
+/// checkpoint wrote them: a run still training exports its current nets (`episodes_trained` in
+/// the manifest says how far it got).
 pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
     let previous = previous_export_files(out)?;
-    let config_path = run_dir.join(CONFIG);
-    let run_config = |message: String| ExportError::RunConfig {
-        path: config_path.clone(),
-        message,
-    };
-    let text = std::fs::read_to_string(&config_path).map_err(|e| run_config(e.to_string()))?;
-    let run: RunManifest = toml::from_str(&text).map_err(|e| run_config(e.to_string()))?;
-    let trainer = load_checkpoint(&run_dir.join(CHECKPOINT))?;
-    let method = trainer.method();
-    let nets = trainer.dec_policies();
-    if nets.is_empty() {
+    let description = read_description(run_dir)?;
+    let run = &description.run;
+    let dec: Vec<_> = description
+        .nets
+        .iter()
+        .filter(|n| n.role == NetRole::Dec)
+        .collect();
+    if dec.is_empty() {
         return Err(ExportError::NotDecentralized {
             dir: run_dir.to_path_buf(),
-            method: method.name(),
+            method: run.method.clone(),
         });
     }
-    let config = trainer.config();
-    let (mlp, hidden) = (config.dec_mlp_layer_size, config.dec_rnn_h_size);
-    for (agent, net) in nets.iter().enumerate() {
-        let cfg = net.config();
-        if (cfg.mlp, cfg.hidden) != (mlp, hidden) {
+    let (mlp, hidden) = (dec[0].sizes.mlp, dec[0].sizes.hidden);
+    let mut weights = Vec::with_capacity(dec.len());
+    for (agent, entry) in dec.iter().enumerate() {
+        if (entry.sizes.mlp, entry.sizes.hidden) != (mlp, hidden) {
             return Err(ExportError::NetSize {
                 dir: run_dir.to_path_buf(),
                 agent,
-                found: format!("M = {}, H = {}", cfg.mlp, cfg.hidden),
-                expected: format!("M = {mlp}, H = {hidden}"),
+                found: format!("M = {}, H = {}", entry.sizes.mlp, entry.sizes.hidden),
+                expected: format!("M = {mlp}, H = {hidden} (agent 0's)"),
             });
         }
+        // nn's loader checks the checksum and every tensor; the export writes the checked net.
+        let net = description.load_net(run_dir, entry)?;
+        weights.push(to_safetensors_bytes(&net.params));
     }
-    let weights: Vec<Vec<u8>> = nets
-        .iter()
-        .map(|n| to_safetensors_bytes(&n.params))
-        .collect();
     let info = RunInfo {
-        experiment: run.experiment,
-        method: method.name().to_string(),
-        variant: run.variant,
-        seed: trainer.seed(),
-        episodes_trained: trainer.episodes(),
-        config: serde_json::to_value(config).map_err(|e| run_config(e.to_string()))?,
+        experiment: run.experiment.clone(),
+        method: run.method.clone(),
+        variant: run.variant.clone(),
+        seed: run.seed,
+        episodes_trained: run.episodes_trained,
+        config: run.config.clone(),
     };
     let manifest = Manifest::write_policy(
         out,
-        crate::algos::trainer::env_spec(config),
-        config.discount,
+        run.env,
+        run.discount,
         Architecture::ddrqn(mlp, hidden),
         info,
         &weights,

@@ -7,8 +7,9 @@
 //! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
 //! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
 //! CLI's hidden `--mock` flag). [`remote`] drives robots that already run elsewhere (`macdec
-//! domain`, the ROS bridge of issue 14). Only [`export`] reads a run's checkpoint; [`import`] builds the
-//! same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
+//! domain`, the ROS bridge of issue 14). Only [`export`] reads a run directory, and only its
+//! policy files ([`crate::experiment::policy_files`]), never its checkpoint; deploy imports nothing
+//! of the learner (`src/algos`). [`import`] builds the same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
 //! any policy directory's greedy episodes in-process, exactly as deployment does.
 
 pub mod architecture;

@@ -75,7 +75,7 @@ pub fn qnet_factory(net: QNet) -> PolicyFactory {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::architecture::{synthetic_weights, Architecture};
+    use crate::deploy::architecture::Architecture;
     use crate::deploy::manifest::{load_agent, RunInfo};
     use crate::envs::EnvSpec;
     use crate::nn::safetensors_io::to_safetensors_bytes;
@@ -140,106 +140,6 @@ mod tests {
             policy.q_values(&obs, &mut q);
             assert_eq!(q, nets[2].act_step(&obs, &mut state));
         }
-    }
-
-    /// Robot server threads running real (randomly initialized) Q-nets, reached over loopback
-    /// TCP, give exactly what `algos::evaluate::greedy_episode` gives in-process.
-    #[test]
-    fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
-        use crate::algos::evaluate::{greedy_episode, GreedyPolicy};
-        use crate::deploy::link::JsonLink;
-        use crate::deploy::robot::RobotSpec;
-        use crate::deploy::run_episodes;
-        use crate::deploy::server::{spawn_server, Limits};
-        use crate::envs::{EnvRng, MacroEnv};
-        use std::net::TcpListener;
-        use std::time::Duration;
-
-        let env_spec = EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.2,
-        };
-        let mut env = env_spec.build().unwrap();
-        // Large pseudo-random weights, so the greedy actions change along an episode (freshly
-        // initialized nets mostly repeat one macro-action).
-        let arch = Architecture::ddrqn(16, 8);
-        let weights: Vec<Vec<u8>> = (0..env.n_agents())
-            .map(|i| {
-                synthetic_weights(&arch, env.obs_sizes()[i], env.n_actions()[i], |name, k| {
-                    let mut h = (k as u64) ^ ((name.len() as u64) << 32) ^ ((i as u64) << 48);
-                    for _ in 0..2 {
-                        h = (h ^ (h >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-                    }
-                    ((h >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 3.0
-                })
-            })
-            .collect();
-        let run = RunInfo {
-            experiment: "test".into(),
-            method: "our1".into(),
-            variant: String::new(),
-            seed: 0,
-            episodes_trained: 0,
-            config: serde_json::Value::Null,
-        };
-        let manifest = Manifest::build(env_spec, 0.95, arch, run, &weights).unwrap();
-        let nets: Vec<QNet> = (0..env.n_agents())
-            .map(|i| {
-                let verified = VerifiedAgent {
-                    index: i,
-                    weights: weights[i].clone(),
-                };
-                load_net(&manifest, &verified).unwrap()
-            })
-            .collect();
-        let servers: Vec<_> = (0..env.n_agents())
-            .map(|i| {
-                let factory = qnet_factory(nets[i].clone());
-                let spec = Arc::new(RobotSpec::new(&manifest, i).unwrap());
-                let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-                spawn_server(listener, factory, spec, Limits::default()).unwrap()
-            })
-            .collect();
-        let mut links: Vec<_> = servers
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                JsonLink::connect(s.local_addr(), i, &manifest, Duration::from_secs(20)).unwrap()
-            })
-            .collect();
-        let episodes = 3;
-        let deployed = run_episodes(
-            &mut env,
-            &mut links,
-            manifest.discount,
-            episodes,
-            &mut EnvRng::seed_from_u64(4),
-        )
-        .unwrap();
-
-        let refs: Vec<&QNet> = nets.iter().collect();
-        let mut eval_rng = EnvRng::seed_from_u64(4);
-        let mut distinct_actions = std::collections::BTreeSet::new();
-        for trace in &deployed {
-            let mut steps = Vec::new();
-            let ret = greedy_episode(
-                &mut env,
-                GreedyPolicy::Dec(&refs),
-                manifest.discount,
-                &mut eval_rng,
-                |e, _, r| steps.push((e.executed().to_vec(), r)),
-            )
-            .unwrap();
-            assert_eq!(trace.discounted_return, ret);
-            let got: Vec<(Vec<usize>, f64)> = trace
-                .trajectory
-                .iter()
-                .map(|s| (s.executed.clone(), s.reward))
-                .collect();
-            assert_eq!(got, steps);
-            distinct_actions.extend(steps.iter().map(|(a, _)| a.clone()));
-        }
-        assert!(distinct_actions.len() > 1, "{distinct_actions:?}");
     }
 
     #[test]

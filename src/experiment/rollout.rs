@@ -2,9 +2,11 @@
 
 use crate::algos::acting::ActScratch;
 use crate::algos::evaluate::GreedyActor;
-use crate::algos::trainer::env_spec;
+use crate::algos::evaluate::GreedyPolicy;
+use crate::envs::MacroEnv;
+use crate::experiment::policy_files::{read_policy_files, NetRole, PolicyFilesError};
 use crate::experiment::seeds::{stream, Role};
-use crate::experiment::train_run::{load_checkpoint, RunError, CHECKPOINT};
+use crate::nn::QNet;
 use crate::render::{record_episode, write_gif, RenderError};
 use std::path::Path;
 
@@ -12,14 +14,17 @@ use std::path::Path;
 #[derive(Debug, thiserror::Error)]
 pub enum RolloutError {
     #[error(transparent)]
-    Run(#[from] RunError),
+    Policy(#[from] PolicyFilesError),
     #[error(transparent)]
     Render(#[from] RenderError),
     #[error("{0}: cannot build the run's environment: {1}")]
     Env(String, crate::envs::EnvError),
+    #[error("{0}: the policy files' nets do not fit the domain: {1}")]
+    NetSize(String, String),
 }
 
-/// Render `episodes` greedy episodes of the run in `run_dir` (its last checkpoint) into one GIF.
+/// Render `episodes` greedy episodes of the run in `run_dir` (its policy files, as of its last
+/// checkpoint) into one GIF.
 /// Returns each episode's undiscounted team return.
 pub fn render_run(
     run_dir: &Path,
@@ -27,13 +32,20 @@ pub fn render_run(
     out: &Path,
     frame_ms: u32,
 ) -> Result<Vec<f64>, RolloutError> {
-    let trainer = load_checkpoint(&run_dir.join(CHECKPOINT))?;
-    let mut env = env_spec(trainer.config())
+    let run = read_policy_files(run_dir)?;
+    let mut env = run
+        .run
+        .env
         .build()
         .map_err(|e| RolloutError::Env(run_dir.display().to_string(), e))?;
-    let dec = trainer.dec_policies();
-    let policy = trainer.greedy_policy(&dec);
-    let mut rng = stream(trainer.seed(), Role::EvalEnv);
+    let dec: Vec<&QNet> = run.dec.iter().collect();
+    let policy = match (run.run.evaluated, &run.cen) {
+        (NetRole::Cen, Some(cen)) => GreedyPolicy::Cen(cen),
+        _ => GreedyPolicy::Dec(&dec),
+    };
+    check_sizes(&env, policy)
+        .map_err(|m| RolloutError::NetSize(run_dir.display().to_string(), m))?;
+    let mut rng = stream(run.run.seed, Role::EvalEnv);
     let mut scratch = ActScratch::new(&env);
     let mut frames = Vec::new();
     let mut returns = Vec::new();
@@ -45,4 +57,44 @@ pub fn render_run(
     }
     write_gif(&frames, out, frame_ms)?;
     Ok(returns)
+}
+
+/// The nets' input and output sizes against the domain's, so a mismatched file is an error here
+/// rather than a panic while acting.
+fn check_sizes(env: &impl MacroEnv, policy: GreedyPolicy<'_>) -> Result<(), String> {
+    let expect = |what: String, net: &QNet, input: usize, output: usize| {
+        let c = net.config();
+        if (c.input, c.output) == (input, output) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{what} has {} inputs and {} outputs, the domain needs {input} and {output}",
+                c.input, c.output
+            ))
+        }
+    };
+    match policy {
+        GreedyPolicy::Dec(nets) => {
+            if nets.len() != env.n_agents() {
+                return Err(format!(
+                    "{} decentralized nets for {} agents",
+                    nets.len(),
+                    env.n_agents()
+                ));
+            }
+            for (i, net) in nets.iter().enumerate() {
+                expect(
+                    format!("agent {i}'s net"),
+                    net,
+                    env.obs_sizes()[i],
+                    env.n_actions()[i],
+                )?;
+            }
+            Ok(())
+        }
+        GreedyPolicy::Cen(net) => {
+            let (input, output) = (env.joint_obs_size(), env.n_joint_actions());
+            expect("the centralized net".into(), net, input, output)
+        }
+    }
 }

@@ -2,17 +2,23 @@
 //!
 //! Layout of `<results>/<experiment>/<curve>/seed-<k>/`: `config.toml` (the resolved config plus
 //! method and seed), `metrics.csv` (see [`crate::experiment::metrics`]), `checkpoint.bin` (the
-//! whole trainer: nets, Adam moments, replay, RNG states, counters) and `finished` once done.
+//! whole trainer: nets, Adam moments, replay, RNG states, counters; for resuming only),
+//! `policy/` (the nets as safetensors plus `policy.json`, written with every checkpoint; see
+//! [`crate::experiment::policy_files`]) and `finished` once done.
 //! Every file is written atomically; a killed run resumes from its last checkpoint and ends with
 //! the metrics an uninterrupted run would have written.
 
+use crate::algos::evaluate::GreedyPolicy;
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
+use crate::algos::trainer::{env_spec, Advance, RunRngs, TrainError, Trainer};
 use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
 use crate::experiment::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics::{self, METRICS_FILE};
+use crate::experiment::policy_files::{
+    write_policy_files, NetRole, PolicyFilesError, RunPolicyInfo,
+};
 use crate::experiment::provenance::Provenance;
 use crate::experiment::runner::{Progress, FINISHED_MARKER};
 use crate::experiment::seeds::{stream, Role};
@@ -166,6 +172,8 @@ pub enum RunError {
     BadCheckpoint { path: PathBuf, message: String },
     #[error(transparent)]
     Train(#[from] TrainError),
+    #[error(transparent)]
+    PolicyFiles(#[from] PolicyFilesError),
 }
 
 fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
@@ -242,6 +250,29 @@ fn save_checkpoint(
     write_atomic(path, &bytes).map_err(|e| io(path, e))
 }
 
+/// Write the trainer's nets as the run's policy files (see [`crate::experiment::policy_files`]).
+fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &Trainer) -> Result<(), RunError> {
+    let dec = trainer.dec_policies();
+    let evaluated = match trainer.greedy_policy(&dec) {
+        GreedyPolicy::Dec(_) => NetRole::Dec,
+        GreedyPolicy::Cen(_) => NetRole::Cen,
+    };
+    let config = trainer.config();
+    let info = RunPolicyInfo {
+        experiment: spec.experiment.clone(),
+        method: trainer.method().name().to_string(),
+        variant: spec.variant.clone(),
+        seed: trainer.seed(),
+        episodes_trained: trainer.episodes(),
+        env: env_spec(config),
+        discount: config.discount,
+        evaluated,
+        config: serde_json::to_value(config).map_err(|e| io(dir, e))?,
+    };
+    write_policy_files(dir, info, &dec, trainer.cen_policy())?;
+    Ok(())
+}
+
 fn save_metrics(dir: &Path, trainer: &Trainer) -> Result<(), RunError> {
     let rows = trainer.evals();
     let path = dir.join(METRICS_FILE);
@@ -296,10 +327,12 @@ pub fn train_run(
         if checkpoint_due {
             save_metrics(dir, &trainer)?;
             save_checkpoint(&checkpoint, &identity, &mut trainer)?;
+            save_policy_files(dir, spec, &trainer)?;
         }
     }
     save_metrics(dir, &trainer)?;
     save_checkpoint(&checkpoint, &identity, &mut trainer)?;
+    save_policy_files(dir, spec, &trainer)?;
     let marker = dir.join(FINISHED_MARKER);
     write_atomic(&marker, b"").map_err(|e| io(&marker, e))?;
     Ok(())

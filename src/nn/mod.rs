@@ -21,6 +21,8 @@ pub use adam::{Adam, AdamConfig};
 pub use linear::LinearVars;
 pub use lstm::LstmState;
 pub use params::{LinearParams, LstmParams, Params};
-pub use qnet::{flatten_padded, QNet, QNetConfig, QNetParams, QNetVars, TENSOR_NAMES};
+pub use qnet::{
+    flatten_padded, Dim, QNet, QNetConfig, QNetParams, QNetVars, TensorSpec, TENSORS, TENSOR_NAMES,
+};
 pub use safetensors_io::WeightsError;
 pub use update::{TdBatch, Updater};

@@ -32,45 +32,106 @@ pub struct QNetConfig {
     pub output: usize,
 }
 
-/// The parameter tensors in PyTorch state_dict order, with their names.
-pub const TENSOR_NAMES: [&str; 12] = [
-    "fc1.weight",
-    "fc1.bias",
-    "fc2.weight",
-    "fc2.bias",
-    "lstm.weight_ih_l0",
-    "lstm.weight_hh_l0",
-    "lstm.bias_ih_l0",
-    "lstm.bias_hh_l0",
-    "fc3.weight",
-    "fc3.bias",
-    "fc4.weight",
-    "fc4.bias",
-];
+/// A size a tensor dimension takes from a [`QNetConfig`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dim {
+    /// `input`.
+    Input,
+    /// M (`mlp`).
+    Mlp,
+    /// H (`hidden`).
+    Hidden,
+    /// 4H: the LSTM's four stacked gates i, f, g, o.
+    Gates,
+    /// `output`.
+    Output,
+}
+
+/// One parameter tensor: its PyTorch state_dict name and its shape in [`Dim`]s
+/// (`nn.Linear.weight` is `[out, in]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TensorSpec {
+    pub name: &'static str,
+    pub dims: &'static [Dim],
+}
+
+/// The one table of the Q-net's parameter tensors, in state_dict order (fc1, fc2, lstm, fc3,
+/// fc4, as the reference's module). Names, shapes, the flat parameter order (gradients, Adam,
+/// target copies) and safetensors I/O all follow it; [`QNetParams`]'s field list
+/// (`qnet_tensors!`) is checked against it by a test.
+pub const TENSORS: [TensorSpec; 12] = {
+    use Dim::*;
+    const fn t(name: &'static str, dims: &'static [Dim]) -> TensorSpec {
+        TensorSpec { name, dims }
+    }
+    [
+        t("fc1.weight", &[Mlp, Input]),
+        t("fc1.bias", &[Mlp]),
+        t("fc2.weight", &[Hidden, Mlp]),
+        t("fc2.bias", &[Hidden]),
+        t("lstm.weight_ih_l0", &[Gates, Hidden]),
+        t("lstm.weight_hh_l0", &[Gates, Hidden]),
+        t("lstm.bias_ih_l0", &[Gates]),
+        t("lstm.bias_hh_l0", &[Gates]),
+        t("fc3.weight", &[Mlp, Hidden]),
+        t("fc3.bias", &[Mlp]),
+        t("fc4.weight", &[Output, Mlp]),
+        t("fc4.bias", &[Output]),
+    ]
+};
+
+/// The parameter tensors' names, in [`TENSORS`] order.
+pub const TENSOR_NAMES: [&str; 12] = {
+    let mut names = [""; 12];
+    let mut i = 0;
+    while i < TENSORS.len() {
+        names[i] = TENSORS[i].name;
+        i += 1;
+    }
+    names
+};
+
+/// `[f(&p.fc1.weight), f(&p.fc1.bias), ...]` for `qnet_tensors!(f, &p)` (or `&mut p`): the
+/// parameter arrays of a [`QNetParams`] in [`TENSORS`] order, the one place the fields are listed.
+macro_rules! qnet_tensors {
+    ($f:path, $($r:tt)+) => {
+        [
+            $f($($r)+.fc1.weight),
+            $f($($r)+.fc1.bias),
+            $f($($r)+.fc2.weight),
+            $f($($r)+.fc2.bias),
+            $f($($r)+.lstm.weight_ih),
+            $f($($r)+.lstm.weight_hh),
+            $f($($r)+.lstm.bias_ih),
+            $f($($r)+.lstm.bias_hh),
+            $f($($r)+.fc3.weight),
+            $f($($r)+.fc3.bias),
+            $f($($r)+.fc4.weight),
+            $f($($r)+.fc4.bias),
+        ]
+    };
+}
+
+/// A tensor of any rank as a dynamic-rank view (for [`QNetParams::named`]).
+fn dyn_view<D: ndarray::Dimension>(a: &ndarray::Array<f32, D>) -> ArrayViewD<'_, f32> {
+    a.view().into_dyn()
+}
 
 impl QNetConfig {
-    /// The shape of each tensor of [`TENSOR_NAMES`], in the same order.
+    /// The size `dim` stands for.
+    pub fn size(&self, dim: Dim) -> usize {
+        match dim {
+            Dim::Input => self.input,
+            Dim::Mlp => self.mlp,
+            Dim::Hidden => self.hidden,
+            Dim::Gates => 4 * self.hidden,
+            Dim::Output => self.output,
+        }
+    }
+
+    /// The shape of each tensor of [`TENSORS`], in the same order.
     pub fn tensor_shapes(&self) -> [Vec<usize>; 12] {
-        let QNetConfig {
-            input,
-            mlp,
-            hidden,
-            output,
-        } = *self;
-        [
-            vec![mlp, input],
-            vec![mlp],
-            vec![hidden, mlp],
-            vec![hidden],
-            vec![4 * hidden, hidden],
-            vec![4 * hidden, hidden],
-            vec![4 * hidden],
-            vec![4 * hidden],
-            vec![mlp, hidden],
-            vec![mlp],
-            vec![output, mlp],
-            vec![output],
-        ]
+        TENSORS.map(|t| t.dims.iter().map(|&d| self.size(d)).collect())
     }
 
     /// Number of trainable scalars.
@@ -135,21 +196,12 @@ impl QNetParams {
 
     /// Every tensor with its state_dict name, in [`TENSOR_NAMES`] order.
     pub fn named(&self) -> [(&'static str, ArrayViewD<'_, f32>); 12] {
-        let n = TENSOR_NAMES;
-        [
-            (n[0], self.fc1.weight.view().into_dyn()),
-            (n[1], self.fc1.bias.view().into_dyn()),
-            (n[2], self.fc2.weight.view().into_dyn()),
-            (n[3], self.fc2.bias.view().into_dyn()),
-            (n[4], self.lstm.weight_ih.view().into_dyn()),
-            (n[5], self.lstm.weight_hh.view().into_dyn()),
-            (n[6], self.lstm.bias_ih.view().into_dyn()),
-            (n[7], self.lstm.bias_hh.view().into_dyn()),
-            (n[8], self.fc3.weight.view().into_dyn()),
-            (n[9], self.fc3.bias.view().into_dyn()),
-            (n[10], self.fc4.weight.view().into_dyn()),
-            (n[11], self.fc4.bias.view().into_dyn()),
-        ]
+        let views = qnet_tensors!(dyn_view, &self);
+        let mut i = 0;
+        views.map(|v| {
+            i += 1;
+            (TENSOR_NAMES[i - 1], v)
+        })
     }
 
     /// The tensor called `name` (state_dict naming), if there is one.
@@ -175,37 +227,11 @@ impl QNetParams {
 
 impl Params for QNetParams {
     fn slices(&self) -> Vec<&[f32]> {
-        vec![
-            flat(&self.fc1.weight),
-            flat(&self.fc1.bias),
-            flat(&self.fc2.weight),
-            flat(&self.fc2.bias),
-            flat(&self.lstm.weight_ih),
-            flat(&self.lstm.weight_hh),
-            flat(&self.lstm.bias_ih),
-            flat(&self.lstm.bias_hh),
-            flat(&self.fc3.weight),
-            flat(&self.fc3.bias),
-            flat(&self.fc4.weight),
-            flat(&self.fc4.bias),
-        ]
+        Vec::from(qnet_tensors!(flat, &self))
     }
 
     fn slices_mut(&mut self) -> Vec<&mut [f32]> {
-        vec![
-            flat_mut(&mut self.fc1.weight),
-            flat_mut(&mut self.fc1.bias),
-            flat_mut(&mut self.fc2.weight),
-            flat_mut(&mut self.fc2.bias),
-            flat_mut(&mut self.lstm.weight_ih),
-            flat_mut(&mut self.lstm.weight_hh),
-            flat_mut(&mut self.lstm.bias_ih),
-            flat_mut(&mut self.lstm.bias_hh),
-            flat_mut(&mut self.fc3.weight),
-            flat_mut(&mut self.fc3.bias),
-            flat_mut(&mut self.fc4.weight),
-            flat_mut(&mut self.fc4.bias),
-        ]
+        Vec::from(qnet_tensors!(flat_mut, &mut self))
     }
 }
 
@@ -514,6 +540,31 @@ mod tests {
         hidden: 4,
         output: 3,
     };
+
+    /// The field list (`qnet_tensors!`) and the table agree: every array has its table shape,
+    /// named and flat views list the same values in the same order, and sizes are all distinct
+    /// here so a swapped dimension or field would show.
+    #[test]
+    fn the_tensor_table_describes_the_fields_in_order() {
+        let net = QNet::new(CFG, &mut ChaCha8Rng::seed_from_u64(3));
+        let named = net.params.named();
+        let slices = net.params.slices();
+        assert_eq!(slices.len(), TENSORS.len());
+        for (((name, view), shape), (spec, flat)) in named
+            .iter()
+            .zip(CFG.tensor_shapes())
+            .zip(TENSORS.iter().zip(&slices))
+        {
+            assert_eq!(*name, spec.name);
+            assert_eq!(view.shape(), shape.as_slice(), "{name}");
+            assert_eq!(view.iter().copied().collect::<Vec<f32>>(), flat.to_vec());
+        }
+        assert_eq!(
+            CFG.n_params(),
+            slices.iter().map(|s| s.len()).sum::<usize>()
+        );
+        assert_eq!(TENSOR_NAMES[4], "lstm.weight_ih_l0");
+    }
 
     fn setup(lengths: &[usize], seed: u64) -> (QNet, Array2<f32>, SeqPacking) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
