@@ -359,7 +359,6 @@ struct DomainArgs {
     timeout_secs: u64,
 }
 
-
 /// A count flag that must be at least 1 (0 would do nothing useful, silently).
 fn at_least_one(text: &str) -> Result<usize, String> {
     match text.trim().parse::<usize>() {

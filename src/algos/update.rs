@@ -199,7 +199,7 @@ fn run_iteration(
             });
         }
         if p.method.dec_target_action() == Some(DecTargetAction::CenCondArgmax) {
-            let view = if p.method == Method::Our2 {
+            let view = if p.method.dec_batch_is_separate() {
                 squeeze_joint(dec_batch, layout)?
             } else {
                 joint
@@ -245,7 +245,12 @@ fn run_iteration(
             .target
             .forward_nograd_padded(view.next_inputs.view(), &view.lengths);
         let y = targets(&view.rewards, &view.dones, &qt, &a_star, p.discount);
-        let agent_loss = td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, p.h);
+        let h = if p.method.dec_loss_is_hysteretic() {
+            p.h
+        } else {
+            1.0
+        };
+        let agent_loss = td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, h);
         loss.total += agent_loss;
         loss.steps += 1;
         if let Some(t) = trace.as_deref_mut() {

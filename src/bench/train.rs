@@ -37,7 +37,7 @@ impl TrainBench {
 pub fn suite() -> Vec<(EnvName, Method)> {
     let mut v: Vec<(EnvName, Method)> = Method::ALL
         .into_iter()
-        .filter(|&m| m != Method::Our2)
+        .filter(|&m| !m.requires_episode_buffer())
         .map(|m| (EnvName::BoxPushing, m))
         .collect();
     v.extend(Method::ALL.into_iter().map(|m| (EnvName::Warehouse, m)));

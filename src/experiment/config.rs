@@ -636,7 +636,7 @@ fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)>
     if !(c.tb_m_noisy >= 0.0 && c.tb_m_noisy.is_finite()) {
         return Err(("tb_m_noisy", format!("must be >= 0, got {}", c.tb_m_noisy)));
     }
-    if method == Method::Our2 && !c.sample_epi {
+    if method.requires_episode_buffer() && !c.sample_epi {
         // Spec Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
         return Err((
             "sample_epi",
