@@ -553,8 +553,9 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
     Ok(config)
 }
 
-/// Range checks that types cannot express. Returns the offending key and why.
-fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
+/// Range checks that types cannot express. Returns the offending key and why. The library entry
+/// point [`crate::train`] runs them too, so a config built in code is held to the same rules.
+pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
     let positive = [
         ("env_terminate_step", c.env_terminate_step),
         ("total_epi", c.total_epi),
