@@ -109,9 +109,8 @@ impl MacroEnv for Rendezvous {
                 got: actions.len(),
             });
         }
-        for agent in 0..2 {
+        for (agent, &action) in actions.iter().enumerate() {
             if self.mac_done[agent] {
-                let action = actions[agent];
                 if action >= WAYPOINTS.len() {
                     return Err(EnvError::ActionOutOfRange {
                         agent,

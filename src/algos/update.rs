@@ -180,7 +180,7 @@ fn run_iteration(
         } else {
             1.0
         };
-        let cen_loss = td_step(
+        let cen_loss = step_nets(
             cen,
             &joint.inputs,
             &joint.lengths,
@@ -250,7 +250,7 @@ fn run_iteration(
         } else {
             1.0
         };
-        let agent_loss = td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, h);
+        let agent_loss = step_nets(nets, &view.inputs, &view.lengths, &view.actions, &y, h);
         loss.total += agent_loss;
         loss.steps += 1;
         if let Some(t) = trace.as_deref_mut() {
@@ -341,7 +341,7 @@ pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
 /// One Adam step on `nets.policy` for loss = mean_k (max(h d_k, d_k))^2, d_k = y_k - Q(h_k, a_k)
 /// (spec 5, quirk Q4: the hysteretic transform is a leaky ReLU of slope h before squaring, and
 /// the mean runs over all kept records of the batch, quirk Q17). Returns the loss.
-fn td_step(
+fn step_nets(
     nets: &mut Nets,
     inputs: &Array3<f32>,
     lengths: &[usize],

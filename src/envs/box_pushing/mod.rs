@@ -23,7 +23,7 @@ mod properties;
 mod scenarios;
 
 use self::actions::{ACTION_NAMES, N_ACTIONS};
-use self::layout::Layout;
+use self::layout::GridLayout;
 use self::observe::{OBS_NAMES, OBS_SIZE, RESET_OBS};
 use self::state::{Boxes, Robot};
 use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -57,7 +57,7 @@ pub struct DeliveryStats {
 /// Constructed in the reset state, so `step` may be called at once.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BoxPushing {
-    layout: Layout,
+    layout: GridLayout,
     horizon: usize,
     robots: [Robot; N_AGENTS],
     boxes: Boxes,
@@ -106,7 +106,7 @@ impl BoxPushing {
                 reason: "must be at least 1 primitive step, got 0".to_string(),
             });
         }
-        let layout = Layout::new(grid as i32);
+        let layout = GridLayout::new(grid as i32);
         Ok(Self {
             robots: start_robots(&layout),
             boxes: start_boxes(&layout),
@@ -128,7 +128,7 @@ impl BoxPushing {
     }
 
     /// The fixed start configuration and waypoints.
-    pub fn layout(&self) -> &Layout {
+    pub fn layout(&self) -> &GridLayout {
         &self.layout
     }
 
@@ -185,13 +185,13 @@ impl BoxPushing {
 }
 
 /// Both robots at their start cells, free, remembering no waypoint (spec 2).
-fn start_robots(layout: &Layout) -> [Robot; N_AGENTS] {
+fn start_robots(layout: &GridLayout) -> [Robot; N_AGENTS] {
     layout
         .robot_starts
         .map(|(cell, heading)| Robot::at_start(cell, heading))
 }
 
-fn start_boxes(layout: &Layout) -> Boxes {
+fn start_boxes(layout: &GridLayout) -> Boxes {
     Boxes {
         small: layout.small_boxes,
         big_left: layout.big_box_left,

@@ -9,7 +9,6 @@
 //! file. At the paper's settings nothing is random; with `tb_move_noisy > 0` travel steps draw
 //! normals from the caller's [`EnvRng`].
 
-mod bench;
 mod fetch;
 mod human;
 mod observe;
@@ -26,7 +25,6 @@ mod scenarios;
 #[cfg(test)]
 mod testkit;
 
-pub use bench::{measure_random_steps_per_sec, run_random_macro_actions, RandomRunStats};
 pub use fetch::{Fetch, FetchAction};
 pub use human::Human;
 pub use observe::{FETCH_OBS, TB_OBS};
