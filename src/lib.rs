@@ -11,6 +11,7 @@ pub mod algos;
 pub mod api;
 pub mod autograd;
 pub mod bench;
+pub mod curve_stats;
 pub mod deploy;
 pub mod envs;
 pub mod experiment;

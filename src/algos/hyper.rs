@@ -19,6 +19,14 @@ pub enum EnvName {
 }
 
 impl EnvName {
+    /// A short label for tables and benchmarks: `bp<grid>` (e.g. `bp10`) or `wtd`.
+    pub fn short_name(self, grid_dim: usize) -> String {
+        match self {
+            EnvName::BoxPushing => format!("bp{grid_dim}"),
+            EnvName::Warehouse => "wtd".into(),
+        }
+    }
+
     /// The domain spec these `config.toml` keys describe (`grid_dim` only for Box Pushing,
     /// `tb_m_noisy` only for Warehouse).
     pub fn spec(self, grid_dim: usize, horizon: usize, tb_m_noisy: f64) -> EnvSpec {

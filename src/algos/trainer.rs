@@ -465,6 +465,7 @@ impl<E: MacroEnv> Trainer<E> {
             discount: c.discount as f32,
             h: self.h as f32,
             early_return_skips_all: c.early_return_skips_all,
+            sub_trace_len: c.sub_trace_len,
         };
         let dec_batch = self
             .lane

@@ -10,7 +10,7 @@ use crate::algos::method::{DecTargetAction, Method};
 use crate::algos::record::Layout;
 use crate::algos::replay::Batch;
 use crate::algos::squeeze::{
-    joint_rows_of_agent, squeeze_agent, squeeze_joint, AgentView, JointView,
+    joint_rows_of_agent, squeeze_agent_min, squeeze_joint, AgentView, JointView,
 };
 use crate::algos::ReplayError;
 use crate::autograd::SeqPacking;
@@ -84,6 +84,9 @@ pub struct IterationParams {
     pub h: f32,
     /// Quirk Q9: an empty agent view skips every decentralized step of this iteration.
     pub early_return_skips_all: bool,
+    /// `sub_trace_len`: an agent's sequence with fewer kept records is dropped from its view
+    /// (spec 3.3; the paper's 1 drops only sequences without any).
+    pub sub_trace_len: usize,
 }
 
 /// What one iteration did.
@@ -223,7 +226,7 @@ fn run_iteration(
         return Ok(loss);
     };
     let views: Vec<AgentView> = (0..dec.len())
-        .map(|i| squeeze_agent(dec_batch, layout, i))
+        .map(|i| squeeze_agent_min(dec_batch, layout, i, p.sub_trace_len))
         .collect::<Result<_, _>>()?;
     if p.early_return_skips_all && views.iter().any(|v| v.is_empty()) {
         return Ok(loss); // Q9 (faithful): one empty view skips every agent's step.
@@ -376,6 +379,7 @@ mod tests {
     use super::*;
     use crate::algos::record::{Episode, RecordRef};
     use crate::algos::replay::Sequence;
+    use crate::algos::squeeze::squeeze_agent;
     use ndarray::array;
 
     /// Two agents with one observation value and two macro-actions each. Step 0: agent 0 ran
@@ -535,6 +539,7 @@ mod tests {
                 discount: 0.9,
                 h: 0.5,
                 early_return_skips_all: true,
+                sub_trace_len: 1,
             };
             let (mut d1, mut c1) = (dec.clone(), cen.clone());
             let (mut d2, mut c2) = (dec.clone(), cen.clone());

@@ -67,11 +67,7 @@ pub fn bench_train(
 
 /// The row name of a configuration, e.g. `bp10 our1`.
 pub fn name(env: EnvName, method: Method) -> String {
-    let env_name = match env {
-        EnvName::BoxPushing => "bp10",
-        EnvName::Warehouse => "wtd",
-    };
-    format!("{env_name} {method}")
+    format!("{} {method}", env.short_name(10))
 }
 
 /// A Markdown table of the results.
