@@ -4,13 +4,23 @@
 //! a Centralized Q-Net* (Xiao, Hoffman, Xia, Amato, ICRA 2020). Data flows one way:
 //! `experiment` (config, runner) -> `algos` (trainer) -> `envs` + `nn` (on `autograd`), and the
 //! results feed `plot` and `deploy`. Lower layers never name higher ones.
+//!
+//! Your own domain: implement [`MacroEnv`] and call [`train`] (see `examples/custom_domain.rs`).
 
 pub mod algos;
+pub mod api;
 pub mod autograd;
 pub mod bench;
+pub mod curve_stats;
 pub mod deploy;
 pub mod envs;
 pub mod experiment;
 pub mod nn;
 pub mod plot;
 pub mod render;
+
+pub use algos::hyper::{paper_defaults, EnvName, RunConfig};
+pub use algos::method::Method;
+pub use algos::trainer::EvalPoint;
+pub use api::{train, LibraryTrainError};
+pub use envs::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};

@@ -372,6 +372,7 @@ fn run_case(case: &str) -> String {
         discount: g.hyper.gamma as f32,
         h: g.hyper.h as f32,
         early_return_skips_all: g.hyper.early_return_skips_all,
+        sub_trace_len: 1,
     };
     // The reference's weights before each iteration, and our Adam fed with its gradients.
     let mut ref_weights: HashMap<String, QNet> = HashMap::new();

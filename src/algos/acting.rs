@@ -18,16 +18,9 @@ pub struct Explore<'a> {
     pub carry_state: bool,
 }
 
-/// Index of the first maximal value (quirk Q14: ties go to the lowest index).
-pub fn argmax(q: &[f32]) -> usize {
-    let mut best = 0;
-    for (i, &v) in q.iter().enumerate().skip(1) {
-        if v > q[best] {
-            best = i;
-        }
-    }
-    best
-}
+/// Index of the first maximal value (quirk Q14: ties go to the lowest index): the crate's one
+/// rule, [`crate::nn::argmax`].
+pub use crate::nn::argmax;
 
 /// Scratch space for one acting lane, so selection allocates nothing per step.
 #[derive(Debug, Clone)]

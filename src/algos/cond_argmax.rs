@@ -143,16 +143,10 @@ pub fn cond_argmax_rows(
     Ok(out)
 }
 
-/// First index of the maximal value (strict `>`, so ties keep the earliest; NaN never wins).
-fn first_argmax(mut items: impl Iterator<Item = (usize, f32)>) -> usize {
-    let (mut best, mut best_q) = items.next().expect("at least one allowed joint action");
-    for (idx, q) in items {
-        if q > best_q || (best_q.is_nan() && !q.is_nan()) {
-            best = idx;
-            best_q = q;
-        }
-    }
-    best
+/// First index of the maximal value (strict `>`, so ties keep the earliest; NaN never wins):
+/// the crate's one rule, [`crate::nn::argmax::first_argmax`].
+fn first_argmax(items: impl Iterator<Item = (usize, f32)>) -> usize {
+    crate::nn::argmax::first_argmax(items).expect("at least one allowed joint action")
 }
 
 /// The allowed joint indices in increasing (C-order) order: an odometer over the free agents, the

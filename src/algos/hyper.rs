@@ -4,6 +4,7 @@
 //! `--set` overrides. Field names are the reference's command-line flags (spec `algorithms.md` 10).
 
 use crate::algos::method::Method;
+use crate::envs::EnvSpec;
 use serde::{Deserialize, Serialize};
 
 /// Which domain a run trains on, by the reference's `--env_name`.
@@ -15,6 +16,31 @@ pub enum EnvName {
     /// Warehouse Tool Delivery (`warehouse.md`).
     #[serde(rename = "OSD_S_4", alias = "warehouse")]
     Warehouse,
+}
+
+impl EnvName {
+    /// A short label for tables and benchmarks: `bp<grid>` (e.g. `bp10`) or `wtd`.
+    pub fn short_name(self, grid_dim: usize) -> String {
+        match self {
+            EnvName::BoxPushing => format!("bp{grid_dim}"),
+            EnvName::Warehouse => "wtd".into(),
+        }
+    }
+
+    /// The domain spec these `config.toml` keys describe (`grid_dim` only for Box Pushing,
+    /// `tb_m_noisy` only for Warehouse).
+    pub fn spec(self, grid_dim: usize, horizon: usize, tb_m_noisy: f64) -> EnvSpec {
+        match self {
+            EnvName::BoxPushing => EnvSpec::BoxPushing {
+                grid: grid_dim,
+                horizon,
+            },
+            EnvName::Warehouse => EnvSpec::Warehouse {
+                horizon,
+                tb_m_noisy,
+            },
+        }
+    }
 }
 
 /// The resolved configuration of one run: every hyperparameter concrete and validated.
@@ -82,14 +108,18 @@ pub struct RunConfig {
     pub early_return_skips_all: bool,
 }
 
+impl RunConfig {
+    /// The environment this config describes, from its `env_name`, `grid_dim`,
+    /// `env_terminate_step` and `tb_m_noisy` keys.
+    pub fn env_spec(&self) -> EnvSpec {
+        self.env_name
+            .spec(self.grid_dim, self.env_terminate_step, self.tb_m_noisy)
+    }
+}
+
 /// The paper's settings for a domain and method (spec `algorithms.md` 10), before user keys.
 pub fn paper_defaults(env: EnvName, grid_dim: usize, method: Method) -> RunConfig {
-    let dec_hysteretic = method == Method::DecHddrqn;
-    let (init_h, end_h) = if dec_hysteretic {
-        (0.2, 0.4)
-    } else {
-        (1.0, 1.0)
-    };
+    let (init_h, end_h) = method.paper_hysteresis();
     // 10x10: horizon 100, windows of 15; 30x30: horizon 200, windows of 45 (spec 10.1, 10.2).
     let big = grid_dim >= 30;
     let trace_len = if big { 45 } else { 15 };
@@ -109,7 +139,7 @@ pub fn paper_defaults(env: EnvName, grid_dim: usize, method: Method) -> RunConfi
         eps_l_d_steps: 6000,
         eps_end: 0.1,
         h_explore: false,
-        cen_explore: matches!(method, Method::Our1 | Method::Our1R),
+        cen_explore: method.paper_cen_explore(),
         l_rate: 0.001,
         discount: 0.98,
         start_train: 2,
@@ -123,7 +153,7 @@ pub fn paper_defaults(env: EnvName, grid_dim: usize, method: Method) -> RunConfi
         cen_mlp_layer_size: 32,
         cen_rnn_h_size: 64,
         eval_freq: 10,
-        eval_num_epi: if dec_hysteretic { 20 } else { 1 },
+        eval_num_epi: method.paper_eval_num_epi(),
         checkpoint_freq: 500,
         early_return_skips_all: true,
     };

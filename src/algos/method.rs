@@ -2,6 +2,7 @@
 //! (spec `algorithms.md` 4.6 and 5): which nets exist, who picks the action inside each target,
 //! how the training env(s) explore, and whether a loss is hysteretic.
 
+use crate::algos::schedule::HysteresisSchedule;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -77,12 +78,18 @@ impl Method {
 
     /// Whether the method trains per-agent decentralized Q-nets.
     pub fn has_dec_nets(self) -> bool {
-        self != Method::CenDdrqn
+        match self {
+            Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => true,
+            Method::CenDdrqn => false,
+        }
     }
 
     /// Whether the method trains the centralized Q-net.
     pub fn has_cen_net(self) -> bool {
-        self != Method::DecHddrqn
+        match self {
+            Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => true,
+            Method::DecHddrqn => false,
+        }
     }
 
     /// Who picks a*_i in the decentralized targets (`None` for Cen-DDRQN, which has none).
@@ -97,7 +104,47 @@ impl Method {
     /// Whether the centralized loss uses the hysteretic transform: only Cen-DDRQN's does (spec
     /// 5.2); Our-1/2's centralized step never applies h (spec 5.3 Step A).
     pub fn cen_loss_is_hysteretic(self) -> bool {
-        self == Method::CenDdrqn
+        match self {
+            Method::CenDdrqn => true,
+            Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => false,
+        }
+    }
+
+    /// Whether the decentralized losses use the hysteretic transform with the run's current h
+    /// (spec 5.1, 5.3 Step B). Every method with decentralized nets applies h there; only
+    /// Dec-HDDRQN's paper schedule ([`Self::paper_hysteresis`]) moves it away from 1.
+    pub fn dec_loss_is_hysteretic(self) -> bool {
+        match self {
+            Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => true,
+            Method::CenDdrqn => false,
+        }
+    }
+
+    /// The paper's hysteresis schedule end points `(init_h, end_h)` (spec 5.6, 10): Dec-HDDRQN
+    /// moves from 0.2 to 0.4; every other method keeps h = 1 (no hysteresis).
+    pub fn paper_hysteresis(self) -> (f64, f64) {
+        match self {
+            Method::DecHddrqn => (0.2, 0.4),
+            Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => (1.0, 1.0),
+        }
+    }
+
+    /// The paper's greedy episodes per evaluation (spec 10): Dec-HDDRQN's code averages 20, the
+    /// ICRA code evaluates once.
+    pub fn paper_eval_num_epi(self) -> usize {
+        match self {
+            Method::DecHddrqn => 20,
+            Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => 1,
+        }
+    }
+
+    /// The paper's `--cen_explore` (spec 4.6, 10): Our-1 and Our-1-R explore centrally; the flag
+    /// means nothing to the other methods and is off for them.
+    pub fn paper_cen_explore(self) -> bool {
+        match self {
+            Method::Our1 | Method::Our1R => true,
+            Method::DecHddrqn | Method::CenDdrqn | Method::Our2 => false,
+        }
     }
 
     /// The exploration of the training env(s); `cen_explore` is Our-1's `--cen_explore` flag.
@@ -110,6 +157,87 @@ impl Method {
             Method::Our2 => Exploration::Parallel,
         }
     }
+
+    /// Quirk Q12: whether a training env exploring with `exploration` still runs the
+    /// decentralized selection each step (hidden states advance, draws are consumed) and
+    /// discards its actions. Our-1 / Our-1-R do under centralized exploration.
+    pub fn shadow_dec_selection(self, exploration: Exploration) -> bool {
+        match self {
+            Method::Our1 | Method::Our1R => exploration == Exploration::Centralized,
+            Method::DecHddrqn | Method::CenDdrqn | Method::Our2 => false,
+        }
+    }
+
+    /// The policy the paper evaluates (spec 7.1): Cen-DDRQN acts centrally, all others by agent.
+    pub fn evaluated_policy(self) -> EvaluatedPolicy {
+        match self {
+            Method::CenDdrqn => EvaluatedPolicy::Centralized,
+            Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => {
+                EvaluatedPolicy::Decentralized
+            }
+        }
+    }
+
+    /// Whether the decentralized batch comes from an env of its own, so the centralized a*
+    /// selection for the decentralized targets must squeeze that batch jointly instead of reusing
+    /// the centralized step's view (Our-2, spec 5.5).
+    pub fn dec_batch_is_separate(self) -> bool {
+        match self {
+            Method::Our2 => true,
+            Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R => false,
+        }
+    }
+
+    /// Whether the method needs the whole-episode replay (`sample_epi = true`): the reference's
+    /// windowed path for Our-2 crashes (spec Q10), so Our-2 stays episode-based.
+    pub fn requires_episode_buffer(self) -> bool {
+        match self {
+            Method::Our2 => true,
+            Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R => false,
+        }
+    }
+}
+
+/// The run's hysteresis settings (`dynamic_h`, `init_h`, `end_h`, `h_stable_at`): the one place
+/// the value of h is decided. Which losses apply h is [`Method::cen_loss_is_hysteretic`] and
+/// [`Method::dec_loss_is_hysteretic`]; the paper's end points are [`Method::paper_hysteresis`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HysteresisRule {
+    /// Follow the schedule (spec 5.6); otherwise h = 1 - epsilon (the reference's fallback).
+    pub dynamic: bool,
+    pub init_h: f64,
+    pub end_h: f64,
+    pub h_stable_at: f64,
+}
+
+impl HysteresisRule {
+    /// h until the first training iteration: the schedule's start (1 if the schedule is invalid).
+    pub fn initial(&self) -> f64 {
+        HysteresisSchedule::new(self.init_h, self.end_h, self.h_stable_at)
+            .map(|s| s.initial())
+            .unwrap_or(1.0)
+    }
+
+    /// h at a training iteration after `episodes` episodes, with the exploration rate `epsilon`
+    /// of the previous iteration (quirk Q8: h is recomputed before the step, epsilon after it).
+    pub fn at(&self, episodes: f64, epsilon: f64) -> f64 {
+        if self.dynamic {
+            HysteresisSchedule::new(self.init_h, self.end_h, self.h_stable_at)
+                .map(|s| s.at(episodes))
+                .unwrap_or(1.0)
+        } else {
+            1.0 - epsilon
+        }
+    }
+}
+
+/// Which nets act in the evaluated (greedy) policy of a method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EvaluatedPolicy {
+    /// Each agent's own decentralized net.
+    Decentralized,
+    /// The centralized net with the conditional argmax.
+    Centralized,
 }
 
 impl fmt::Display for Method {
@@ -153,5 +281,45 @@ mod tests {
         assert_eq!(a.has_cen_net(), b.has_cen_net());
         assert_eq!(a.exploration(true), b.exploration(true));
         assert_eq!(a.cen_loss_is_hysteretic(), b.cen_loss_is_hysteretic());
+        assert_eq!(a.dec_loss_is_hysteretic(), b.dec_loss_is_hysteretic());
+        assert_eq!(a.paper_hysteresis(), b.paper_hysteresis());
+        assert_eq!(a.evaluated_policy(), b.evaluated_policy());
+        assert_eq!(
+            a.shadow_dec_selection(Exploration::Centralized),
+            b.shadow_dec_selection(Exploration::Centralized)
+        );
+    }
+
+    #[test]
+    fn hysteresis_follows_the_schedule_or_one_minus_epsilon() {
+        let mut r = HysteresisRule {
+            dynamic: true,
+            init_h: 0.2,
+            end_h: 0.4,
+            h_stable_at: 100.0,
+        };
+        assert_eq!(r.initial(), 0.2);
+        assert!((r.at(50.0, 0.7) - 0.3).abs() < 1e-12);
+        assert_eq!(r.at(500.0, 0.7), 0.4);
+        r.dynamic = false;
+        assert!((r.at(50.0, 0.7) - 0.3).abs() < 1e-12);
+        r.h_stable_at = 0.0;
+        r.dynamic = true;
+        assert_eq!((r.initial(), r.at(5.0, 0.5)), (1.0, 1.0));
+    }
+
+    #[test]
+    fn only_dec_hddrqn_has_a_hysteresis_schedule_and_only_cen_ddrqn_acts_centrally() {
+        for m in Method::ALL {
+            assert_eq!(m.paper_hysteresis() != (1.0, 1.0), m == Method::DecHddrqn);
+            assert_eq!(
+                m.evaluated_policy() == EvaluatedPolicy::Centralized,
+                !m.has_dec_nets()
+            );
+            assert_eq!(m.dec_loss_is_hysteretic(), m.has_dec_nets());
+            assert!(!m.shadow_dec_selection(Exploration::Decentralized));
+        }
+        assert!(Method::Our1.shadow_dec_selection(Exploration::Centralized));
+        assert!(!Method::CenDdrqn.shadow_dec_selection(Exploration::Centralized));
     }
 }

@@ -12,25 +12,7 @@ use super::record::{Episode, Layout, RecordRef};
 use super::ReplayError;
 use crate::envs::{MacroEnv, StepOutcome};
 
-/// What the first record of an episode holds as its "before" observation (quirk Q20).
-///
-/// The reference Warehouse env hands out its own held-observation list from `reset()` and the
-/// first `step()` overwrites the entries of the agents that finished in that step (warehouse.md
-/// Q10); the worker builds the first record after the step, so those agents' entries of the first
-/// record's `obs` are their post-step observations. Box Pushing rebinds its list instead, so its
-/// first record holds the true reset observation.
-///
-/// Under the paper's settings the two choices give the same numbers: only the Fetch can finish at
-/// step 1 (Wait), and its observation after that step equals its reset observation (no tool
-/// staged, no Turtlebot beside the table yet). The switch keeps the port exact anyway.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub enum FirstRecordObs {
-    /// The observation returned by reset (Box Pushing; the fixed behaviour for Warehouse).
-    #[default]
-    Reset,
-    /// Agents that finished at step 1 show their post-step observation (Warehouse, faithful).
-    OverwrittenByFirstStep,
-}
+pub use crate::envs::FirstRecordObs;
 
 /// Accumulators and the growing episode of one training environment.
 ///

@@ -97,12 +97,23 @@ pub fn packed_rows(lengths: &[usize]) -> Vec<(usize, usize)> {
         .collect()
 }
 
-/// Agent `agent`'s squeezed view of `batch`. Refuses an out-of-range agent or episodes whose
-/// shape differs from `layout`.
+/// Agent `agent`'s squeezed view of `batch`, dropping only sequences without a kept record.
+/// Refuses an out-of-range agent or episodes whose shape differs from `layout`.
 pub fn squeeze_agent(
     batch: &Batch<'_>,
     layout: &Layout,
     agent: usize,
+) -> Result<AgentView, ReplayError> {
+    squeeze_agent_min(batch, layout, agent, 1)
+}
+
+/// [`squeeze_agent`] keeping only the sequences with at least `min_records` kept records
+/// (`sub_trace_len`, spec 3.3; values below 1 act as 1).
+pub fn squeeze_agent_min(
+    batch: &Batch<'_>,
+    layout: &Layout,
+    agent: usize,
+    min_records: usize,
 ) -> Result<AgentView, ReplayError> {
     let n = layout.n_agents();
     if agent >= n {
@@ -111,7 +122,7 @@ pub fn squeeze_agent(
     check_batch(batch, layout)?;
     let range = layout.obs_range(agent);
     let d = range.len();
-    let kept = Kept::count(batch, |ep, t| ep.valid_of(t, agent));
+    let kept = Kept::count(batch, min_records, |ep, t| ep.valid_of(t, agent));
 
     let mut inputs = Array3::<f32>::zeros((kept.lengths.len(), kept.t_max, d));
     let mut next_inputs = Array3::<f32>::zeros((kept.lengths.len(), kept.t_max, d));
@@ -159,7 +170,7 @@ pub fn squeeze_joint(batch: &Batch<'_>, layout: &Layout) -> Result<JointView, Re
     let n = layout.n_agents();
     let n_actions = layout.n_actions();
     let d = layout.joint_obs_size();
-    let kept = Kept::count(batch, Episode::vj);
+    let kept = Kept::count(batch, 1, Episode::vj);
 
     let mut inputs = Array3::<f32>::zeros((kept.lengths.len(), kept.t_max, d));
     let mut next_inputs = Array3::<f32>::zeros((kept.lengths.len(), kept.t_max, d));
@@ -270,11 +281,18 @@ struct Kept {
 }
 
 impl Kept {
-    fn count(batch: &Batch<'_>, keep: impl Fn(&Episode, usize) -> bool) -> Self {
+    /// Sequences with fewer than `min_records` kept records (at least 1) count as dropped.
+    fn count(
+        batch: &Batch<'_>,
+        min_records: usize,
+        keep: impl Fn(&Episode, usize) -> bool,
+    ) -> Self {
+        let min_records = min_records.max(1);
         let per_sequence: Vec<usize> = batch
             .sequences
             .iter()
             .map(|seq| seq.records().filter(|&t| keep(seq.episode, t)).count())
+            .map(|c| if c >= min_records { c } else { 0 })
             .collect();
         let lengths: Vec<usize> = per_sequence.iter().copied().filter(|&c| c > 0).collect();
         Self {
@@ -411,6 +429,22 @@ mod tests {
         assert_eq!(v0.actions, vec![1, 2, 2, 2]);
         assert_eq!(v0.rewards, vec![-2.0, -2.0, -2.0, -2.0]);
         assert_eq!(v0.dones, vec![0.0, 0.0, 1.0, 0.0]); // C ends at its t = 1
+                                                        // sub_trace_len: 1 is the plain view; 2 keeps only A's two-record sequence; 3 none.
+        let same = squeeze_agent_min(&batch, &layout(), 0, 1).unwrap();
+        assert_eq!(
+            (same.lengths, same.actions),
+            (v0.lengths.clone(), v0.actions.clone())
+        );
+        let two = squeeze_agent_min(&batch, &layout(), 0, 2).unwrap();
+        assert_eq!(two.lengths, vec![2]);
+        assert_eq!(two.actions, vec![1, 2]);
+        assert_eq!(
+            two.inputs.slice(s![0, .., ..]),
+            ndarray::arr2(&[[110.0, 111.0], [130.0, 131.0]])
+        );
+        assert!(squeeze_agent_min(&batch, &layout(), 0, 3)
+            .unwrap()
+            .is_empty());
 
         let v1 = squeeze_agent(&batch, &layout(), 1).unwrap();
         assert_eq!(v1.lengths, vec![2, 1, 2]); // A: t 3, 4; C: t 0; window: t 3, 4

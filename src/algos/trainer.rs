@@ -7,12 +7,12 @@
 
 use crate::algos::acting::{select_cen, select_dec, ActScratch, Explore};
 use crate::algos::evaluate::{evaluate, GreedyPolicy};
-use crate::algos::hyper::{EnvName, RunConfig};
-use crate::algos::method::{Exploration, Method};
+use crate::algos::hyper::RunConfig;
+use crate::algos::method::{EvaluatedPolicy, Exploration, HysteresisRule, Method};
 use crate::algos::record::Layout;
-use crate::algos::recorder::{FirstRecordObs, Recorder};
+use crate::algos::recorder::Recorder;
 use crate::algos::replay::ReplayBuffer;
-use crate::algos::schedule::{EpsilonSchedule, HysteresisSchedule};
+use crate::algos::schedule::EpsilonSchedule;
 use crate::algos::update::{train_iteration, IterationParams, Nets, UpdateError};
 use crate::algos::ReplayError;
 use crate::envs::{AnyEnv, EnvError, EnvRng, EnvSpec, MacroEnv};
@@ -51,8 +51,8 @@ pub enum TrainError {
 
 /// One training environment with everything needed to act in it and record from it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-struct Lane {
-    env: AnyEnv,
+struct Lane<E> {
+    env: E,
     rng: EnvRng,
     exploration: Exploration,
     recorder: Recorder,
@@ -93,7 +93,7 @@ pub enum Advance {
 
 /// The complete state of a training run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Trainer {
+pub struct Trainer<E = AnyEnv> {
     config: RunConfig,
     method: Method,
     seed: u64,
@@ -101,10 +101,10 @@ pub struct Trainer {
     dec: Vec<Nets>,
     cen: Option<Nets>,
     /// The training env; Our-2's decentralized-exploring env.
-    lane: Lane,
+    lane: Lane<E>,
     /// Our-2's centralized-exploring env.
-    cen_lane: Option<Lane>,
-    eval_env: AnyEnv,
+    cen_lane: Option<Lane<E>>,
+    eval_env: E,
     rngs: RunRngs,
     epsilon: f64,
     h: f64,
@@ -122,30 +122,40 @@ pub struct Trainer {
     segment_start: Option<std::time::Instant>,
 }
 
-/// The environment a config describes.
+/// The environment a config describes ([`RunConfig::env_spec`]).
 pub fn env_spec(c: &RunConfig) -> EnvSpec {
-    match c.env_name {
-        EnvName::BoxPushing => EnvSpec::BoxPushing {
-            grid: c.grid_dim,
-            horizon: c.env_terminate_step,
-        },
-        EnvName::Warehouse => EnvSpec::Warehouse {
-            horizon: c.env_terminate_step,
-            tb_m_noisy: c.tb_m_noisy,
-        },
-    }
+    c.env_spec()
 }
 
-impl Trainer {
-    /// Build nets, envs and buffers for `method` with seed `seed` (spec 2.2, 6).
+impl Trainer<AnyEnv> {
+    /// Build nets, envs and buffers for `method` with seed `seed` (spec 2.2, 6) on the domain
+    /// the config names ([`RunConfig::env_spec`]).
     pub fn new(
         config: RunConfig,
         method: Method,
         seed: u64,
-        mut rngs: RunRngs,
+        rngs: RunRngs,
     ) -> Result<Self, TrainError> {
         let spec = env_spec(&config);
-        let eval_env = spec.build()?;
+        Self::with_env(config, method, seed, rngs, || spec.build())
+    }
+}
+
+impl<E: MacroEnv> Trainer<E> {
+    /// Build nets, envs and buffers for `method` with seed `seed` (spec 2.2, 6) on the domain
+    /// `make_env` builds, called once per environment the method needs (evaluation, training,
+    /// Our-2's centralized lane). What the learner needs to know about the domain comes from
+    /// its [`MacroEnv`] implementation; the config's `env_name`, `grid_dim` and `tb_m_noisy`
+    /// are not read here.
+    pub fn with_env(
+        config: RunConfig,
+        method: Method,
+        seed: u64,
+        mut rngs: RunRngs,
+        make_env: impl Fn() -> Result<E, EnvError>,
+    ) -> Result<Self, TrainError> {
+        let eval_env = make_env()?;
+        let horizon = eval_env.horizon();
         let layout = Layout::of_env(&eval_env)?;
         let dec: Vec<Nets> = if method.has_dec_nets() {
             (0..layout.n_agents())
@@ -176,42 +186,36 @@ impl Trainer {
             Exploration::Parallel => (Exploration::Decentralized, Some(Exploration::Centralized)),
             e => (e, None),
         };
-        let make_lane = |exploration: Exploration, mut rng: EnvRng| -> Result<Lane, TrainError> {
-            let mut env = spec.build()?;
-            env.reset(&mut rng);
-            let first = match config.env_name {
-                EnvName::Warehouse => FirstRecordObs::OverwrittenByFirstStep,
-                EnvName::BoxPushing => FirstRecordObs::Reset,
+        let make_lane =
+            |exploration: Exploration, mut rng: EnvRng| -> Result<Lane<E>, TrainError> {
+                let mut env = make_env()?;
+                env.reset(&mut rng);
+                let mut recorder = Recorder::new(&layout, env.first_record_obs(), horizon);
+                recorder.begin_from_env(&env)?;
+                let buffer = if config.sample_epi {
+                    ReplayBuffer::episodes(&layout, config.replay_buffer_size)?
+                } else {
+                    ReplayBuffer::windows(&layout, config.replay_buffer_size, config.trace_len)?
+                };
+                Ok(Lane {
+                    dec_states: dec_zero_states(&dec),
+                    cen_state: cen.as_ref().map(|c| c.policy.zero_state()),
+                    actions: vec![0; layout.n_agents()],
+                    shadow_dec_selection: method.shadow_dec_selection(exploration),
+                    discarded: vec![0; layout.n_agents()],
+                    scratch: None,
+                    env,
+                    rng,
+                    exploration,
+                    recorder,
+                    buffer,
+                })
             };
-            let mut recorder = Recorder::new(&layout, first, config.env_terminate_step);
-            recorder.begin_from_env(&env)?;
-            let buffer = if config.sample_epi {
-                ReplayBuffer::episodes(&layout, config.replay_buffer_size)?
-            } else {
-                ReplayBuffer::windows(&layout, config.replay_buffer_size, config.trace_len)?
-            };
-            Ok(Lane {
-                dec_states: dec_zero_states(&dec),
-                cen_state: cen.as_ref().map(|c| c.policy.zero_state()),
-                actions: vec![0; layout.n_agents()],
-                shadow_dec_selection: exploration == Exploration::Centralized
-                    && matches!(method, Method::Our1 | Method::Our1R),
-                discarded: vec![0; layout.n_agents()],
-                scratch: None,
-                env,
-                rng,
-                exploration,
-                recorder,
-                buffer,
-            })
-        };
         let lane = make_lane(main_exploration, rngs.env.clone())?;
         let cen_lane = cen_lane_exploration
             .map(|e| make_lane(e, rngs.cen_env.clone()))
             .transpose()?;
-        let h = HysteresisSchedule::new(config.init_h, config.end_h, config.h_stable_at as f64)
-            .map(|s| s.initial())
-            .unwrap_or(1.0);
+        let h = hysteresis_rule(&config).initial();
         Ok(Trainer {
             config,
             method,
@@ -353,13 +357,7 @@ impl Trainer {
         let c = self.config.clone();
         if self.step.is_multiple_of(c.train_freq as u64) && self.episodes >= c.start_train as u64 {
             let e = self.episodes as f64;
-            if c.dynamic_h {
-                self.h = HysteresisSchedule::new(c.init_h, c.end_h, c.h_stable_at as f64)
-                    .map(|s| s.at(e))
-                    .unwrap_or(1.0);
-            } else {
-                self.h = 1.0 - self.epsilon;
-            }
+            self.h = hysteresis_rule(&c).at(e, self.epsilon);
             self.train()?;
             self.epsilon = if c.eps_l_d {
                 EpsilonSchedule::new(c.eps_end, c.eps_l_d_steps as f64)
@@ -467,6 +465,7 @@ impl Trainer {
             discount: c.discount as f32,
             h: self.h as f32,
             early_return_skips_all: c.early_return_skips_all,
+            sub_trace_len: c.sub_trace_len,
         };
         let dec_batch = self
             .lane
@@ -517,7 +516,7 @@ impl Trainer {
         let c = &self.config;
         let dec: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
         let policy = policy_of(self.method, &dec, self.cen.as_ref());
-        let deterministic = c.env_name == EnvName::BoxPushing || c.tb_m_noisy == 0.0;
+        let deterministic = self.eval_env.deterministic();
         let eval_return = evaluate(
             &mut self.eval_env,
             policy,
@@ -545,11 +544,22 @@ impl Trainer {
 
 /// The evaluated policy of `method` (spec 7.1): Cen-DDRQN acts centrally, all others by agent.
 fn policy_of<'a>(method: Method, dec: &'a [&'a QNet], cen: Option<&'a Nets>) -> GreedyPolicy<'a> {
-    match method {
-        Method::CenDdrqn => {
-            GreedyPolicy::Cen(&cen.expect("Cen-DDRQN has a centralized net").policy)
-        }
-        _ => GreedyPolicy::Dec(dec),
+    match method.evaluated_policy() {
+        EvaluatedPolicy::Centralized => GreedyPolicy::Cen(
+            &cen.expect("a centrally evaluated method has a centralized net")
+                .policy,
+        ),
+        EvaluatedPolicy::Decentralized => GreedyPolicy::Dec(dec),
+    }
+}
+
+/// The hysteresis settings of a config.
+fn hysteresis_rule(c: &RunConfig) -> HysteresisRule {
+    HysteresisRule {
+        dynamic: c.dynamic_h,
+        init_h: c.init_h,
+        end_h: c.end_h,
+        h_stable_at: c.h_stable_at as f64,
     }
 }
 

@@ -10,7 +10,7 @@ use crate::algos::method::{DecTargetAction, Method};
 use crate::algos::record::Layout;
 use crate::algos::replay::Batch;
 use crate::algos::squeeze::{
-    joint_rows_of_agent, squeeze_agent, squeeze_joint, AgentView, JointView,
+    joint_rows_of_agent, squeeze_agent_min, squeeze_joint, AgentView, JointView,
 };
 use crate::algos::ReplayError;
 use crate::autograd::SeqPacking;
@@ -84,6 +84,9 @@ pub struct IterationParams {
     pub h: f32,
     /// Quirk Q9: an empty agent view skips every decentralized step of this iteration.
     pub early_return_skips_all: bool,
+    /// `sub_trace_len`: an agent's sequence with fewer kept records is dropped from its view
+    /// (spec 3.3; the paper's 1 drops only sequences without any).
+    pub sub_trace_len: usize,
 }
 
 /// What one iteration did.
@@ -180,7 +183,7 @@ fn run_iteration(
         } else {
             1.0
         };
-        let cen_loss = td_step(
+        let cen_loss = step_nets(
             cen,
             &joint.inputs,
             &joint.lengths,
@@ -199,7 +202,7 @@ fn run_iteration(
             });
         }
         if p.method.dec_target_action() == Some(DecTargetAction::CenCondArgmax) {
-            let view = if p.method == Method::Our2 {
+            let view = if p.method.dec_batch_is_separate() {
                 squeeze_joint(dec_batch, layout)?
             } else {
                 joint
@@ -223,7 +226,7 @@ fn run_iteration(
         return Ok(loss);
     };
     let views: Vec<AgentView> = (0..dec.len())
-        .map(|i| squeeze_agent(dec_batch, layout, i))
+        .map(|i| squeeze_agent_min(dec_batch, layout, i, p.sub_trace_len))
         .collect::<Result<_, _>>()?;
     if p.early_return_skips_all && views.iter().any(|v| v.is_empty()) {
         return Ok(loss); // Q9 (faithful): one empty view skips every agent's step.
@@ -245,7 +248,12 @@ fn run_iteration(
             .target
             .forward_nograd_padded(view.next_inputs.view(), &view.lengths);
         let y = targets(&view.rewards, &view.dones, &qt, &a_star, p.discount);
-        let agent_loss = td_step(nets, &view.inputs, &view.lengths, &view.actions, &y, p.h);
+        let h = if p.method.dec_loss_is_hysteretic() {
+            p.h
+        } else {
+            1.0
+        };
+        let agent_loss = step_nets(nets, &view.inputs, &view.lengths, &view.actions, &y, h);
         loss.total += agent_loss;
         loss.steps += 1;
         if let Some(t) = trace.as_deref_mut() {
@@ -336,7 +344,7 @@ pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
 /// One Adam step on `nets.policy` for loss = mean_k (max(h d_k, d_k))^2, d_k = y_k - Q(h_k, a_k)
 /// (spec 5, quirk Q4: the hysteretic transform is a leaky ReLU of slope h before squaring, and
 /// the mean runs over all kept records of the batch, quirk Q17). Returns the loss.
-fn td_step(
+fn step_nets(
     nets: &mut Nets,
     inputs: &Array3<f32>,
     lengths: &[usize],
@@ -371,6 +379,7 @@ mod tests {
     use super::*;
     use crate::algos::record::{Episode, RecordRef};
     use crate::algos::replay::Sequence;
+    use crate::algos::squeeze::squeeze_agent;
     use ndarray::array;
 
     /// Two agents with one observation value and two macro-actions each. Step 0: agent 0 ran
@@ -530,6 +539,7 @@ mod tests {
                 discount: 0.9,
                 h: 0.5,
                 early_return_skips_all: true,
+                sub_trace_len: 1,
             };
             let (mut d1, mut c1) = (dec.clone(), cen.clone());
             let (mut d2, mut c2) = (dec.clone(), cen.clone());

@@ -37,7 +37,7 @@ impl TrainBench {
 pub fn suite() -> Vec<(EnvName, Method)> {
     let mut v: Vec<(EnvName, Method)> = Method::ALL
         .into_iter()
-        .filter(|&m| m != Method::Our2)
+        .filter(|&m| !m.requires_episode_buffer())
         .map(|m| (EnvName::BoxPushing, m))
         .collect();
     v.extend(Method::ALL.into_iter().map(|m| (EnvName::Warehouse, m)));
@@ -67,11 +67,7 @@ pub fn bench_train(
 
 /// The row name of a configuration, e.g. `bp10 our1`.
 pub fn name(env: EnvName, method: Method) -> String {
-    let env_name = match env {
-        EnvName::BoxPushing => "bp10",
-        EnvName::Warehouse => "wtd",
-    };
-    format!("{env_name} {method}")
+    format!("{} {method}", env.short_name(10))
 }
 
 /// A Markdown table of the results.

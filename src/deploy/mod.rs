@@ -73,13 +73,7 @@ impl<P: AgentPolicy + ?Sized> AgentPolicy for Box<P> {
 /// Index of the first maximal Q-value: the greedy macro-action, with ties going to the lowest
 /// index exactly as in training and evaluation (quirk Q14). Callers reject non-finite Q first.
 pub fn greedy_action(q: &[f32]) -> usize {
-    let mut best = 0;
-    for (i, &v) in q.iter().enumerate().skip(1) {
-        if v > q[best] {
-            best = i;
-        }
-    }
-    best
+    crate::nn::argmax(q)
 }
 
 #[cfg(test)]

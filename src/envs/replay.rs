@@ -25,7 +25,7 @@ pub struct ReplayFile {
 
 /// Why a replay file was refused. Messages name the step (1-based) and agent at fault.
 #[derive(Debug, thiserror::Error)]
-pub enum ReplayError {
+pub enum ReplayFileError {
     #[error("not valid JSON: {0}")]
     Json(#[source] serde_json::Error),
     #[error("expected a JSON object with `env`, its parameters and `steps`, got {0}")]
@@ -63,14 +63,15 @@ pub enum ReplayError {
 
 /// Parse a replay file's text. Only the shape is checked here; actions are checked while
 /// replaying, since an entry matters only when its agent is free.
-pub fn parse_replay(text: &str) -> Result<ReplayFile, ReplayError> {
-    let value: Value = serde_json::from_str(text).map_err(ReplayError::Json)?;
+pub fn parse_replay(text: &str) -> Result<ReplayFile, ReplayFileError> {
+    let value: Value = serde_json::from_str(text).map_err(ReplayFileError::Json)?;
     let Value::Object(mut map) = value else {
-        return Err(ReplayError::NotAnObject(json_kind(&value)));
+        return Err(ReplayFileError::NotAnObject(json_kind(&value)));
     };
-    let steps = map.remove("steps").ok_or(ReplayError::MissingSteps)?;
-    let steps: Vec<Vec<i64>> = serde_json::from_value(steps).map_err(ReplayError::BadSteps)?;
-    let spec: EnvSpec = serde_json::from_value(Value::Object(map)).map_err(ReplayError::BadSpec)?;
+    let steps = map.remove("steps").ok_or(ReplayFileError::MissingSteps)?;
+    let steps: Vec<Vec<i64>> = serde_json::from_value(steps).map_err(ReplayFileError::BadSteps)?;
+    let spec: EnvSpec =
+        serde_json::from_value(Value::Object(map)).map_err(ReplayFileError::BadSpec)?;
     Ok(ReplayFile { spec, steps })
 }
 
@@ -125,7 +126,7 @@ fn all_obs<E: MacroEnv>(env: &E) -> Vec<Vec<f32>> {
 /// out. With `pictures`, each frame carries [`MacroEnv::render_ascii`] of the state after it. The
 /// whole file is checked (row lengths up front, free agents' entries as they are reached) before
 /// anything is returned, so a bad file yields an error and no partial output.
-pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayError> {
+pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayFileError> {
     let mut frames = Vec::new();
     let unused_steps = walk(file, pictures, &mut |f| {
         frames.push(f);
@@ -143,8 +144,8 @@ pub fn run_replay(file: &ReplayFile, pictures: bool) -> Result<Replay, ReplayErr
 pub fn stream_replay(
     file: &ReplayFile,
     pictures: bool,
-    on_frame: &mut dyn FnMut(ReplayFrame) -> Result<(), ReplayError>,
-) -> Result<usize, ReplayError> {
+    on_frame: &mut dyn FnMut(ReplayFrame) -> Result<(), ReplayFileError>,
+) -> Result<usize, ReplayFileError> {
     walk(file, false, &mut |_| Ok(()))?;
     walk(file, pictures, on_frame)
 }
@@ -153,9 +154,9 @@ pub fn stream_replay(
 fn walk(
     file: &ReplayFile,
     pictures: bool,
-    on_frame: &mut dyn FnMut(ReplayFrame) -> Result<(), ReplayError>,
-) -> Result<usize, ReplayError> {
-    let mut env = file.spec.build().map_err(ReplayError::Build)?;
+    on_frame: &mut dyn FnMut(ReplayFrame) -> Result<(), ReplayFileError>,
+) -> Result<usize, ReplayFileError> {
+    let mut env = file.spec.build().map_err(ReplayFileError::Build)?;
     let n_agents = env.n_agents();
     if let Some((k, row)) = file
         .steps
@@ -163,7 +164,7 @@ fn walk(
         .enumerate()
         .find(|(_, row)| row.len() != n_agents)
     {
-        return Err(ReplayError::RowLength {
+        return Err(ReplayFileError::RowLength {
             step: k + 1,
             expected: n_agents,
             got: row.len(),
@@ -196,7 +197,7 @@ fn walk(
             *slot = usize::try_from(entry)
                 .ok()
                 .filter(|&a| a < n_actions)
-                .ok_or(ReplayError::BadAction {
+                .ok_or(ReplayFileError::BadAction {
                     step,
                     agent,
                     action: entry,
@@ -205,7 +206,7 @@ fn walk(
         }
         let out = env
             .step(&actions, &mut rng)
-            .map_err(|source| ReplayError::Step { step, source })?;
+            .map_err(|source| ReplayFileError::Step { step, source })?;
         used += 1;
         on_frame(ReplayFrame {
             line: ReplayLine {

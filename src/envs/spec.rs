@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::box_pushing::BoxPushing;
 use super::warehouse::{Warehouse, WarehouseParams};
-use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use super::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
 
 /// Which domain, with its parameters. Serialized with the tag `env`:
 /// `{"env": "box-pushing", "grid": 10, "horizon": 100}` or `{"env": "warehouse", "horizon": 150}`.
@@ -120,6 +120,18 @@ impl MacroEnv for AnyEnv {
     }
     fn render_ascii(&self) -> String {
         dispatch!(self, e => e.render_ascii())
+    }
+    fn first_record_obs(&self) -> FirstRecordObs {
+        dispatch!(self, e => e.first_record_obs())
+    }
+    fn deterministic(&self) -> bool {
+        dispatch!(self, e => e.deterministic())
+    }
+    fn optimal_return(&self, discount: f64) -> Option<f64> {
+        dispatch!(self, e => e.optimal_return(discount))
+    }
+    fn describe(&self) -> String {
+        dispatch!(self, e => e.describe())
     }
 }
 

@@ -553,8 +553,9 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
     Ok(config)
 }
 
-/// Range checks that types cannot express. Returns the offending key and why.
-fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
+/// Range checks that types cannot express. Returns the offending key and why. The library entry
+/// point [`crate::train`] runs them too, so a config built in code is held to the same rules.
+pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
     let positive = [
         ("env_terminate_step", c.env_terminate_step),
         ("total_epi", c.total_epi),
@@ -636,7 +637,7 @@ fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)>
     if !(c.tb_m_noisy >= 0.0 && c.tb_m_noisy.is_finite()) {
         return Err(("tb_m_noisy", format!("must be >= 0, got {}", c.tb_m_noisy)));
     }
-    if method == Method::Our2 && !c.sample_epi {
+    if method.requires_episode_buffer() && !c.sample_epi {
         // Spec Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
         return Err((
             "sample_epi",

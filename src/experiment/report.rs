@@ -1,9 +1,9 @@
 //! A terminal summary of learning curves after `macdec train`: mean greedy return over seeds at
 //! evenly spaced evaluation points, with a bar per point.
 
+use crate::curve_stats::aggregate;
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics;
-use crate::plot::stats::aggregate;
 use std::collections::BTreeMap;
 use std::path::Path;
 

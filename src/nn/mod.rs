@@ -7,6 +7,7 @@
 //! - `safetensors_io`: weight files with PyTorch's state_dict names.
 
 mod adam;
+pub mod argmax;
 pub mod demo;
 pub mod init;
 mod linear;
@@ -18,6 +19,7 @@ pub mod safetensors_io;
 mod update;
 
 pub use adam::{Adam, AdamConfig};
+pub use argmax::argmax;
 pub use linear::LinearVars;
 pub use lstm::LstmState;
 pub use params::{LinearParams, LstmParams, Params};

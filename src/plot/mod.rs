@@ -10,7 +10,9 @@ pub mod figure;
 pub mod font;
 pub mod render;
 pub mod setting;
-pub mod stats;
+/// The curve statistics live below both `plot` and `experiment` ([`crate::curve_stats`]), so
+/// the training report and the figures share them without importing each other.
+pub use crate::curve_stats as stats;
 pub mod summary;
 pub mod welch;
 

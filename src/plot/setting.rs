@@ -6,12 +6,9 @@
 
 use crate::algos::hyper::EnvName;
 
-/// Optimal discounted return of Box Pushing 10x10 (horizon 100, gamma 0.98); `box_pushing.md` 11.
-pub const BP10_OPTIMAL: f64 = 80.71093744250365;
-/// Optimal discounted return of Box Pushing 30x30 (horizon 200, gamma 0.98); `box_pushing.md` 11.
-pub const BP30_OPTIMAL: f64 = 41.75397237445474;
-/// Best achievable return of Warehouse Tool Delivery (horizon 150, gamma 1); `warehouse.md` 10.
-pub const WTD_OPTIMAL: f64 = 262.0;
+pub use crate::envs::box_pushing::{BP10_OPTIMAL, BP30_OPTIMAL};
+pub use crate::envs::warehouse::WTD_OPTIMAL;
+use crate::envs::{AnyEnv, MacroEnv};
 
 /// The domain settings of one run that decide the optimal return.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,26 +58,30 @@ impl EnvSetting {
         })
     }
 
-    /// The optimal return of this setting when the spec derives one: BP 10x10 horizon 100 and
-    /// BP 30x30 horizon 200 at gamma 0.98, WTD horizon 150 at gamma 1. `None` otherwise (another
-    /// grid, horizon or discount has no verified optimum, so no line is drawn).
-    pub fn optimal_return(&self) -> Option<f64> {
-        match (self.env_name, self.grid_dim, self.horizon) {
-            (EnvName::BoxPushing, 10, 100) if self.discount == 0.98 => Some(BP10_OPTIMAL),
-            (EnvName::BoxPushing, 30, 200) if self.discount == 0.98 => Some(BP30_OPTIMAL),
-            (EnvName::Warehouse, _, 150) if self.discount == 1.0 => Some(WTD_OPTIMAL),
-            _ => None,
-        }
+    /// The domain this setting describes, built (in its reset state) so it can be asked what it
+    /// knows about itself; `None` when the keys describe no valid domain.
+    fn domain(&self) -> Option<AnyEnv> {
+        // Movement noise decides neither the optimum nor the description.
+        self.env_name
+            .spec(self.grid_dim, self.horizon, 0.0)
+            .build()
+            .ok()
     }
 
-    /// A short description for the figure title, e.g. "Box Pushing 10x10, horizon 100".
+    /// The optimal return of this setting when the domain knows one ([`MacroEnv::optimal_return`]:
+    /// BP 10x10 horizon 100 and BP 30x30 horizon 200 at gamma 0.98, WTD horizon 150 at gamma 1).
+    /// `None` otherwise (another grid, horizon or discount has no verified optimum, so no line is
+    /// drawn).
+    pub fn optimal_return(&self) -> Option<f64> {
+        self.domain()?.optimal_return(self.discount)
+    }
+
+    /// A short description for the figure title, e.g. "Box Pushing 10x10, horizon 100"
+    /// ([`MacroEnv::describe`]).
     pub fn describe(&self) -> String {
-        match self.env_name {
-            EnvName::BoxPushing => format!(
-                "Box Pushing {0}x{0}, horizon {1}",
-                self.grid_dim, self.horizon
-            ),
-            EnvName::Warehouse => format!("Warehouse Tool Delivery, horizon {}", self.horizon),
+        match self.domain() {
+            Some(env) => env.describe(),
+            None => format!("{:?}, horizon {}", self.env_name, self.horizon),
         }
     }
 }

@@ -8,7 +8,7 @@ use super::geometry::{Cell, Heading};
 /// axes: the reference computes several x positions from ylen (Q9), which only matters on
 /// non-square grids, and those are not supported.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct Layout {
+pub struct GridLayout {
     /// Grid side N (even, >= 8).
     pub n: i32,
     /// Robot start cells and headings: robot 0 at (1, 1) facing east, robot 1 at (N-2, 1) facing
@@ -22,7 +22,7 @@ pub struct Layout {
     pub waypoints: [Cell; 4],
 }
 
-impl Layout {
+impl GridLayout {
     /// The layout of an N x N grid. `n` must be even and >= 8 (checked by the constructor of
     /// [`super::BoxPushing`]).
     pub fn new(n: i32) -> Self {
@@ -57,7 +57,7 @@ mod tests {
 
     #[test]
     fn ten_by_ten_matches_the_spec_table() {
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         assert_eq!(l.robot_starts[0], (Cell::new(1, 1), Heading::East));
         assert_eq!(l.robot_starts[1], (Cell::new(8, 1), Heading::West));
         assert_eq!(l.small_boxes, [Cell::new(1, 5), Cell::new(8, 5)]);
@@ -76,7 +76,7 @@ mod tests {
 
     #[test]
     fn thirty_by_thirty_matches_the_spec_table() {
-        let l = Layout::new(30);
+        let l = GridLayout::new(30);
         assert_eq!(l.robot_starts[1], (Cell::new(28, 1), Heading::West));
         assert_eq!(l.small_boxes, [Cell::new(1, 15), Cell::new(28, 15)]);
         assert_eq!(l.big_box_left, Cell::new(14, 15));
@@ -94,7 +94,7 @@ mod tests {
     #[test]
     fn every_waypoint_is_directly_below_its_box() {
         for n in [8, 10, 12, 30] {
-            let l = Layout::new(n);
+            let l = GridLayout::new(n);
             assert_eq!(l.waypoints[0].step(Heading::North), l.small_boxes[0]);
             assert_eq!(l.waypoints[1].step(Heading::North), l.small_boxes[1]);
             assert_eq!(l.waypoints[2].step(Heading::North), l.big_box_left);

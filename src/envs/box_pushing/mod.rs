@@ -23,7 +23,7 @@ mod properties;
 mod scenarios;
 
 use self::actions::{ACTION_NAMES, N_ACTIONS};
-use self::layout::Layout;
+use self::layout::GridLayout;
 use self::observe::{OBS_NAMES, OBS_SIZE, RESET_OBS};
 use self::state::{Boxes, Robot};
 use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -57,7 +57,7 @@ pub struct DeliveryStats {
 /// Constructed in the reset state, so `step` may be called at once.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BoxPushing {
-    layout: Layout,
+    layout: GridLayout,
     horizon: usize,
     robots: [Robot; N_AGENTS],
     boxes: Boxes,
@@ -106,7 +106,7 @@ impl BoxPushing {
                 reason: "must be at least 1 primitive step, got 0".to_string(),
             });
         }
-        let layout = Layout::new(grid as i32);
+        let layout = GridLayout::new(grid as i32);
         Ok(Self {
             robots: start_robots(&layout),
             boxes: start_boxes(&layout),
@@ -128,7 +128,7 @@ impl BoxPushing {
     }
 
     /// The fixed start configuration and waypoints.
-    pub fn layout(&self) -> &Layout {
+    pub fn layout(&self) -> &GridLayout {
         &self.layout
     }
 
@@ -185,13 +185,13 @@ impl BoxPushing {
 }
 
 /// Both robots at their start cells, free, remembering no waypoint (spec 2).
-fn start_robots(layout: &Layout) -> [Robot; N_AGENTS] {
+fn start_robots(layout: &GridLayout) -> [Robot; N_AGENTS] {
     layout
         .robot_starts
         .map(|(cell, heading)| Robot::at_start(cell, heading))
 }
 
-fn start_boxes(layout: &Layout) -> Boxes {
+fn start_boxes(layout: &GridLayout) -> Boxes {
     Boxes {
         small: layout.small_boxes,
         big_left: layout.big_box_left,
@@ -257,7 +257,29 @@ impl MacroEnv for BoxPushing {
     fn render_ascii(&self) -> String {
         render::render(self)
     }
+
+    /// Known for the paper's two settings at gamma 0.98 (10x10 horizon 100, 30x30 horizon 200).
+    fn optimal_return(&self, discount: f64) -> Option<f64> {
+        match (self.grid(), self.horizon) {
+            (10, 100) if discount == 0.98 => Some(BP10_OPTIMAL),
+            (30, 200) if discount == 0.98 => Some(BP30_OPTIMAL),
+            _ => None,
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "Box Pushing {0}x{0}, horizon {1}",
+            self.grid(),
+            self.horizon
+        )
+    }
 }
+
+/// Optimal discounted return of Box Pushing 10x10 (horizon 100, gamma 0.98); `box_pushing.md` 11.
+pub const BP10_OPTIMAL: f64 = 80.71093744250365;
+/// Optimal discounted return of Box Pushing 30x30 (horizon 200, gamma 0.98); `box_pushing.md` 11.
+pub const BP30_OPTIMAL: f64 = 41.75397237445474;
 
 #[cfg(test)]
 mod tests {

@@ -69,10 +69,10 @@ pub fn move_step(robot: &mut Robot, k: u8, target: Cell, boxes: &Boxes) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::layout::Layout;
+    use super::super::layout::GridLayout;
     use super::*;
 
-    fn boxes(l: &Layout) -> Boxes {
+    fn boxes(l: &GridLayout) -> Boxes {
         Boxes {
             small: l.small_boxes,
             big_left: l.big_box_left,
@@ -80,7 +80,7 @@ mod tests {
     }
 
     /// Steps until finished, with a cap.
-    fn travel(robot: &mut Robot, k: u8, l: &Layout, cap: usize) -> Option<usize> {
+    fn travel(robot: &mut Robot, k: u8, l: &GridLayout, cap: usize) -> Option<usize> {
         let b = boxes(l);
         robot.finished = false;
         for s in 1..=cap {
@@ -96,7 +96,7 @@ mod tests {
     fn travel_times_from_the_start_match_the_spec_table() {
         // Spec 5.1: robot 0 to W0..W3 takes N/2-1, 3N/2-4, N-3, N-2 steps; robot 1 mirrored.
         for n in [8, 10, 12, 30] {
-            let l = Layout::new(n);
+            let l = GridLayout::new(n);
             let r0 = [n / 2 - 1, 3 * n / 2 - 4, n - 3, n - 2];
             let r1 = [3 * n / 2 - 4, n / 2 - 1, n - 2, n - 3];
             for k in 0..4u8 {
@@ -120,7 +120,7 @@ mod tests {
     #[test]
     fn robot_zero_to_w2_moves_east_three_times_turns_then_goes_north() {
         // Spec 5.1 example on 10x10.
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         let b = boxes(&l);
         let mut r = Robot::at_start(Cell::new(1, 1), Heading::East);
         r.finished = false;
@@ -148,7 +148,7 @@ mod tests {
     #[test]
     fn detour_around_small_box_one_takes_fourteen_steps() {
         // Spec 5.1 detour example (scenario S14's last leg): from (9,9) facing north to W1.
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         let b = boxes(&l);
         let mut r = Robot::at_start(Cell::new(9, 9), Heading::North);
         r.finished = false;
@@ -179,7 +179,7 @@ mod tests {
     #[test]
     fn behind_choice_turns_clockwise_not_towards_the_goal() {
         // Quirk Q7: facing east with the target straight west, the robot turns to south.
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         let b = boxes(&l);
         let mut r = Robot::at_start(Cell::new(6, 4), Heading::East);
         r.finished = false;
@@ -189,7 +189,7 @@ mod tests {
 
     #[test]
     fn on_the_waypoint_any_heading_snaps_north_in_one_step() {
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         let b = boxes(&l);
         let mut r = Robot::at_start(l.waypoints[3], Heading::South);
         r.finished = false;
@@ -204,7 +204,7 @@ mod tests {
         // Spec 5.1: exhaustive for N = 10 and 30, worst case 14 steps over the Manhattan distance.
         let mut worst = 0;
         for n in [10, 30] {
-            let l = Layout::new(n);
+            let l = GridLayout::new(n);
             let b = boxes(&l);
             for col in 0..n {
                 for row in 0..n {

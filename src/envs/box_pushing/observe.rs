@@ -33,7 +33,7 @@ pub fn observe(robot: &Robot, teammate: &Robot, boxes: &Boxes, n: i32) -> [f32; 
 #[cfg(test)]
 mod tests {
     use super::super::geometry::{Cell, Heading};
-    use super::super::layout::Layout;
+    use super::super::layout::GridLayout;
     use super::*;
 
     fn at(col: i32, row: i32, h: Heading) -> Robot {
@@ -41,7 +41,7 @@ mod tests {
     }
 
     fn start_boxes() -> Boxes {
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         Boxes {
             small: l.small_boxes,
             big_left: l.big_box_left,

@@ -62,11 +62,11 @@ pub fn push_step(robot: &mut Robot, boxes: &mut Boxes, n: i32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::super::geometry::Cell;
-    use super::super::layout::Layout;
+    use super::super::layout::GridLayout;
     use super::*;
 
     fn setup(cell: Cell, heading: Heading) -> (Robot, Boxes) {
-        let l = Layout::new(10);
+        let l = GridLayout::new(10);
         let mut r = Robot::at_start(cell, heading);
         r.finished = false;
         (

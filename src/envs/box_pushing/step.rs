@@ -2,7 +2,7 @@
 
 use super::actions::{MacroAction, N_ACTIONS, PUSH};
 use super::geometry::Heading;
-use super::layout::Layout;
+use super::layout::GridLayout;
 use super::navigate::move_step;
 use super::observe::observe;
 use super::push::push_step;
@@ -19,7 +19,7 @@ pub const BIG_BOX_BONUS: f64 = 100.0;
 
 /// One primitive step of macro-action `m` for one robot (spec 5). Returns its penalty.
 #[inline]
-fn execute(robot: &mut Robot, m: MacroAction, boxes: &mut Boxes, layout: &Layout) -> f64 {
+fn execute(robot: &mut Robot, m: MacroAction, boxes: &mut Boxes, layout: &GridLayout) -> f64 {
     match m {
         MacroAction::MoveTo(k) => {
             move_step(robot, k, layout.waypoints[k as usize], boxes);

@@ -9,7 +9,6 @@
 //! file. At the paper's settings nothing is random; with `tb_move_noisy > 0` travel steps draw
 //! normals from the caller's [`EnvRng`].
 
-mod bench;
 mod fetch;
 mod human;
 mod observe;
@@ -26,7 +25,6 @@ mod scenarios;
 #[cfg(test)]
 mod testkit;
 
-pub use bench::{measure_random_steps_per_sec, run_random_macro_actions, RandomRunStats};
 pub use fetch::{Fetch, FetchAction};
 pub use human::Human;
 pub use observe::{FETCH_OBS, TB_OBS};
@@ -36,7 +34,7 @@ pub use turtlebot::{TbAction, Turtlebot};
 
 use rand_distr::Normal;
 
-use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use crate::envs::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
 use fetch::FetchDynamics;
 use turtlebot::TbDynamics;
 
@@ -232,4 +230,30 @@ impl MacroEnv for Warehouse {
     fn render_ascii(&self) -> String {
         render::render(self)
     }
+
+    /// Warehouse's first step overwrites the held observations of the agents that finished in it
+    /// (quirk Q20, faithful).
+    fn first_record_obs(&self) -> FirstRecordObs {
+        FirstRecordObs::OverwrittenByFirstStep
+    }
+
+    /// Random only with Turtlebot movement noise.
+    fn deterministic(&self) -> bool {
+        self.params.tb_move_noisy == 0.0
+    }
+
+    /// Known for the paper's horizon 150 at gamma 1.
+    fn optimal_return(&self, discount: f64) -> Option<f64> {
+        (self.params.terminate_step == 150 && discount == 1.0).then_some(WTD_OPTIMAL)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "Warehouse Tool Delivery, horizon {}",
+            self.params.terminate_step
+        )
+    }
 }
+
+/// Best achievable return of Warehouse Tool Delivery (horizon 150, gamma 1); `warehouse.md` 10.
+pub const WTD_OPTIMAL: f64 = 262.0;

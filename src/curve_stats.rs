@@ -1,6 +1,7 @@
 //! The statistics behind a learning curve (spec `algorithms.md` 7.2): the mean over runs at each
 //! evaluation point, its standard error, and the centred moving average the paper calls
-//! "smoothed by 20 neighbors". Pure functions on numbers; no files, no drawing.
+//! "smoothed by 20 neighbors". Pure functions on numbers; no files, no drawing. Shared by the
+//! figures (`plot`) and the terminal report after training (`experiment::report`), and below both.
 
 use std::collections::BTreeMap;
 
