@@ -133,6 +133,18 @@ pub fn synthetic_weights(
     n_actions: usize,
     value: impl Fn(&str, usize) -> f32,
 ) -> Vec<u8> {
+    synthetic_weights_named(arch, obs_len, n_actions, str::to_string, value)
+}
+
+/// [`synthetic_weights`] with every tensor stored under `rename(canonical_name)` (e.g. the
+/// reference's `rnn.*` scheme); `value` still sees the canonical name.
+pub fn synthetic_weights_named(
+    arch: &Architecture,
+    obs_len: usize,
+    n_actions: usize,
+    rename: impl Fn(&str) -> String,
+    value: impl Fn(&str, usize) -> f32,
+) -> Vec<u8> {
     let tensors: Vec<(String, Vec<usize>, Vec<u8>)> = arch
         .tensors(obs_len, n_actions)
         .into_iter()
@@ -141,7 +153,7 @@ pub fn synthetic_weights(
             let bytes = (0..n)
                 .flat_map(|i| value(name, i).to_le_bytes())
                 .collect::<Vec<u8>>();
-            (name.to_string(), shape, bytes)
+            (rename(name), shape, bytes)
         })
         .collect();
     let views = tensors.iter().map(|(name, shape, bytes)| {

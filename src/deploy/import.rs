@@ -12,7 +12,7 @@ use crate::deploy::manifest::{sha256_hex, Manifest, ManifestError, RunInfo};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::nn::safetensors_io::{from_safetensors_bytes, to_safetensors_bytes};
 use crate::nn::QNetConfig;
-use safetensors::tensor::{Dtype, TensorView};
+use safetensors::tensor::Dtype;
 use safetensors::SafeTensors;
 use serde::Serialize;
 use std::io::Read;
@@ -411,30 +411,17 @@ pub fn reference_state_dict(
     naming: Naming,
     value: impl Fn(&str, usize) -> f32,
 ) -> Vec<u8> {
-    let tensors: Vec<(String, Vec<usize>, Vec<u8>)> = arch
-        .tensors(obs_len, n_actions)
-        .into_iter()
-        .map(|(name, shape)| {
-            let n: usize = shape.iter().product();
-            let bytes = (0..n).flat_map(|i| value(name, i).to_le_bytes()).collect();
-            let named = match naming {
-                Naming::Rnn => name.replacen(LSTM_PREFIX, RNN_PREFIX, 1),
-                Naming::Lstm => name.to_string(),
-            };
-            (named, shape, bytes)
-        })
-        .collect();
-    let views = tensors.iter().map(|(name, shape, bytes)| {
-        let view = TensorView::new(Dtype::F32, shape.clone(), bytes)
-            .expect("shape and byte count agree by construction");
-        (name.clone(), view)
-    });
-    safetensors::serialize(views, &None).expect("serializing in-memory f32 tensors cannot fail")
+    let rename = |name: &str| match naming {
+        Naming::Rnn => name.replacen(LSTM_PREFIX, RNN_PREFIX, 1),
+        Naming::Lstm => name.to_string(),
+    };
+    crate::deploy::architecture::synthetic_weights_named(arch, obs_len, n_actions, rename, value)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use safetensors::tensor::TensorView;
     use crate::deploy::architecture::synthetic_weights;
     use crate::deploy::manifest::load_all;
 
