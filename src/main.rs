@@ -872,12 +872,8 @@ fn deploy(args: DeployArgs) -> Result<()> {
         args.episodes,
         &mut rng,
         std::time::Duration::from_secs(args.timeout_secs),
-        |mut trace| {
-            if !args.trajectories {
-                trace.trajectory.clear();
-            }
-            serde_json::to_writer(&mut out, &trace).map_err(std::io::Error::from)?;
-            writeln!(out)?;
+        |trace| {
+            writeln!(out, "{}", trace.json_line(args.trajectories))?;
             out.flush()?;
             count += 1;
             sum += trace.discounted_return;

@@ -421,9 +421,9 @@ pub fn reference_state_dict(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use safetensors::tensor::TensorView;
     use crate::deploy::architecture::synthetic_weights;
     use crate::deploy::manifest::load_all;
+    use safetensors::tensor::TensorView;
 
     const BP10: EnvSpec = EnvSpec::BoxPushing {
         grid: 10,
