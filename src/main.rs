@@ -263,9 +263,11 @@ struct RobotArgs {
     exit_on_stdin_close: bool,
 }
 
+/// The flags of every command that plays a policy's greedy episodes (`deploy`, `eval`,
+/// `domain`), so the three take them with one spelling, one default and one meaning.
 #[derive(clap::Args)]
-struct DeployArgs {
-    /// Exported policy directory.
+struct EpisodeArgs {
+    /// Policy directory (from `export` or `import`).
     #[arg(long)]
     policy: PathBuf,
     /// Episodes to run.
@@ -278,6 +280,12 @@ struct DeployArgs {
     /// Include every step (executed macro-actions, reward, finished flags) in the output.
     #[arg(long)]
     trajectories: bool,
+}
+
+#[derive(clap::Args)]
+struct DeployArgs {
+    #[command(flatten)]
+    episodes: EpisodeArgs,
     /// Seconds to wait for a robot to start or to answer one message.
     #[arg(long, default_value_t = 30)]
     timeout_secs: u64,
@@ -323,37 +331,22 @@ struct ImportArgs {
 
 #[derive(clap::Args)]
 struct EvalArgs {
-    /// Policy directory (from `export` or `import`).
-    #[arg(long)]
-    policy: PathBuf,
-    /// Episodes to run.
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
-    episodes: usize,
-    /// Seed of the environment's random stream (default: the run's seed), as for `deploy`.
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Include every step (executed macro-actions, reward, finished flags) in the output.
-    #[arg(long)]
-    trajectories: bool,
+    #[command(flatten)]
+    episodes: EpisodeArgs,
 }
 
 #[derive(clap::Args)]
+// The robots must serve this very policy: said where `domain --help` describes --policy.
+#[command(mut_arg("policy", |a| a.help(
+    "Policy directory the robots run (their `info` must report its manifest)"
+)))]
 struct DomainArgs {
-    /// Policy directory the robots run (their `info` must report its manifest).
-    #[arg(long)]
-    policy: PathBuf,
+    #[command(flatten)]
+    episodes: EpisodeArgs,
     /// Comma-separated robot addresses in agent order, e.g. 127.0.0.1:7000,127.0.0.1:7001.
-    #[arg(long, value_delimiter = ',', required = true)]
+    // Listed right after --policy in the help, where it was before --policy moved to EpisodeArgs.
+    #[arg(long, value_delimiter = ',', required = true, display_order = 0)]
     robots: Vec<std::net::SocketAddr>,
-    /// Episodes to run.
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
-    episodes: usize,
-    /// Seed of the environment's random stream (default: the run's seed), as for `deploy`.
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Include every step (executed macro-actions, reward, finished flags) in the output.
-    #[arg(long)]
-    trajectories: bool,
     /// Seconds to wait for a robot to accept the connection or to answer one message.
     #[arg(long, default_value_t = 30)]
     timeout_secs: u64,
@@ -848,45 +841,103 @@ fn robot(args: RobotArgs) -> Result<()> {
     Ok(())
 }
 
+/// A loaded policy directory and the evaluation stream its episodes draw from.
+struct EpisodeRun {
+    manifest: macdec::deploy::Manifest,
+    verified: Vec<macdec::deploy::VerifiedAgent>,
+    /// `--seed`, or the run's seed.
+    seed: u64,
+    rng: macdec::envs::EnvRng,
+}
+
+impl EpisodeArgs {
+    /// The policy (manifest and verified weights) and the evaluation env's stream of the seed.
+    fn load(&self) -> Result<EpisodeRun> {
+        use macdec::experiment::seeds::{stream, Role};
+        let (manifest, verified) = macdec::deploy::manifest::load_all(&self.policy)
+            .with_context(|| format!("loading policy {}", self.policy.display()))?;
+        let seed = self.seed.unwrap_or(manifest.run.seed);
+        Ok(EpisodeRun {
+            manifest,
+            verified,
+            seed,
+            rng: stream(seed, Role::EvalEnv),
+        })
+    }
+}
+
+/// Prints each episode's JSON line to stdout as it ends (flushed, so a long run streams) and
+/// keeps the sums the summary line reports.
+struct EpisodePrinter {
+    trajectories: bool,
+    count: usize,
+    discounted: f64,
+    undiscounted: f64,
+}
+
+impl EpisodePrinter {
+    fn new(trajectories: bool) -> Self {
+        Self {
+            trajectories,
+            count: 0,
+            discounted: 0.0,
+            undiscounted: 0.0,
+        }
+    }
+
+    fn print(
+        &mut self,
+        trace: macdec::deploy::EpisodeTrace,
+    ) -> Result<(), macdec::deploy::driver::DeployError> {
+        let mut out = std::io::stdout().lock();
+        writeln!(out, "{}", trace.json_line(self.trajectories))?;
+        out.flush()?;
+        self.count += 1;
+        self.discounted += trace.discounted_return;
+        self.undiscounted += trace.undiscounted_return;
+        Ok(())
+    }
+
+    /// `N episode(s) of DOMAIN WHERE, seed S: mean discounted return M`, the line every episode
+    /// command ends with (on stderr, so stdout stays JSON lines).
+    fn summary(&self, run: &EpisodeRun, place: &str) -> String {
+        format!(
+            "{} episode(s) of {} {place}, seed {}: mean discounted return {:.4}",
+            self.count,
+            run.manifest.env.name(),
+            run.seed,
+            self.discounted / self.count.max(1) as f64
+        )
+    }
+
+    fn mean_undiscounted(&self) -> f64 {
+        self.undiscounted / self.count.max(1) as f64
+    }
+}
+
 fn deploy(args: DeployArgs) -> Result<()> {
-    use macdec::deploy::{manifest::load_all, processes::deploy_streaming};
-    use macdec::experiment::seeds::{stream, Role};
-    let (manifest, _) = load_all(&args.policy)
-        .with_context(|| format!("loading policy {}", args.policy.display()))?;
-    let seed = args.seed.unwrap_or(manifest.run.seed);
-    let mut rng = stream(seed, Role::EvalEnv);
+    use macdec::deploy::processes::deploy_streaming;
+    let mut run = args.episodes.load()?;
     let exe = std::env::current_exe().context("locating the macdec executable")?;
     let extra: Vec<String> = if args.mock {
         vec!["--mock".into()]
     } else {
         vec![]
     };
-    // Each episode's line is printed and flushed as it ends.
-    let (mut count, mut sum) = (0usize, 0.0f64);
-    let mut out = std::io::stdout().lock();
+    let mut printer = EpisodePrinter::new(args.episodes.trajectories);
     deploy_streaming(
         &exe,
-        &args.policy,
-        &manifest,
+        &args.episodes.policy,
+        &run.manifest,
         &extra,
-        args.episodes,
-        &mut rng,
+        args.episodes.episodes,
+        &mut run.rng,
         std::time::Duration::from_secs(args.timeout_secs),
-        |trace| {
-            writeln!(out, "{}", trace.json_line(args.trajectories))?;
-            out.flush()?;
-            count += 1;
-            sum += trace.discounted_return;
-            Ok(())
-        },
+        |trace| printer.print(trace),
     )
-    .with_context(|| format!("deploying {}", args.policy.display()))?;
-    let mean = sum / count.max(1) as f64;
-    eprintln!(
-        "{count} episode(s) of {} with {} robot process(es), seed {seed}: mean discounted return {mean:.4}",
-        manifest.env.name(),
-        manifest.agents.len()
-    );
+    .with_context(|| format!("deploying {}", args.episodes.policy.display()))?;
+    let place = format!("with {} robot process(es)", run.manifest.agents.len());
+    eprintln!("{}", printer.summary(&run, &place));
     Ok(())
 }
 
@@ -925,64 +976,43 @@ fn import(args: ImportArgs) -> Result<()> {
 }
 
 fn eval(args: EvalArgs) -> Result<()> {
-    use macdec::deploy::{driver::DeployError, local_eval::eval_policy, manifest::load_all};
-    use macdec::experiment::seeds::{stream, Role};
-    let (manifest, verified) = load_all(&args.policy)
-        .with_context(|| format!("loading policy {}", args.policy.display()))?;
-    let seed = args.seed.unwrap_or(manifest.run.seed);
-    let mut rng = stream(seed, Role::EvalEnv);
-    let mut out = std::io::stdout().lock();
-    let (mut n, mut sum, mut sum_undiscounted) = (0usize, 0.0, 0.0);
-    eval_policy(&manifest, &verified, args.episodes, &mut rng, |trace| {
-        writeln!(out, "{}", trace.json_line(args.trajectories))
-            .and_then(|()| out.flush())
-            .map_err(|e| DeployError::Policy(format!("writing to stdout: {e}")))?;
-        n += 1;
-        sum += trace.discounted_return;
-        sum_undiscounted += trace.undiscounted_return;
-        Ok(())
-    })
+    let args = args.episodes;
+    let mut run = args.load()?;
+    let mut printer = EpisodePrinter::new(args.trajectories);
+    macdec::deploy::local_eval::eval_policy(
+        &run.manifest,
+        &run.verified,
+        args.episodes,
+        &mut run.rng,
+        |trace| printer.print(trace),
+    )
     .with_context(|| format!("evaluating {}", args.policy.display()))?;
-    let count = n.max(1) as f64;
     eprintln!(
-        "{n} episode(s) of {} in-process, seed {seed}: mean discounted return {:.4}, mean undiscounted {:.4}",
-        manifest.env.name(),
-        sum / count,
-        sum_undiscounted / count
+        "{}, mean undiscounted {:.4}",
+        printer.summary(&run, "in-process"),
+        printer.mean_undiscounted()
     );
     Ok(())
 }
 
 fn domain(args: DomainArgs) -> Result<()> {
-    use macdec::deploy::{driver::DeployError, manifest::load_all, remote::run_with_robots_at};
-    use macdec::experiment::seeds::{stream, Role};
-    let (manifest, _) = load_all(&args.policy)
-        .with_context(|| format!("loading policy {}", args.policy.display()))?;
-    let seed = args.seed.unwrap_or(manifest.run.seed);
-    let mut rng = stream(seed, Role::EvalEnv);
-    let mut out = std::io::stdout().lock();
-    let (mut n, mut sum) = (0usize, 0.0);
-    run_with_robots_at(
-        &manifest,
+    let mut run = args.episodes.load()?;
+    let mut printer = EpisodePrinter::new(args.episodes.trajectories);
+    macdec::deploy::remote::run_with_robots_at(
+        &run.manifest,
         &args.robots,
-        args.episodes,
-        &mut rng,
+        args.episodes.episodes,
+        &mut run.rng,
         std::time::Duration::from_secs(args.timeout_secs),
-        |trace| {
-            writeln!(out, "{}", trace.json_line(args.trajectories))
-                .and_then(|()| out.flush())
-                .map_err(|e| DeployError::Policy(format!("writing to stdout: {e}")))?;
-            n += 1;
-            sum += trace.discounted_return;
-            Ok(())
-        },
+        |trace| printer.print(trace),
     )
-    .with_context(|| format!("running {} against its robots", args.policy.display()))?;
-    eprintln!(
-        "{n} episode(s) of {} with {} remote robot(s), seed {seed}: mean discounted return {:.4}",
-        manifest.env.name(),
-        manifest.agents.len(),
-        sum / n.max(1) as f64
-    );
+    .with_context(|| {
+        format!(
+            "running {} against its robots",
+            args.episodes.policy.display()
+        )
+    })?;
+    let place = format!("with {} remote robot(s)", run.manifest.agents.len());
+    eprintln!("{}", printer.summary(&run, &place));
     Ok(())
 }
