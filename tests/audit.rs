@@ -4,13 +4,10 @@
 
 use std::io::Write;
 use std::path::Path;
-use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+mod common;
 
-fn macdec(args: &[&str]) -> std::process::Output {
-    Command::new(BIN).args(args).output().expect("macdec runs")
-}
+use common::run as macdec;
 
 fn gzip(bytes: &[u8]) -> Vec<u8> {
     let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());

@@ -12,7 +12,9 @@ use macdec::experiment::seeds::{stream, Role};
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+mod common;
+
+use common::{ok, traces, BIN};
 
 const BP10: EnvSpec = EnvSpec::BoxPushing {
     grid: 10,
@@ -203,16 +205,7 @@ fn deployed_robot_processes_equal_in_process_greedy_execution() {
         .arg(dir.path())
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let deployed: Vec<EpisodeTrace> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let deployed = traces(&out);
     let mut links: Vec<LocalLink<MockPolicy>> = mock_policies(&manifest)
         .into_iter()
         .map(LocalLink::new)
@@ -265,11 +258,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         .arg(&results)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
 
     // Cen-DDRQN has no decentralized nets: refused with the reason.
     let out = Command::new(BIN)
@@ -292,11 +281,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         .arg(&policy)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let (manifest, _) = macdec::deploy::manifest::load_all(&policy).unwrap();
     assert_eq!(
         (manifest.run.method.as_str(), manifest.run.seed),
@@ -317,16 +302,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         .arg(&policy)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let deployed: Vec<EpisodeTrace> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let deployed = traces(&out);
     assert_eq!(deployed.len(), episodes);
 
     // In-process greedy evaluation of the checkpoint's nets, same seed (the run's), same stream.

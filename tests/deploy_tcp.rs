@@ -4,18 +4,22 @@
 //! at addresses (`macdec deploy --robots`) likewise, refused by name when misordered.
 
 use macdec::algos::evaluate::{greedy_episode, GreedyPolicy};
-use macdec::deploy::architecture::{synthetic_weights, Architecture};
+use macdec::deploy::architecture::Architecture;
 use macdec::deploy::driver::{run_episodes, EpisodeTrace};
 use macdec::deploy::link::{JsonLink, LocalLink};
 use macdec::deploy::local_eval::eval_policy;
-use macdec::deploy::manifest::{load_all, Manifest, RunInfo, VerifiedAgent};
+use macdec::deploy::manifest::{load_all, Manifest, VerifiedAgent};
 use macdec::deploy::mock::{mock_manifest, mock_policies, MockPolicy};
 use macdec::deploy::qnet_policy::{load_net, qnet_factory};
 use macdec::deploy::remote::run_with_robots_at;
 use macdec::deploy::robot::RobotSpec;
-use macdec::deploy::server::{spawn_server, Limits, PolicyFactory, RobotServer};
+use macdec::deploy::server::{spawn_server, Limits, RobotServer};
 use macdec::deploy::{greedy_action, AgentPolicy};
 use macdec::envs::{EnvRng, EnvSpec, MacroEnv};
+
+mod common;
+
+use common::{mock_robot_server, synthetic_agent_weights, test_run, write_synthetic_policy};
 use macdec::nn::QNet;
 use rand::SeedableRng;
 use std::net::{SocketAddr, TcpListener};
@@ -64,17 +68,8 @@ fn tcp_robots(
     Vec<JsonLink<std::io::BufReader<std::net::TcpStream>, std::net::TcpStream>>,
 ) {
     let manifest = mock_manifest(env_spec);
-    let servers: Vec<RobotServer> = manifest
-        .agents
-        .iter()
-        .map(|a| {
-            let (obs, n, salt) = (a.obs_size, a.n_actions, a.index as u64);
-            let factory: PolicyFactory =
-                Arc::new(move || Box::new(MockPolicy::new(obs, n, salt)) as Box<dyn AgentPolicy>);
-            let spec = Arc::new(RobotSpec::new(&manifest, a.index).unwrap());
-            let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-            spawn_server(listener, factory, spec, Limits::default()).unwrap()
-        })
+    let servers: Vec<RobotServer> = (0..manifest.agents.len())
+        .map(|i| mock_robot_server(&manifest, i, i as u64))
         .collect();
     let links = servers
         .iter()
@@ -225,29 +220,10 @@ fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
         tb_m_noisy: 0.2,
     };
     let mut env = env_spec.build().unwrap();
-    // Large pseudo-random weights, so the greedy actions change along an episode (freshly
-    // initialized nets mostly repeat one macro-action).
+    // Large pseudo-random weights, so the greedy actions change along an episode.
     let arch = Architecture::ddrqn(16, 8);
-    let weights: Vec<Vec<u8>> = (0..env.n_agents())
-        .map(|i| {
-            synthetic_weights(&arch, env.obs_sizes()[i], env.n_actions()[i], |name, k| {
-                let mut h = (k as u64) ^ ((name.len() as u64) << 32) ^ ((i as u64) << 48);
-                for _ in 0..2 {
-                    h = (h ^ (h >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-                }
-                ((h >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 3.0
-            })
-        })
-        .collect();
-    let run = RunInfo {
-        experiment: "test".into(),
-        method: "our1".into(),
-        variant: String::new(),
-        seed: 0,
-        episodes_trained: 0,
-        config: serde_json::Value::Null,
-    };
-    let manifest = Manifest::build(env_spec, 0.95, arch, run, &weights).unwrap();
+    let weights = synthetic_agent_weights(&env, &arch);
+    let manifest = Manifest::build(env_spec, 0.95, arch, test_run(0), &weights).unwrap();
     let nets: Vec<QNet> = (0..env.n_agents())
         .map(|i| {
             let verified = VerifiedAgent {
@@ -307,21 +283,6 @@ fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
     assert!(distinct_actions.len() > 1, "{distinct_actions:?}");
 }
 
-/// Large pseudo-random weights, so greedy actions change along an episode.
-fn weights(env: &impl MacroEnv, arch: &Architecture) -> Vec<Vec<u8>> {
-    (0..env.n_agents())
-        .map(|i| {
-            synthetic_weights(arch, env.obs_sizes()[i], env.n_actions()[i], |name, k| {
-                let mut h = (k as u64) ^ ((name.len() as u64) << 32) ^ ((i as u64) << 48);
-                for _ in 0..2 {
-                    h = (h ^ (h >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-                }
-                ((h >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 3.0
-            })
-        })
-        .collect()
-}
-
 #[test]
 fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
     let spec = EnvSpec::Warehouse {
@@ -329,25 +290,8 @@ fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
         tb_m_noisy: 0.3,
     };
     let mut env = spec.build().unwrap();
-    let arch = Architecture::ddrqn(16, 8);
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo {
-        experiment: "test".into(),
-        method: "our1".into(),
-        variant: String::new(),
-        seed: 0,
-        episodes_trained: 0,
-        config: serde_json::Value::Null,
-    };
-    Manifest::write_policy(
-        dir.path(),
-        spec,
-        1.0,
-        arch,
-        run,
-        &weights(&env, &Architecture::ddrqn(16, 8)),
-    )
-    .unwrap();
+    write_synthetic_policy(dir.path(), spec, 1.0, 0);
     let (manifest, verified) = load_all(dir.path()).unwrap();
 
     let mut seen = Vec::new();
@@ -398,18 +342,6 @@ fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
     assert_ne!(seen[0].trajectory, seen[1].trajectory);
 }
 
-/// A robot server thread serving agent `agent` of `manifest` with a mock policy salted
-/// `salt` (the agent's own salt is its index).
-fn robot(manifest: &Manifest, agent: usize, salt: u64) -> RobotServer {
-    let a = &manifest.agents[agent];
-    let (obs, n) = (a.obs_size, a.n_actions);
-    let factory: PolicyFactory =
-        Arc::new(move || Box::new(MockPolicy::new(obs, n, salt)) as Box<dyn AgentPolicy>);
-    let spec = Arc::new(RobotSpec::new(manifest, agent).unwrap());
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    spawn_server(listener, factory, spec, Limits::default()).unwrap()
-}
-
 fn spec() -> EnvSpec {
     EnvSpec::Warehouse {
         horizon: 150,
@@ -421,7 +353,7 @@ fn spec() -> EnvSpec {
 fn robots_at_addresses_give_the_in_process_episodes() {
     let manifest = mock_manifest(spec());
     let servers: Vec<RobotServer> = (0..manifest.agents.len())
-        .map(|i| robot(&manifest, i, i as u64))
+        .map(|i| mock_robot_server(&manifest, i, i as u64))
         .collect();
     let addrs: Vec<SocketAddr> = servers.iter().map(|s| s.local_addr()).collect();
     let mut remote = Vec::new();
@@ -458,7 +390,7 @@ fn robots_at_addresses_give_the_in_process_episodes() {
 fn robots_in_the_wrong_order_or_number_are_refused_by_name() {
     let manifest = mock_manifest(spec());
     let servers: Vec<RobotServer> = (0..manifest.agents.len())
-        .map(|i| robot(&manifest, i, i as u64))
+        .map(|i| mock_robot_server(&manifest, i, i as u64))
         .collect();
     let mut addrs: Vec<SocketAddr> = servers.iter().map(|s| s.local_addr()).collect();
     let run = |addrs: &[SocketAddr]| {

@@ -2,41 +2,9 @@
 //! are driven by `macdec domain --robots`, which prints exactly `macdec eval`'s episodes; robots
 //! given in the wrong order are refused by name.
 
-use std::io::{BufRead, BufReader};
-use std::path::Path;
-use std::process::{Child, Command, Output, Stdio};
+mod common;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-/// A listening robot process and its address; killed on drop.
-struct Robot(Child, String);
-
-impl Drop for Robot {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn robot(policy: &Path, agent: usize) -> Robot {
-    let mut child = Command::new(BIN)
-        .args(["robot", "--policy", policy.to_str().unwrap()])
-        .args(["--agent", &agent.to_string(), "--listen", "127.0.0.1:0"])
-        .args(["--mock"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let v: serde_json::Value = serde_json::from_str(&line).unwrap();
-    Robot(child, v["listening"].as_str().unwrap().to_string())
-}
+use common::{robot_process, run};
 
 #[test]
 fn domain_against_listening_robots_prints_the_eval_and_deploy_episodes() {
@@ -47,8 +15,8 @@ fn domain_against_listening_robots_prints_the_eval_and_deploy_episodes() {
     };
     macdec::deploy::mock::write_mock_policy(dir.path(), spec).unwrap();
     let p = dir.path().to_str().unwrap();
-    let robots: Vec<Robot> = (0..3).map(|i| robot(dir.path(), i)).collect();
-    let addrs: Vec<&str> = robots.iter().map(|r| r.1.as_str()).collect();
+    let robots: Vec<_> = (0..3).map(|i| robot_process(dir.path(), i, true)).collect();
+    let addrs: Vec<&str> = robots.iter().map(|r| r.addr.as_str()).collect();
     let common = [
         "--policy",
         p,

@@ -3,70 +3,14 @@
 //! runs exactly as `deploy` does on robot processes; bad files are refused with the file and
 //! tensor named, and nothing is written.
 
+mod common;
+
+use common::{agents_arg, run, stdout_lines, weight, write_agents};
 use macdec::deploy::architecture::Architecture;
 use macdec::deploy::import::{reference_state_dict, Naming};
 use macdec::deploy::manifest::{load_all, MANIFEST_FILE};
 use macdec::deploy::EpisodeTrace;
-use macdec::envs::{EnvSpec, MacroEnv};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
-
-/// Large pseudo-random weights (agent-specific), so greedy actions change along an episode.
-fn weight(agent: usize) -> impl Fn(&str, usize) -> f32 {
-    move |name, k| {
-        let mut h = (k as u64) ^ ((name.len() as u64) << 32) ^ ((agent as u64) << 48);
-        for _ in 0..2 {
-            h = (h ^ (h >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        }
-        ((h >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 3.0
-    }
-}
-
-/// One reference-named state_dict per agent of `env` in `dir`, agent i named as `namings[i]`.
-fn write_agents(dir: &Path, env: EnvSpec, arch: &Architecture, namings: &[Naming]) -> Vec<PathBuf> {
-    let built = env.build().unwrap();
-    (0..built.n_agents())
-        .map(|i| {
-            let bytes = reference_state_dict(
-                arch,
-                built.obs_sizes()[i],
-                built.n_actions()[i],
-                namings[i % namings.len()],
-                weight(i),
-            );
-            let path = dir.join(format!("a{i}.safetensors"));
-            std::fs::write(&path, bytes).unwrap();
-            path
-        })
-        .collect()
-}
-
-fn agents_arg(paths: &[PathBuf]) -> String {
-    paths
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn stdout_lines(out: &Output) -> Vec<String> {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone())
-        .unwrap()
-        .lines()
-        .map(str::to_string)
-        .collect()
-}
+use macdec::envs::EnvSpec;
 
 #[test]
 fn imported_policies_evaluate_exactly_as_deployed_on_robot_processes() {

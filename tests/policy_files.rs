@@ -8,7 +8,9 @@ use macdec::experiment::train_run::{load_checkpoint, CHECKPOINT};
 use std::path::Path;
 use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+mod common;
+
+use common::{ok, BIN};
 
 /// A tiny Box Pushing experiment with one decentralized and one centralized method.
 const TINY: &str = r#"
@@ -35,15 +37,6 @@ fn macdec(args: &[&str], paths: &[&Path]) -> std::process::Output {
         cmd.arg(p);
     }
     cmd.output().unwrap()
-}
-
-fn ok(out: &std::process::Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 fn export(run: &Path, out: &Path) -> std::process::Output {

@@ -8,16 +8,18 @@
 //! every episode played over ROS to equal `macdec eval`'s. A second run seeds the eval side
 //! differently and requires the script to report the difference, so "identical" is not vacuous.
 
+mod common;
+
+use common::{agents_arg, write_agents, BIN};
 use macdec::deploy::architecture::Architecture;
-use macdec::deploy::import::{reference_state_dict, Naming};
-use macdec::envs::{EnvSpec, MacroEnv};
+use macdec::deploy::import::Naming;
+use macdec::envs::EnvSpec;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
-
+/// `macdec ARGS`, which must succeed.
 fn run(args: &[&str]) -> Output {
-    let out = Command::new(BIN).args(args).output().unwrap();
+    let out = common::run(args);
     assert!(
         out.status.success(),
         "macdec {args:?}: {}",
@@ -31,30 +33,13 @@ fn warehouse_policy(dir: &Path) -> PathBuf {
     let env = EnvSpec::Warehouse {
         horizon: 150,
         tb_m_noisy: 0.3,
-    }
-    .build()
-    .unwrap();
-    let arch = Architecture::ddrqn(16, 8);
-    let files: Vec<String> = (0..env.n_agents())
-        .map(|i| {
-            let bytes = reference_state_dict(
-                &arch,
-                env.obs_sizes()[i],
-                env.n_actions()[i],
-                Naming::Lstm,
-                |name, k| {
-                    let mut h = (k as u64) ^ ((name.len() as u64) << 32) ^ ((i as u64) << 48);
-                    for _ in 0..2 {
-                        h = (h ^ (h >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-                    }
-                    ((h >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 3.0
-                },
-            );
-            let path = dir.join(format!("a{i}.safetensors"));
-            std::fs::write(&path, bytes).unwrap();
-            path.display().to_string()
-        })
-        .collect();
+    };
+    let files = agents_arg(&write_agents(
+        dir,
+        env,
+        &Architecture::ddrqn(16, 8),
+        &[Naming::Lstm],
+    ));
     let policy = dir.join("policy-wtd");
     run(&[
         "import",
@@ -65,7 +50,7 @@ fn warehouse_policy(dir: &Path) -> PathBuf {
         "--tb-m-noisy",
         "0.3",
         "--agents",
-        &files.join(","),
+        &files,
         "--out",
         policy.to_str().unwrap(),
     ]);

@@ -4,7 +4,9 @@
 use std::path::Path;
 use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+mod common;
+
+use common::BIN;
 
 const TINY: &str = r#"
 name = "tiny_slurm"

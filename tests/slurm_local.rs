@@ -10,7 +10,9 @@
 use std::path::Path;
 use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+mod common;
+
+use common::BIN;
 
 /// The values of the script's `slurm-local: <prefix><value>` lines.
 fn values<'a>(out: &'a str, prefix: &str) -> Vec<&'a str> {

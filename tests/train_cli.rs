@@ -4,7 +4,9 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_macdec");
+mod common;
+
+use common::BIN;
 
 /// A tiny Box Pushing experiment: a few hundred episodes, frequent checkpoints.
 const TINY: &str = r#"
