@@ -1,8 +1,10 @@
-//! Elementwise ops on same-shaped arrays: add, sub, mul, scale, sigmoid, tanh, leaky ReLU, square.
+//! Elementwise ops on same-shaped arrays: sub, leaky ReLU and square (the TD loss), and add, mul,
+//! sigmoid and tanh for the tests' unfused LSTM.
 
 use ndarray::{Array2, Zip};
 
 use super::{put, Op};
+#[cfg(test)]
 use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace};
 use crate::autograd::tape::{GradCx, Tape, Var};
 
@@ -28,6 +30,10 @@ impl Tape {
     }
 
     /// y = a + b (same shapes; see [`Tape::add_bias`] for broadcasting a row).
+    ///
+    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
+    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
+    #[cfg(test)]
     pub fn add(&mut self, a: Var, b: Var) -> Var {
         let y = self.binary(a, b, "add", |a, b| a + b);
         self.push_op(y, Op::Add { a, b }, &[a, b])
@@ -40,19 +46,20 @@ impl Tape {
     }
 
     /// y = a * b elementwise (same shapes).
+    ///
+    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
+    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
+    #[cfg(test)]
     pub fn mul(&mut self, a: Var, b: Var) -> Var {
         let y = self.binary(a, b, "mul", |a, b| a * b);
         self.push_op(y, Op::Mul { a, b }, &[a, b])
     }
 
-    /// y = c * x for a constant c.
-    pub fn scale(&mut self, x: Var, c: f32) -> Var {
-        let mut y = self.copy_of(x);
-        y.mapv_inplace(|v| c * v);
-        self.push_op(y, Op::Scale { x, c }, &[x])
-    }
-
     /// y = 1 / (1 + e^-x). Backward reuses the output: dy/dx = y (1 - y).
+    ///
+    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
+    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
+    #[cfg(test)]
     pub fn sigmoid(&mut self, x: Var) -> Var {
         let mut y = self.copy_of(x);
         sigmoid_inplace(y.as_slice_mut().expect("tape arrays are contiguous"));
@@ -60,6 +67,10 @@ impl Tape {
     }
 
     /// y = tanh(x). Backward reuses the output: dy/dx = 1 - y^2.
+    ///
+    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
+    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
+    #[cfg(test)]
     pub fn tanh(&mut self, x: Var) -> Var {
         let mut y = self.copy_of(x);
         tanh_inplace(y.as_slice_mut().expect("tape arrays are contiguous"));
@@ -83,6 +94,7 @@ impl Tape {
 }
 
 // d(a + b) = da + db
+#[cfg(test)]
 pub(super) fn add_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     for v in [a, b] {
         if let Some((d, mode)) = cx.slot(v) {
@@ -102,6 +114,7 @@ pub(super) fn sub_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
 }
 
 // d(a * b) = b da + a db (a fan-out mul(x, x) gets both terms: 2 x dx)
+#[cfg(test)]
 pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     let (va, vb) = (cx.value(a), cx.value(b));
     if let Some((d, mode)) = cx.slot(a) {
@@ -112,14 +125,8 @@ pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     }
 }
 
-// d(c x) = c dx
-pub(super) fn scale_backward(x: Var, c: f32, g: &Array2<f32>, cx: &mut GradCx) {
-    if let Some((d, mode)) = cx.slot(x) {
-        put!(mode, d, g; |g| c * g);
-    }
-}
-
 // dy/dx = y (1 - y)
+#[cfg(test)]
 pub(super) fn sigmoid_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         put!(mode, d, g, y; |g, y| g * y * (1.0 - y));
@@ -127,6 +134,7 @@ pub(super) fn sigmoid_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mu
 }
 
 // dy/dx = 1 - y^2
+#[cfg(test)]
 pub(super) fn tanh_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         put!(mode, d, g, y; |g, y| g * (1.0 - y * y));
@@ -177,11 +185,6 @@ mod tests {
     fn mul_fan_out_matches_finite_differences() {
         // y = x * x: dy/dx = 2 x, both operand slots feed the same gradient.
         grad_check(|t, v| t.mul(v[0], v[0]), &[(3, 3)], Inputs::Any);
-    }
-
-    #[test]
-    fn scale_matches_finite_differences() {
-        grad_check(|t, v| t.scale(v[0], -2.5), &[(2, 3)], Inputs::Any);
     }
 
     #[test]
@@ -246,14 +249,6 @@ mod tests {
         );
         grad_check(
             |t, v| {
-                let y = t.scale(v[0], 3.0);
-                t.mul(y, v[0])
-            },
-            &[(2, 2)],
-            Inputs::Any,
-        );
-        grad_check(
-            |t, v| {
                 let y = t.leaky_relu(v[0], 0.2);
                 t.mul(y, v[0])
             },
@@ -269,7 +264,7 @@ mod tests {
         let mut t = crate::autograd::Tape::new();
         let x = t.param(ndarray::arr2(&[[1.0f32, -2.0]]).view());
         let y = t.sub(x, x);
-        let s = t.sum(y);
+        let s = t.mean(y);
         t.backward(s);
         assert_eq!(t.grad(x).unwrap(), ndarray::arr2(&[[0.0f32, 0.0]]));
     }

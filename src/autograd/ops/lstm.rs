@@ -40,15 +40,22 @@ impl Tape {
     /// h for every valid position of every sequence, each unrolled from a zero state
     /// (spec `algorithms.md` 2.3). x: [K, in] in flat (sequence, time) order with
     /// K = packing.total(); result [K, H] in the same order. Reorders rows around
-    /// [`Tape::lstm_packed`]; nets that stay in packed order throughout skip that.
+    /// [`Tape::lstm_packed`].
+    ///
+    /// Test-only: the Q-net stays in packed order throughout and calls `lstm_packed` itself;
+    /// this flat-order form is what the tests compare with the step-by-step LSTM and the
+    /// unfused composition.
+    #[cfg(test)]
     pub fn lstm(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {
         let xp = self.gather_rows(x, packing.packed_to_flat());
         let yp = self.lstm_packed(xp, w, packing);
         self.gather_rows(yp, packing.flat_to_packed())
     }
 
-    /// [`Tape::lstm`] with x and the result in packed order (see [`SeqPacking`]), where every
-    /// step reads and writes contiguous rows. Panics on inconsistent shapes.
+    /// The LSTM over packed sequences: h for every valid position of every sequence, each
+    /// unrolled from a zero state (spec `algorithms.md` 2.3), with x: [K, in] and the result
+    /// [K, H] in packed order (see [`SeqPacking`]), where every step reads and writes contiguous
+    /// rows. Panics on inconsistent shapes.
     pub fn lstm_packed(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {
         let k = self.shape(x).0;
         let h = self.shape(w.w_hh).1;

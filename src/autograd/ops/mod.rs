@@ -19,14 +19,12 @@ use super::tape::{GradCx, Var};
 pub(crate) enum Op {
     /// Parameter, constant, or an op's cache: nothing to propagate.
     Leaf,
-    MatMul {
-        a: Var,
-        b: Var,
-    },
+    #[cfg(test)]
     MatMulNt {
         a: Var,
         b: Var,
     },
+    #[cfg(test)]
     AddBias {
         x: Var,
         bias: Var,
@@ -37,6 +35,7 @@ pub(crate) enum Op {
         b: Var,
         act: Activation,
     },
+    #[cfg(test)]
     Add {
         a: Var,
         b: Var,
@@ -45,17 +44,16 @@ pub(crate) enum Op {
         a: Var,
         b: Var,
     },
+    #[cfg(test)]
     Mul {
         a: Var,
         b: Var,
     },
-    Scale {
-        x: Var,
-        c: f32,
-    },
+    #[cfg(test)]
     Sigmoid {
         x: Var,
     },
+    #[cfg(test)]
     Tanh {
         x: Var,
     },
@@ -66,12 +64,11 @@ pub(crate) enum Op {
     Square {
         x: Var,
     },
-    ConcatCols {
-        parts: Vec<Var>,
-    },
+    #[cfg(test)]
     ConcatRows {
         parts: Vec<Var>,
     },
+    #[cfg(test)]
     SliceCols {
         x: Var,
         start: usize,
@@ -84,20 +81,8 @@ pub(crate) enum Op {
         x: Var,
         index: Vec<usize>,
     },
-    Sum {
-        x: Var,
-    },
     Mean {
         x: Var,
-    },
-    MaskedMean {
-        x: Var,
-        mask: Var,
-        count: f32,
-    },
-    Mse {
-        x: Var,
-        target: Var,
     },
     Lstm(Box<lstm::LstmNode>),
 }
@@ -108,29 +93,29 @@ impl Op {
     pub(crate) fn backward(&self, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
         match self {
             Op::Leaf => {}
-            Op::MatMul { a, b } => matmul::matmul_backward(*a, *b, g, cx),
+            #[cfg(test)]
             Op::MatMulNt { a, b } => matmul::matmul_nt_backward(*a, *b, g, cx),
+            #[cfg(test)]
             Op::AddBias { x, bias } => matmul::add_bias_backward(*x, *bias, g, cx),
             Op::Linear { x, w, b, act } => matmul::linear_backward(*x, *w, *b, *act, y, g, cx),
+            #[cfg(test)]
             Op::Add { a, b } => elementwise::add_backward(*a, *b, g, cx),
             Op::Sub { a, b } => elementwise::sub_backward(*a, *b, g, cx),
+            #[cfg(test)]
             Op::Mul { a, b } => elementwise::mul_backward(*a, *b, g, cx),
-            Op::Scale { x, c } => elementwise::scale_backward(*x, *c, g, cx),
+            #[cfg(test)]
             Op::Sigmoid { x } => elementwise::sigmoid_backward(*x, y, g, cx),
+            #[cfg(test)]
             Op::Tanh { x } => elementwise::tanh_backward(*x, y, g, cx),
             Op::LeakyRelu { x, slope } => elementwise::leaky_relu_backward(*x, *slope, g, cx),
             Op::Square { x } => elementwise::square_backward(*x, g, cx),
-            Op::ConcatCols { parts } => shape::concat_cols_backward(parts, g, cx),
+            #[cfg(test)]
             Op::ConcatRows { parts } => shape::concat_rows_backward(parts, g, cx),
+            #[cfg(test)]
             Op::SliceCols { x, start } => shape::slice_cols_backward(*x, *start, g, cx),
             Op::GatherCols { x, index } => shape::gather_cols_backward(*x, index, g, cx),
             Op::GatherRows { x, index } => shape::gather_rows_backward(*x, index, g, cx),
-            Op::Sum { x } => reduce::sum_backward(*x, g, cx),
             Op::Mean { x } => reduce::mean_backward(*x, g, cx),
-            Op::MaskedMean { x, mask, count } => {
-                reduce::masked_mean_backward(*x, *mask, *count, g, cx)
-            }
-            Op::Mse { x, target } => reduce::mse_backward(*x, *target, g, cx),
             Op::Lstm(node) => node.backward(g, cx),
         }
     }

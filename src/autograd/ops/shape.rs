@@ -1,41 +1,22 @@
 //! Ops that move values without arithmetic: concatenation and slicing along features, row
 //! concatenation, and gathers (Q of the chosen action, row selection).
 
-use ndarray::{s, Array2, Axis};
+#[cfg(test)]
+use ndarray::s;
+use ndarray::{Array2, Axis};
 
-use super::{put, Op};
+#[cfg(test)]
+use super::put;
+use super::Op;
 use crate::autograd::kernels::gemm::Mode;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 impl Tape {
-    /// y = [a | b | ...] along columns (features). Panics if the row counts differ or `parts`
-    /// is empty.
-    pub fn concat_cols(&mut self, parts: &[Var]) -> Var {
-        assert!(!parts.is_empty(), "concat_cols: no parts");
-        let rows = self.shape(parts[0]).0;
-        let mut cols = 0;
-        for &p in parts {
-            let (r, c) = self.shape(p);
-            assert_eq!(r, rows, "concat_cols: row counts differ");
-            cols += c;
-        }
-        let mut y = self.pool().array(rows, cols);
-        let mut at = 0;
-        for &p in parts {
-            let c = self.shape(p).1;
-            y.slice_mut(s![.., at..at + c]).assign(&self.value(p));
-            at += c;
-        }
-        self.push_op(
-            y,
-            Op::ConcatCols {
-                parts: parts.to_vec(),
-            },
-            parts,
-        )
-    }
-
     /// y = [a; b; ...] stacked along rows. Panics if the column counts differ or `parts` is empty.
+    ///
+    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
+    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
+    #[cfg(test)]
     pub fn concat_rows(&mut self, parts: &[Var]) -> Var {
         assert!(!parts.is_empty(), "concat_rows: no parts");
         let cols = self.shape(parts[0]).1;
@@ -62,6 +43,10 @@ impl Tape {
     }
 
     /// y = x[:, start..end]. Panics if the range is out of bounds.
+    ///
+    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
+    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
+    #[cfg(test)]
     pub fn slice_cols(&mut self, x: Var, start: usize, end: usize) -> Var {
         let (rows, cols) = self.shape(x);
         assert!(
@@ -116,19 +101,8 @@ impl Tape {
     }
 }
 
-// Each part receives its block of columns of g.
-pub(super) fn concat_cols_backward(parts: &[Var], g: &Array2<f32>, cx: &mut GradCx) {
-    let mut at = 0;
-    for &p in parts {
-        let c = cx.value(p).ncols();
-        if let Some((d, mode)) = cx.slot(p) {
-            put!(mode, d, g.slice(s![.., at..at + c]); |g| g);
-        }
-        at += c;
-    }
-}
-
 // Each part receives its block of rows of g.
+#[cfg(test)]
 pub(super) fn concat_rows_backward(parts: &[Var], g: &Array2<f32>, cx: &mut GradCx) {
     let mut at = 0;
     for &p in parts {
@@ -141,6 +115,7 @@ pub(super) fn concat_rows_backward(parts: &[Var], g: &Array2<f32>, cx: &mut Grad
 }
 
 // dx[:, start..end] += g, zero elsewhere.
+#[cfg(test)]
 pub(super) fn slice_cols_backward(x: Var, start: usize, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         if mode == Mode::Overwrite {
@@ -179,24 +154,6 @@ pub(super) fn gather_rows_backward(x: Var, index: &[usize], g: &Array2<f32>, cx:
 #[cfg(test)]
 mod tests {
     use super::super::grad_check::{grad_check, Inputs};
-
-    #[test]
-    fn concat_cols_matches_finite_differences() {
-        grad_check(
-            |t, v| t.concat_cols(&[v[0], v[1]]),
-            &[(3, 2), (3, 4)],
-            Inputs::Any,
-        );
-    }
-
-    #[test]
-    fn concat_cols_fan_out_matches_finite_differences() {
-        grad_check(
-            |t, v| t.concat_cols(&[v[0], v[1], v[0]]),
-            &[(2, 2), (2, 1)],
-            Inputs::Any,
-        );
-    }
 
     #[test]
     fn concat_rows_matches_finite_differences() {
