@@ -64,11 +64,6 @@ impl SeqPacking {
         }
     }
 
-    /// Number of sequences.
-    pub fn n_seqs(&self) -> usize {
-        self.lengths.len()
-    }
-
     /// Each sequence's valid length, in batch order.
     pub fn lengths(&self) -> &[usize] {
         &self.lengths

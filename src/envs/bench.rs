@@ -97,14 +97,6 @@ pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
     ]
 }
 
-/// Measure every environment of [`bench_suite`] for at least `min_steps` primitive steps each.
-pub fn bench_envs(min_steps: u64) -> Result<Vec<EnvBench>, EnvError> {
-    bench_suite()
-        .into_iter()
-        .map(|(name, spec)| bench_env(name, spec, min_steps))
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -34,21 +34,6 @@ impl Activation {
             }
         }
     }
-
-    /// dy/dz expressed through the output y.
-    #[inline(always)]
-    pub fn slope_at_output(self, y: f32) -> f32 {
-        match self {
-            Activation::Identity => 1.0,
-            Activation::LeakyRelu(s) => {
-                if y > 0.0 {
-                    1.0
-                } else {
-                    s
-                }
-            }
-        }
-    }
 }
 
 /// out = act(x · w^T + b) with x: [m, k], w: [n, k], b: [n], out: [m, n] (overwritten).

@@ -65,11 +65,6 @@ pub fn transposed(src: ArrayView2<f32>) -> Array2<f32> {
     src.t().as_standard_layout().into_owned()
 }
 
-/// Number of floating-point operations of one [m, k] · [k, n] product (a multiply-add counts 2).
-pub fn gemm_flops(m: usize, k: usize, n: usize) -> f64 {
-    2.0 * m as f64 * k as f64 * n as f64
-}
-
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     //! C[m, n] (=|+=) A[m, k] · B[k, n] for A with any strides and B, C with unit column
