@@ -337,9 +337,12 @@ struct EvalArgs {
 
 #[derive(clap::Args)]
 // The robots must serve this very policy: said where `domain --help` describes --policy.
+// (`mut_arg` moves the argument to the end; moving --robots after it keeps the usage line's
+// order `--policy <POLICY> --robots <ROBOTS>`.)
 #[command(mut_arg("policy", |a| a.help(
     "Policy directory the robots run (their `info` must report its manifest)"
 )))]
+#[command(mut_arg("robots", |a| a))]
 struct DomainArgs {
     #[command(flatten)]
     episodes: EpisodeArgs,

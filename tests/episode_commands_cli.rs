@@ -126,3 +126,18 @@ fn the_shared_flags_are_refused_alike_by_all_three_commands() {
         );
     }
 }
+
+#[test]
+fn domain_usage_names_the_policy_before_the_robots() {
+    // Flattening the shared flags must not reorder the usage line scripts and docs show.
+    let help = common::ok(&run(&["domain", "--help"]));
+    assert!(
+        help.contains("Usage: macdec domain [OPTIONS] --policy <POLICY> --robots <ROBOTS>"),
+        "{help}"
+    );
+    let policy = help.find("--policy <POLICY>  ").unwrap();
+    let robots = help.find("--robots <ROBOTS>  ").unwrap();
+    let episodes = help.find("--episodes <EPISODES>").unwrap();
+    assert!(policy < robots && robots < episodes, "{help}");
+    assert!(help.contains("Policy directory the robots run"), "{help}");
+}
