@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 
 pub mod bench;
 pub mod box_pushing;
+pub mod flags;
 pub mod replay;
 pub mod spec;
 pub mod warehouse;

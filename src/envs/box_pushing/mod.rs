@@ -73,13 +73,8 @@ pub struct BoxPushing {
 }
 
 impl BoxPushing {
-    /// An N x N Box Pushing environment with an episode horizon in primitive steps (paper: 10 with
-    /// 100, 30 with 200).
-    ///
-    /// `grid` must be even and at least 8: the spec's layout formulas need N >= 8 (spec 2) and an
-    /// odd N puts the big box and its waypoints off the cell centres, where they can never be
-    /// reached or seen (quirk Q9). `horizon` must be at least 1.
-    pub fn new(grid: usize, horizon: usize) -> Result<Self, EnvError> {
+    /// Check `grid` and `horizon` as [`Self::new`] does, without building (config validation).
+    pub fn check_params(grid: usize, horizon: usize) -> Result<(), EnvError> {
         if grid < MIN_GRID {
             return Err(EnvError::InvalidParameter {
                 name: "grid",
@@ -106,6 +101,17 @@ impl BoxPushing {
                 reason: "must be at least 1 primitive step, got 0".to_string(),
             });
         }
+        Ok(())
+    }
+
+    /// An N x N Box Pushing environment with an episode horizon in primitive steps (paper: 10 with
+    /// 100, 30 with 200).
+    ///
+    /// `grid` must be even and at least 8: the spec's layout formulas need N >= 8 (spec 2) and an
+    /// odd N puts the big box and its waypoints off the cell centres, where they can never be
+    /// reached or seen (quirk Q9). `horizon` must be at least 1.
+    pub fn new(grid: usize, horizon: usize) -> Result<Self, EnvError> {
+        Self::check_params(grid, horizon)?;
         let layout = GridLayout::new(grid as i32);
         Ok(Self {
             robots: start_robots(&layout),
