@@ -15,7 +15,7 @@
 //! `macdec plot --results OUT_DIR` draws like any other experiment.
 
 use macdec::experiment::metrics;
-use macdec::{paper_defaults, EnvError, EnvName, EnvRng, MacroEnv, Method, StepOutcome};
+use macdec::{paper_defaults, EnvError, EnvRng, EnvSpec, MacroEnv, Method, StepOutcome};
 
 /// Corridor cells.
 const CELLS: usize = 9;
@@ -213,8 +213,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut all_reached = true;
     for method in [Method::Our1, Method::DecHddrqn] {
         // Start from the paper's Warehouse settings (whole-episode replay) and scale them down.
-        let mut config = paper_defaults(EnvName::Warehouse, 10, method);
-        config.env_terminate_step = HORIZON;
+        // The config's `env` stays Warehouse's: `macdec::train` trains on Rendezvous instead and
+        // takes the horizon from it.
+        let mut config = paper_defaults(EnvSpec::paper_warehouse(), method);
         config.discount = DISCOUNT;
         config.total_epi = 3000;
         config.eps_l_d_steps = 1500;

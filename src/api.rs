@@ -30,11 +30,10 @@ pub enum LibraryTrainError {
 ///
 /// `make_env` is called once per environment the method needs (evaluation, training, Our-2's
 /// second training env); each call must build the same domain. What the learner needs to know
-/// about the domain comes from its [`MacroEnv`] implementation; of the config's domain keys only
-/// `env_terminate_step` is checked here (it must be > 0) and `env_name`, `grid_dim` and
-/// `tb_m_noisy` are ignored. The config is validated like a config file's (every key named on
-/// error); `on_episode` is called after every training episode with the trainer, e.g. for
-/// progress output.
+/// about the domain comes from its [`MacroEnv`] implementation, horizon included; the config's
+/// `env` (the spec `macdec train` would build) is not read, only validated like the rest of the
+/// config (every key named on error). `on_episode` is called after every training episode with
+/// the trainer, e.g. for progress output.
 pub fn train<E: MacroEnv>(
     make_env: impl Fn() -> Result<E, EnvError>,
     config: &RunConfig,
@@ -55,11 +54,11 @@ pub fn train<E: MacroEnv>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::hyper::{paper_defaults, EnvName};
-    use crate::envs::AnyEnv;
+    use crate::envs::{AnyEnv, EnvSpec};
+    use crate::experiment::paper::paper_defaults;
 
     fn short(method: Method) -> RunConfig {
-        let mut c = paper_defaults(EnvName::BoxPushing, 10, method);
+        let mut c = paper_defaults(EnvSpec::paper_box_pushing(10), method);
         c.total_epi = 12;
         c.eval_freq = 4;
         c
@@ -69,7 +68,7 @@ mod tests {
     fn library_training_gives_the_numbers_of_the_command_lines_trainer() {
         for method in [Method::Our1, Method::DecHddrqn] {
             let c = short(method);
-            let spec = c.env_spec();
+            let spec = c.env;
             let evals = train(|| spec.build(), &c, method, 5, |_| {}).unwrap();
             let mut t: Trainer<AnyEnv> = Trainer::new(c, method, 5, run_rngs(5)).unwrap();
             while t.advance().unwrap() != Advance::Finished {}
@@ -88,7 +87,7 @@ mod tests {
     fn a_bad_config_key_is_named_before_training() {
         let mut c = short(Method::Our1);
         c.batch_size = 0;
-        let spec = c.env_spec();
+        let spec = c.env;
         let err = train(|| spec.build(), &c, Method::Our1, 0, |_| {}).unwrap_err();
         assert!(err.to_string().contains("batch_size"), "{err}");
     }

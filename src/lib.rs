@@ -19,8 +19,9 @@ pub mod nn;
 pub mod plot;
 pub mod render;
 
-pub use algos::hyper::{paper_defaults, EnvName, RunConfig};
+pub use algos::hyper::RunConfig;
 pub use algos::method::Method;
 pub use algos::trainer::EvalPoint;
 pub use api::{train, LibraryTrainError};
-pub use envs::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
+pub use envs::{EnvError, EnvRng, EnvSpec, FirstRecordObs, MacroEnv, StepOutcome};
+pub use experiment::paper::paper_defaults;

@@ -673,12 +673,12 @@ fn demo_run(steps: usize, seed: u64) -> Result<()> {
 }
 
 fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
-    use macdec::algos::hyper::EnvName;
     use macdec::algos::method::Method;
     use macdec::bench::train;
+    use macdec::envs::EnvSpec;
     let mut rows = Vec::new();
     for (env, method) in train::suite() {
-        if only.is_some_and(|o| o != train::name(env, method)) {
+        if only.is_some_and(|o| o != train::name(&env, method)) {
             continue;
         }
         let row = train::bench_train(env, method, episodes)?;
@@ -688,10 +688,10 @@ fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
     print!("{}", train::format_table(&rows));
     if only.is_none() {
         // Two runs on two threads should take no longer than one alone (no shared state).
-        let one = train::bench_train(EnvName::BoxPushing, Method::Our1, episodes)?;
+        let one = train::bench_train(EnvSpec::paper_box_pushing(10), Method::Our1, episodes)?;
         let (a, b) = rayon::join(
-            || train::bench_train(EnvName::BoxPushing, Method::Our1, episodes),
-            || train::bench_train(EnvName::BoxPushing, Method::Our1, episodes),
+            || train::bench_train(EnvSpec::paper_box_pushing(10), Method::Our1, episodes),
+            || train::bench_train(EnvSpec::paper_box_pushing(10), Method::Our1, episodes),
         );
         let (a, b) = (a?, b?);
         println!(
@@ -945,7 +945,7 @@ fn deploy(args: DeployArgs) -> Result<()> {
 }
 
 fn import(args: ImportArgs) -> Result<()> {
-    use macdec::deploy::import::{import_policy, paper_discount, ImportRequest};
+    use macdec::deploy::import::{import_policy, ImportRequest};
     use macdec::envs::EnvSpec;
     let env = match (args.env, args.grid) {
         (ImportEnv::BoxPushing, Some(grid)) => EnvSpec::BoxPushing {
@@ -961,7 +961,7 @@ fn import(args: ImportArgs) -> Result<()> {
     };
     let request = ImportRequest {
         env,
-        discount: args.discount.unwrap_or_else(|| paper_discount(&env)),
+        discount: args.discount.unwrap_or_else(|| env.paper_discount()),
         agents: args.agents,
     };
     let manifest = import_policy(&request, &args.out)

@@ -229,43 +229,22 @@ fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
     assert!(String::from_utf8_lossy(&res.stderr).contains(MANIFEST_FILE));
 }
 
-/// Deploy's own table of the paper's discounts (it knows no learner) agrees with the learner's
-/// paper defaults for every domain and size.
+/// The discount `macdec import` writes by default ([`EnvSpec::paper_discount`]) is the one the
+/// learner's paper defaults train with: the paper's, Box Pushing 0.98 and Warehouse 1.0 (spec 10).
 #[test]
 fn deploys_paper_discounts_are_the_learners() {
-    use macdec::algos::hyper::{paper_defaults, EnvName};
     use macdec::algos::method::Method;
-    use macdec::deploy::import::paper_discount;
-    for (spec, name, grid) in [
-        (
-            EnvSpec::BoxPushing {
-                grid: 10,
-                horizon: 100,
-            },
-            EnvName::BoxPushing,
-            10,
-        ),
-        (
-            EnvSpec::BoxPushing {
-                grid: 30,
-                horizon: 200,
-            },
-            EnvName::BoxPushing,
-            30,
-        ),
-        (
-            EnvSpec::Warehouse {
-                horizon: 150,
-                tb_m_noisy: 0.0,
-            },
-            EnvName::Warehouse,
-            10,
-        ),
+    use macdec::paper_defaults;
+    for (spec, paper) in [
+        (EnvSpec::paper_box_pushing(10), 0.98),
+        (EnvSpec::paper_box_pushing(30), 0.98),
+        (EnvSpec::paper_warehouse(), 1.0),
     ] {
+        assert_eq!(spec.paper_discount(), paper, "{spec:?}");
         for method in [Method::Our1, Method::CenDdrqn, Method::DecHddrqn] {
             assert_eq!(
-                paper_discount(&spec),
-                paper_defaults(name, grid, method).discount,
+                paper_defaults(spec, method).discount,
+                paper,
                 "{spec:?} {method:?}"
             );
         }

@@ -15,7 +15,7 @@ use crate::algos::replay::ReplayBuffer;
 use crate::algos::schedule::EpsilonSchedule;
 use crate::algos::update::{train_iteration, IterationParams, Nets, UpdateError};
 use crate::algos::ReplayError;
-use crate::envs::{AnyEnv, EnvError, EnvRng, EnvSpec, MacroEnv};
+use crate::envs::{AnyEnv, EnvError, EnvRng, MacroEnv};
 use crate::nn::{LstmState, QNet, QNetConfig};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -122,21 +122,16 @@ pub struct Trainer<E = AnyEnv> {
     segment_start: Option<std::time::Instant>,
 }
 
-/// The environment a config describes ([`RunConfig::env_spec`]).
-pub fn env_spec(c: &RunConfig) -> EnvSpec {
-    c.env_spec()
-}
-
 impl Trainer<AnyEnv> {
     /// Build nets, envs and buffers for `method` with seed `seed` (spec 2.2, 6) on the domain
-    /// the config names ([`RunConfig::env_spec`]).
+    /// the config names ([`RunConfig::env`]).
     pub fn new(
         config: RunConfig,
         method: Method,
         seed: u64,
         rngs: RunRngs,
     ) -> Result<Self, TrainError> {
-        let spec = env_spec(&config);
+        let spec = config.env;
         Self::with_env(config, method, seed, rngs, || spec.build())
     }
 }
@@ -145,8 +140,7 @@ impl<E: MacroEnv> Trainer<E> {
     /// Build nets, envs and buffers for `method` with seed `seed` (spec 2.2, 6) on the domain
     /// `make_env` builds, called once per environment the method needs (evaluation, training,
     /// Our-2's centralized lane). What the learner needs to know about the domain comes from
-    /// its [`MacroEnv`] implementation; the config's `env_name`, `grid_dim` and `tb_m_noisy`
-    /// are not read here.
+    /// its [`MacroEnv`] implementation; the config's `env` is not read here.
     pub fn with_env(
         config: RunConfig,
         method: Method,

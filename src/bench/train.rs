@@ -4,9 +4,10 @@
 //! The reference's figures quoted in the issues were taken the same way (first 200 episodes of
 //! Box Pushing 10x10, all costs included), so the rates compare like for like.
 
-use crate::algos::hyper::{paper_defaults, EnvName};
 use crate::algos::method::Method;
 use crate::algos::trainer::{Advance, TrainError, Trainer};
+use crate::envs::EnvSpec;
+use crate::experiment::paper::paper_defaults;
 use crate::experiment::train_run::run_rngs;
 use std::time::Instant;
 
@@ -34,30 +35,34 @@ impl TrainBench {
 
 /// The configurations benchmarked: every method on BP 10x10 (Our-2 is episode-buffer only, quirk
 /// Q10) and every method on Warehouse.
-pub fn suite() -> Vec<(EnvName, Method)> {
-    let mut v: Vec<(EnvName, Method)> = Method::ALL
+pub fn suite() -> Vec<(EnvSpec, Method)> {
+    let mut v: Vec<(EnvSpec, Method)> = Method::ALL
         .into_iter()
         .filter(|&m| !m.requires_episode_buffer())
-        .map(|m| (EnvName::BoxPushing, m))
+        .map(|m| (EnvSpec::paper_box_pushing(10), m))
         .collect();
-    v.extend(Method::ALL.into_iter().map(|m| (EnvName::Warehouse, m)));
+    v.extend(
+        Method::ALL
+            .into_iter()
+            .map(|m| (EnvSpec::paper_warehouse(), m)),
+    );
     v
 }
 
 /// Train `method` on `env` at the paper's settings for `episodes` episodes (seed 0) and time it.
 pub fn bench_train(
-    env: EnvName,
+    env: EnvSpec,
     method: Method,
     episodes: usize,
 ) -> Result<TrainBench, TrainError> {
-    let mut config = paper_defaults(env, 10, method);
+    let mut config = paper_defaults(env, method);
     config.total_epi = episodes;
     let start = Instant::now();
     let mut trainer = Trainer::new(config, method, 0, run_rngs(0))?;
     while trainer.advance()? != Advance::Finished {}
     let seconds = start.elapsed().as_secs_f64();
     Ok(TrainBench {
-        name: name(env, method),
+        name: name(&env, method),
         episodes: trainer.episodes(),
         env_steps: trainer.env_steps(),
         updates: trainer.updates(),
@@ -66,8 +71,8 @@ pub fn bench_train(
 }
 
 /// The row name of a configuration, e.g. `bp10 our1`.
-pub fn name(env: EnvName, method: Method) -> String {
-    format!("{} {method}", env.short_name(10))
+pub fn name(env: &EnvSpec, method: Method) -> String {
+    format!("{} {method}", env.short_name())
 }
 
 /// A Markdown table of the results.

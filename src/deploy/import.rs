@@ -134,20 +134,10 @@ pub struct CheckedStateDict {
 pub struct ImportRequest {
     pub env: EnvSpec,
     /// Discount per primitive step of the evaluation return written into the manifest
-    /// (see [`paper_discount`]).
+    /// (the paper's is [`EnvSpec::paper_discount`]).
     pub discount: f64,
     /// Agent i's state_dict file is `agents[i]`.
     pub agents: Vec<PathBuf>,
-}
-
-/// The paper's discount for a domain (Box Pushing 0.98, Warehouse 1.0; spec 10), which the
-/// reference also used for its reported returns. Deploy knows no learner, so the values are
-/// written here; `tests/import_eval_cli.rs` checks them against the learner's paper defaults.
-pub fn paper_discount(env: &EnvSpec) -> f64 {
-    match env {
-        EnvSpec::BoxPushing { .. } => 0.98,
-        EnvSpec::Warehouse { .. } => 1.0,
-    }
 }
 
 /// Read `path` whole, refusing anything but a regular file of at most `max_bytes` before
@@ -643,7 +633,7 @@ mod tests {
         let out = dir.path().join("policy");
         let request = ImportRequest {
             env: BP10,
-            discount: paper_discount(&BP10),
+            discount: BP10.paper_discount(),
             agents: vec![a0.clone(), a1.clone()],
         };
         let written = import_policy(&request, &out).unwrap();
@@ -692,7 +682,7 @@ mod tests {
             horizon: 150,
             tb_m_noisy: 0.0,
         };
-        assert_eq!(paper_discount(&spec), 1.0);
+        assert_eq!(spec.paper_discount(), 1.0);
         let env = spec.build().unwrap();
         let dir = tempfile::tempdir().unwrap();
         let arch = Architecture::ddrqn(32, 64);

@@ -189,11 +189,12 @@ pub fn decode(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::hyper::{paper_defaults, EnvName};
+    use crate::envs::EnvSpec;
+    use crate::experiment::paper::paper_defaults;
     use crate::experiment::train_run::run_rngs;
 
     fn tiny() -> (CheckpointIdentity, Trainer) {
-        let mut c = paper_defaults(EnvName::BoxPushing, 8, Method::Our1);
+        let mut c = paper_defaults(EnvSpec::paper_box_pushing(8), Method::Our1);
         c.batch_size = 4;
         c.replay_buffer_size = 50;
         let t = Trainer::new(c.clone(), Method::Our1, 3, run_rngs(3)).unwrap();

@@ -6,10 +6,12 @@
 //! chosen domain and method (spec `algorithms.md` 10): `env_name = "BP_MA"` alone is Figure 4a's
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
-use crate::algos::hyper::{paper_defaults, EnvName, RunConfig};
+use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
+use crate::envs::flags::{check_spec, EnvName, DEFAULT_GRID_DIM};
 use crate::experiment::limits;
 use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
+use crate::experiment::paper::paper_defaults;
 use crate::experiment::seeds::{check_seed_list, parse_seeds, SeedsError};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -515,9 +517,9 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
                 format!("expected a positive integer, got {v}"),
             ))
         }
-        None => 10,
+        None => DEFAULT_GRID_DIM,
     };
-    let defaults = paper_defaults(env, grid_dim, method);
+    let defaults = paper_defaults(env.paper_spec(grid_dim), method);
     let mut table = toml::Table::try_from(&defaults).expect("RunConfig serializes to a table");
     for (key, value) in point {
         if !table.contains_key(key) {
@@ -546,9 +548,24 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
         }
         table.insert(key.clone(), value);
     }
-    let config: RunConfig = toml::Value::Table(table)
+    let config: RunConfig = toml::Value::Table(table.clone())
         .try_into()
         .map_err(|e: toml::de::Error| bad("config", e.message().to_string()))?;
+    // A domain key the chosen domain does not use (`grid_dim` for OSD_S_4, `tb_m_noisy` for
+    // BP_MA) would be dropped and recorded as its default: refuse it instead of ignoring it.
+    // (`env_name` itself is recorded by its reference name even when written as an alias.)
+    let recorded = toml::Table::try_from(&config).expect("RunConfig serializes to a table");
+    for (key, value) in &table {
+        if key != "env_name" && recorded.get(key) != Some(value) {
+            return Err(bad(
+                key,
+                format!(
+                    "env_name = {} does not use this key; leave it out (got {value})",
+                    table["env_name"]
+                ),
+            ));
+        }
+    }
     validate(&config, method).map_err(|(key, message)| bad(key, message))?;
     Ok(config)
 }
@@ -557,7 +574,7 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
 /// point [`crate::train`] runs them too, so a config built in code is held to the same rules.
 pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
     let positive = [
-        ("env_terminate_step", c.env_terminate_step),
+        ("env_terminate_step", c.env.horizon()),
         ("total_epi", c.total_epi),
         ("replay_buffer_size", c.replay_buffer_size),
         ("h_stable_at", c.h_stable_at),
@@ -580,21 +597,8 @@ pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, Stri
             return Err((key, "must be > 0, got 0".into()));
         }
     }
-    if c.env_name == EnvName::BoxPushing && c.grid_dim < 8 {
-        return Err((
-            "grid_dim",
-            format!("Box Pushing needs a grid of at least 8, got {}", c.grid_dim),
-        ));
-    }
-    if c.env_name == EnvName::BoxPushing && !c.grid_dim.is_multiple_of(2) {
-        return Err((
-            "grid_dim",
-            format!(
-                "Box Pushing needs an even grid (an odd one puts the big box off the cell centres), got {}",
-                c.grid_dim
-            ),
-        ));
-    }
+    // The domain checks its own parameters, named by the keys that set them.
+    check_spec(&c.env)?;
     if c.start_train == 0 {
         return Err((
             "start_train",
@@ -633,9 +637,6 @@ pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, Stri
             "l_rate",
             format!("must be a positive number, got {}", c.l_rate),
         ));
-    }
-    if !(c.tb_m_noisy >= 0.0 && c.tb_m_noisy.is_finite()) {
-        return Err(("tb_m_noisy", format!("must be >= 0, got {}", c.tb_m_noisy)));
     }
     if method.requires_episode_buffer() && !c.sample_epi {
         // Spec Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
@@ -751,6 +752,37 @@ mod tests {
         assert_eq!(
             (c.l_rate, c.discount, c.replay_buffer_size),
             (0.0006, 1.0, 1000)
+        );
+    }
+
+    #[test]
+    fn a_domain_key_the_domain_does_not_use_is_refused_not_dropped() {
+        let wtd = "methods = [\"our2\"]\n[params]\nenv_name = \"OSD_S_4\"";
+        // The values every run records anyway are accepted (Warehouse runs record grid_dim = 10).
+        parse(wtd, &["grid_dim=10", "tb_m_noisy=0.2"]).unwrap();
+        let err = parse(wtd, &["grid_dim=30"]).unwrap_err().to_string();
+        assert!(
+            err.contains("`grid_dim`") && err.contains("OSD_S_4"),
+            "{err}"
+        );
+        let err = parse("", &["tb_m_noisy=0.1"]).unwrap_err().to_string();
+        assert!(
+            err.contains("`tb_m_noisy`") && err.contains("BP_MA"),
+            "{err}"
+        );
+        let err = parse(wtd, &["tb_m_noisy=-0.5"]).unwrap_err().to_string();
+        assert!(err.contains("`tb_m_noisy`"), "{err}");
+    }
+
+    #[test]
+    fn env_name_aliases_resolve_to_the_reference_names() {
+        let e = parse("[params]\nenv_name = \"box-pushing\"\ngrid_dim = 30", &[]).unwrap();
+        let c = &e.runs().unwrap()[0].config;
+        assert_eq!(c.env, crate::envs::EnvSpec::paper_box_pushing(30));
+        let text = toml::to_string(c).unwrap();
+        assert!(
+            text.starts_with("env_name = \"BP_MA\"\ngrid_dim = 30\n"),
+            "{text}"
         );
     }
 

@@ -37,7 +37,7 @@ pub const MAX_EVAL_NUM_EPI: usize = 100_000;
 /// Check a resolved config's sizes against the bounds above. Returns the key and why.
 pub fn check_sizes(c: &RunConfig) -> Result<(), (&'static str, String)> {
     let simple = [
-        ("env_terminate_step", c.env_terminate_step, MAX_HORIZON),
+        ("env_terminate_step", c.env.horizon(), MAX_HORIZON),
         ("trace_len", c.trace_len, MAX_TRACE_LEN),
         ("sub_trace_len", c.sub_trace_len, MAX_TRACE_LEN),
         ("batch_size", c.batch_size, MAX_BATCH_SIZE),
@@ -55,7 +55,7 @@ pub fn check_sizes(c: &RunConfig) -> Result<(), (&'static str, String)> {
     }
     // Sequences are windows of trace_len records, or whole episodes with the episode buffer.
     let (seq_key, seq_len) = if c.sample_epi {
-        ("env_terminate_step", c.env_terminate_step)
+        ("env_terminate_step", c.env.horizon())
     } else {
         ("trace_len", c.trace_len)
     };
@@ -110,29 +110,35 @@ pub fn worker_threads(requested: usize, runs: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::hyper::{paper_defaults, EnvName};
     use crate::algos::method::Method;
+    use crate::envs::EnvSpec;
+    use crate::experiment::paper::paper_defaults;
 
     #[test]
     fn the_papers_settings_are_within_every_bound() {
-        for (env, grid) in [(EnvName::BoxPushing, 10), (EnvName::BoxPushing, 30)] {
+        for grid in [10, 30] {
             for m in [Method::DecHddrqn, Method::CenDdrqn, Method::Our1] {
-                check_sizes(&paper_defaults(env, grid, m)).unwrap();
+                check_sizes(&paper_defaults(EnvSpec::paper_box_pushing(grid), m)).unwrap();
             }
         }
         for m in [Method::DecHddrqn, Method::CenDdrqn, Method::Our2] {
-            check_sizes(&paper_defaults(EnvName::Warehouse, 10, m)).unwrap();
+            check_sizes(&paper_defaults(EnvSpec::paper_warehouse(), m)).unwrap();
         }
     }
 
     #[test]
     fn each_size_beyond_its_bound_names_its_key() {
-        let base = paper_defaults(EnvName::BoxPushing, 10, Method::Our1);
+        let base = paper_defaults(EnvSpec::paper_box_pushing(10), Method::Our1);
         type Edit = fn(&mut RunConfig);
         let cases: [(&str, Edit); 6] = [
             ("batch_size", |c| c.batch_size = MAX_BATCH_SIZE + 1),
             ("dec_rnn_h_size", |c| c.dec_rnn_h_size = usize::MAX),
-            ("env_terminate_step", |c| c.env_terminate_step = 1 << 40),
+            ("env_terminate_step", |c| {
+                c.env = EnvSpec::BoxPushing {
+                    grid: 10,
+                    horizon: 1 << 40,
+                }
+            }),
             ("batch_size", |c| {
                 c.batch_size = 60_000;
                 c.trace_len = 60_000;

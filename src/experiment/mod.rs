@@ -8,6 +8,7 @@ pub mod config;
 pub mod limits;
 pub mod metrics;
 pub mod names;
+pub mod paper;
 pub mod policy_files;
 pub mod provenance;
 pub mod report;

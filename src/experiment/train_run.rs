@@ -11,7 +11,7 @@
 use crate::algos::evaluate::GreedyPolicy;
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::algos::trainer::{env_spec, Advance, RunRngs, TrainError, Trainer};
+use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
 use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
 use crate::experiment::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::config::RunSpec;
@@ -264,7 +264,7 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &Trainer) -> Result<()
         variant: spec.variant.clone(),
         seed: trainer.seed(),
         episodes_trained: trainer.episodes(),
-        env: env_spec(config),
+        env: config.env,
         discount: config.discount,
         evaluated,
         config: serde_json::to_value(config).map_err(|e| io(dir, e))?,

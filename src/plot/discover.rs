@@ -308,8 +308,9 @@ fn subdirs_or_note(dir: &Path, notes: &mut Vec<String>) -> Vec<PathBuf> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::algos::hyper::{paper_defaults, EnvName};
+    use crate::envs::EnvSpec;
     use crate::experiment::metrics::MetricsRow;
+    use crate::experiment::paper::paper_defaults;
 
     /// Write a synthetic run: returns at the given episodes, a config, and optionally the marker.
     pub(crate) fn write_run(
@@ -318,7 +319,7 @@ pub(crate) mod tests {
         curve: &str,
         seed: u64,
         points: &[(u64, f64)],
-        env: (EnvName, usize),
+        env: EnvSpec,
         finished: bool,
     ) -> PathBuf {
         let dir = root
@@ -340,7 +341,7 @@ pub(crate) mod tests {
             })
             .collect();
         metrics::write(&dir.join(METRICS_FILE), &rows).unwrap();
-        let config = paper_defaults(env.0, env.1, Method::Our1);
+        let config = paper_defaults(env, Method::Our1);
         std::fs::write(dir.join(CONFIG_FILE), toml::to_string(&config).unwrap()).unwrap();
         if finished {
             std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();
@@ -348,7 +349,10 @@ pub(crate) mod tests {
         dir
     }
 
-    const BP10: (EnvName, usize) = (EnvName::BoxPushing, 10);
+    const BP10: EnvSpec = EnvSpec::BoxPushing {
+        grid: 10,
+        horizon: 100,
+    };
 
     #[test]
     fn finds_experiments_curves_and_seeds_in_paper_order() {
@@ -405,7 +409,7 @@ pub(crate) mod tests {
     #[test]
     fn shared_curves_are_read_from_the_experiment_they_belong_to() {
         let t = tempfile::tempdir().unwrap();
-        let bp = (EnvName::BoxPushing, 10);
+        let bp = EnvSpec::paper_box_pushing(10);
         write_run(t.path(), "fig5", "our2", 0, &[(0, 1.0)], bp, true);
         write_run(t.path(), "fig5", "our2", 1, &[(0, 2.0)], bp, true);
         write_run(t.path(), "fig6", "our1", 0, &[(0, 3.0)], bp, true);

@@ -255,10 +255,13 @@ fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::hyper::EnvName;
+    use crate::envs::EnvSpec;
     use crate::plot::discover::{discover, tests::write_run};
 
-    const BP10: (EnvName, usize) = (EnvName::BoxPushing, 10);
+    const BP10: EnvSpec = EnvSpec::BoxPushing {
+        grid: 10,
+        horizon: 100,
+    };
 
     #[test]
     fn partial_results_are_marked_and_counted_per_curve() {
@@ -344,7 +347,7 @@ mod tests {
             "our2",
             0,
             &[(0, 1.0)],
-            (EnvName::Warehouse, 10),
+            EnvSpec::paper_warehouse(),
             true,
         );
         let d = discover(t.path()).unwrap();

@@ -100,7 +100,7 @@ pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::hyper::EnvName;
+    use crate::envs::EnvSpec;
     use discover::tests::write_run;
 
     /// A noisy rising learning curve, deterministic per seed.
@@ -118,7 +118,7 @@ mod tests {
     fn plots_synthetic_results_to_png_svg_and_summary() {
         let t = tempfile::tempdir().unwrap();
         let res = t.path().join("results");
-        let bp10 = (EnvName::BoxPushing, 10);
+        let bp10 = EnvSpec::paper_box_pushing(10);
         for seed in 0..3 {
             let pts = curve(seed, 95.0, 151);
             write_run(&res, "fig4a_bp10", "our1", seed, &pts, bp10, true);
