@@ -104,6 +104,13 @@ pub fn final_return(points: &[(u64, f64)]) -> Option<f64> {
     Some(tail.iter().map(|p| p.1).sum::<f64>() / k as f64)
 }
 
+/// A run's best single evaluation: the return of the policy the reference keeps (it saves the
+/// decentralized nets whenever an evaluation matches the best so far, so the trained policies it
+/// ships are best-evaluation snapshots, not final ones).
+pub fn best_return(points: &[(u64, f64)]) -> Option<f64> {
+    points.iter().map(|p| p.1).reduce(f64::max)
+}
+
 /// The first episode at which a (smoothed) curve's mean reaches `threshold`, if it ever does.
 pub fn first_reaching(points: &[CurvePoint], threshold: f64) -> Option<u64> {
     points
@@ -147,6 +154,15 @@ mod tests {
         assert_eq!(final_return(&pts), Some(23.0));
         assert_eq!(final_return(&pts[..1]), Some(0.0));
         assert_eq!(final_return(&[]), None);
+    }
+
+    #[test]
+    fn best_return_is_the_highest_evaluation_of_a_run() {
+        assert_eq!(
+            best_return(&[(0, -150.0), (10, 259.0), (20, 178.0)]),
+            Some(259.0)
+        );
+        assert_eq!(best_return(&[]), None);
     }
 
     #[test]

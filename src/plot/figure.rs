@@ -4,8 +4,8 @@
 
 use super::discover::{CurveData, ExperimentData};
 use super::stats::{
-    aggregate, final_return, first_reaching, mean_and_se, mean_over_training, smooth, CurvePoint,
-    SMOOTH_HALF_WINDOW,
+    aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training, smooth,
+    CurvePoint, SMOOTH_HALF_WINDOW,
 };
 use super::summary::CurveSummary;
 use crate::algos::method::Method;
@@ -187,12 +187,14 @@ fn summarize(
         .last()
         .expect("discover keeps only runs with at least one evaluation")
         .episode;
-    let final_returns: Vec<f64> = curve
-        .runs
-        .iter()
-        .filter(|r| r.points.last().is_some_and(|p| p.0 == final_episode))
-        .filter_map(|r| final_return(&r.points))
-        .collect();
+    let complete = || {
+        curve
+            .runs
+            .iter()
+            .filter(move |r| r.points.last().is_some_and(|p| p.0 == final_episode))
+    };
+    let final_returns: Vec<f64> = complete().filter_map(|r| final_return(&r.points)).collect();
+    let best: Vec<f64> = complete().filter_map(|r| best_return(&r.points)).collect();
     let (final_mean, final_se) = mean_and_se(&final_returns).unwrap_or((f64::NAN, f64::NAN));
     let finished: Vec<f64> = curve
         .runs
@@ -209,6 +211,7 @@ fn summarize(
         final_mean,
         final_se,
         final_n: final_returns.len(),
+        best_mean: mean_and_se(&best).map_or(f64::NAN, |(m, _)| m),
         reach95_episode: optimal.and_then(|o| first_reaching(smoothed, 0.95 * o)),
         mean_over_training: mean_over_training(mean).unwrap_or(f64::NAN),
         optimal,

@@ -168,6 +168,13 @@ mod tests {
         let csv = std::fs::read_to_string(&p.summary_csv).unwrap();
         assert_eq!(csv.lines().count(), 4);
         assert!(csv.contains("cen-ddrqn,Cen-DDRQN,2,1,1500,"));
+        // Best evaluation: over the runs that reach the last episode (Cen-DDRQN: seed 0 only).
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let col = header.iter().position(|h| *h == "best_mean").unwrap();
+        let cen = csv.lines().find(|l| l.starts_with("cen-ddrqn,")).unwrap();
+        let best: f64 = cen.split(',').nth(col).unwrap().parse().unwrap();
+        let expected = curve(20, 85.0, 151).iter().map(|p| p.1).fold(f64::MIN, f64::max);
+        assert_eq!(best, expected);
         let md = report.markdown();
         assert!(md.contains("| Our-1 | 3 (3) | 1500 |"), "{md}");
         assert!(report.notes.is_empty(), "{:?}", report.notes);

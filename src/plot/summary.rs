@@ -37,6 +37,10 @@ pub struct CurveSummary {
     pub optimal: Option<f64>,
     /// Mean wall-clock minutes of the finished runs (None when none finished).
     pub run_minutes: Option<f64>,
+    /// (Last, so the earlier columns keep their places.) Mean over the `final_n` runs of each run's best single evaluation
+    /// ([`crate::plot::stats::best_return`]): the level of a best-snapshot policy, the kind the
+    /// reference saves and its authors ship.
+    pub best_mean: f64,
     /// The `final_n` runs' final returns, for the tests between curves.
     #[serde(skip)]
     pub final_returns: Vec<f64>,
@@ -95,7 +99,7 @@ pub fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<(), PlotError>
 /// one-sided Welch p-values between them.
 pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) -> String {
     let mut s = format!(
-        "### {title}\n\n| method | seeds (finished) | final episode | final return (mean ± SE) | 95% of optimal first at | mean over training | optimal | minutes per run |\n|---|---|---|---|---|---|---|---|\n"
+        "### {title}\n\n| method | seeds (finished) | final episode | final return (mean ± SE) | best evaluation (mean) | 95% of optimal first at | mean over training | optimal | minutes per run |\n|---|---|---|---|---|---|---|---|---|\n"
     );
     for r in rows {
         let optimal = r.optimal.map_or("n/a".into(), format_return);
@@ -111,13 +115,14 @@ pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) ->
             (Some(_), Some(e)) => e.to_string(),
         };
         s.push_str(&format!(
-            "| {} | {} ({}) | {} | {:.2} ± {:.2}{at} | {reach} | {:.2} | {optimal} | {minutes} |\n",
+            "| {} | {} ({}) | {} | {:.2} ± {:.2}{at} | {:.2} | {reach} | {:.2} | {optimal} | {minutes} |\n",
             r.legend,
             r.seeds,
             r.finished,
             r.final_episode,
             r.final_mean,
             r.final_se,
+            r.best_mean,
             r.mean_over_training
         ));
     }
@@ -175,6 +180,7 @@ mod tests {
             final_mean: mean,
             final_se: se,
             final_n: finals.len(),
+            best_mean: 81.25,
             reach95_episode: Some(420),
             mean_over_training: 55.5,
             optimal: Some(80.71093744250365),
@@ -195,7 +201,7 @@ mod tests {
         assert!(md.starts_with("### fig4a\n"));
         assert!(
             md.contains(
-                "| Our-1 | 3 (2) | 1500 | 79.50 ± 0.50 (n = 2) | 420 | 55.50 | 80.71 | 12.3 |"
+                "| Our-1 | 3 (2) | 1500 | 79.50 ± 0.50 (n = 2) | 81.25 | 420 | 55.50 | 80.71 | 12.3 |"
             ),
             "{md}"
         );
@@ -222,8 +228,8 @@ mod tests {
         let text = std::fs::read_to_string(&p).unwrap();
         assert_eq!(
             text,
-            "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,reach95_episode,mean_over_training,optimal,run_minutes\n\
-             our1,Our-1,3,2,1500,1.0,0.0,1,,55.5,,\n"
+            "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,reach95_episode,mean_over_training,optimal,run_minutes,best_mean\n\
+             our1,Our-1,3,2,1500,1.0,0.0,1,,55.5,,,81.25\n"
         );
     }
 
