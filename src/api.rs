@@ -1,5 +1,7 @@
 //! The library entry point: train a method on any domain implementing [`MacroEnv`] and get its
-//! learning curve back, without the command line, result directories or checkpoints.
+//! learning curve back ([`train`]), or the curve and the trained nets ([`train_policy`]), without
+//! the command line, result directories or checkpoints. [`TrainedPolicy::export`] writes the
+//! decentralized nets as a policy directory `macdec robot` serves, whatever the domain.
 //!
 //! The command line's `macdec train` drives the same [`Trainer`] with the same per-seed random
 //! streams, so a run through [`train`] on Box Pushing or Warehouse gives exactly the numbers of
@@ -8,10 +10,21 @@
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::algos::trainer::{Advance, EvalPoint, TrainError, Trainer};
+use crate::deploy::export::{export_nets, ExportError};
+use crate::deploy::manifest::{Manifest, RunInfo};
+use crate::deploy::policy_env::PolicyEnv;
 use crate::envs::{EnvError, MacroEnv};
 use crate::experiment::config::validate;
 use crate::experiment::limits::check_sizes;
 use crate::experiment::train_run::run_rngs;
+use crate::nn::QNet;
+use std::path::Path;
+
+/// The `experiment` an exported library policy names in its manifest's `run`.
+pub const LIBRARY_EXPERIMENT: &str = "library";
+/// The config keys that name the built-in domain (`config.toml`'s); a custom domain's exported
+/// config leaves them out, since the library trained on the caller's domain instead.
+const DOMAIN_KEYS: [&str; 4] = ["env_name", "grid_dim", "env_terminate_step", "tb_m_noisy"];
 
 /// Why [`train`] refused or stopped.
 #[derive(Debug, thiserror::Error)]
@@ -33,14 +46,42 @@ pub enum LibraryTrainError {
 /// about the domain comes from its [`MacroEnv`] implementation, horizon included; the config's
 /// `env` (the spec `macdec train` would build) is not read, only validated like the rest of the
 /// config (every key named on error). `on_episode` is called after every training episode with
-/// the trainer, e.g. for progress output.
+/// the trainer, e.g. for progress output. [`train_policy`] also gives back the trained nets.
 pub fn train<E: MacroEnv>(
     make_env: impl Fn() -> Result<E, EnvError>,
     config: &RunConfig,
     method: Method,
     seed: u64,
-    mut on_episode: impl FnMut(&Trainer<E>),
+    on_episode: impl FnMut(&Trainer<E>),
 ) -> Result<Vec<EvalPoint>, LibraryTrainError> {
+    train_policy(make_env, config, method, seed, on_episode).map(|p| p.evals)
+}
+
+/// What [`train_policy`] gives back: the learning curve, the trained nets and what they were
+/// trained with, enough to put the policy on robots ([`Self::export`]).
+#[derive(Debug, Clone)]
+pub struct TrainedPolicy {
+    pub method: Method,
+    pub seed: u64,
+    /// Training episodes completed (the config's `total_epi`).
+    pub episodes_trained: u64,
+    pub config: RunConfig,
+    /// Every evaluation point, as [`train`] returns them.
+    pub evals: Vec<EvalPoint>,
+    /// Agent i's decentralized Q-net is `dec[i]` (empty for Cen-DDRQN, which has none).
+    pub dec: Vec<QNet>,
+    /// The centralized Q-net, for the methods that train one.
+    pub cen: Option<QNet>,
+}
+
+/// [`train`], keeping the trained nets: the same trainer, the same numbers.
+pub fn train_policy<E: MacroEnv>(
+    make_env: impl Fn() -> Result<E, EnvError>,
+    config: &RunConfig,
+    method: Method,
+    seed: u64,
+    mut on_episode: impl FnMut(&Trainer<E>),
+) -> Result<TrainedPolicy, LibraryTrainError> {
     validate(config, method)
         .and_then(|()| check_sizes(config))
         .map_err(|(key, message)| LibraryTrainError::Config { key, message })?;
@@ -48,7 +89,52 @@ pub fn train<E: MacroEnv>(
     while trainer.advance()? != Advance::Finished {
         on_episode(&trainer);
     }
-    Ok(trainer.evals().to_vec())
+    Ok(TrainedPolicy {
+        method,
+        seed,
+        episodes_trained: trainer.episodes(),
+        config: config.clone(),
+        evals: trainer.evals().to_vec(),
+        dec: trainer.dec_policies().into_iter().cloned().collect(),
+        cen: trainer.cen_policy().cloned(),
+    })
+}
+
+impl TrainedPolicy {
+    /// Write the decentralized nets as an exported policy directory `out` (`manifest.json` and
+    /// `agent-<i>.safetensors`) that `macdec robot --policy OUT --agent I` serves. The layout
+    /// (observation sizes and names, macro-action names) comes from `env` through its
+    /// [`MacroEnv`] methods; `domain` names it: [`PolicyEnv::custom`] for a domain of your own
+    /// (`macdec eval`, `deploy`, `domain` and `render` then refuse the policy, since this binary
+    /// cannot simulate it), or a built-in [`crate::EnvSpec`] (`.into()`) if `env` is one.
+    /// `out` must be new, empty or an earlier export.
+    pub fn export<E: MacroEnv>(
+        &self,
+        out: &Path,
+        env: &E,
+        domain: PolicyEnv,
+    ) -> Result<Manifest, ExportError> {
+        let mut config = self.config.clone();
+        if let PolicyEnv::BuiltIn(spec) = &domain {
+            config.env = *spec;
+        }
+        let mut config = serde_json::to_value(&config).expect("a RunConfig serializes to JSON");
+        if let (PolicyEnv::Custom(_), Some(keys)) = (&domain, config.as_object_mut()) {
+            for key in DOMAIN_KEYS {
+                keys.remove(key);
+            }
+        }
+        let run = RunInfo {
+            experiment: LIBRARY_EXPERIMENT.to_string(),
+            method: self.method.name().to_string(),
+            variant: String::new(),
+            seed: self.seed,
+            episodes_trained: self.episodes_trained,
+            config,
+        };
+        let dec: Vec<&QNet> = self.dec.iter().collect();
+        export_nets(out, domain, env, self.config.discount, run, &dec)
+    }
 }
 
 #[cfg(test)]
@@ -81,6 +167,56 @@ mod tests {
                 assert_eq!(a.loss.map(f64::to_bits), b.loss.map(f64::to_bits));
             }
         }
+    }
+
+    #[test]
+    fn an_exported_library_policy_holds_the_trained_nets_for_either_kind_of_domain() {
+        use crate::deploy::manifest::load_agent;
+        use crate::deploy::qnet_policy::load_net;
+        let c = short(Method::Our1);
+        let spec = c.env;
+        let trained = train_policy(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
+        let evals = train(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
+        let no_wall = |e: &[EvalPoint]| -> Vec<EvalPoint> {
+            e.iter()
+                .map(|p| EvalPoint {
+                    wall_seconds: 0.0,
+                    ..*p
+                })
+                .collect()
+        };
+        assert_eq!(no_wall(&trained.evals), no_wall(&evals));
+        assert_eq!((trained.dec.len(), trained.episodes_trained), (2, 12));
+        let env = spec.build().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        for (sub, domain) in [
+            ("built-in", PolicyEnv::from(spec)),
+            ("custom", PolicyEnv::custom("my-pushing", &env)),
+        ] {
+            let out = dir.path().join(sub);
+            let written = trained.export(&out, &env, domain.clone()).unwrap();
+            assert_eq!(written.env, domain);
+            assert_eq!(written.run.method, "our1");
+            let has_domain_keys = written.run.config.get("env_name").is_some();
+            assert_eq!(has_domain_keys, sub == "built-in");
+            for agent in 0..2 {
+                let (manifest, verified) = load_agent(&out, agent).unwrap();
+                assert_eq!(manifest, written);
+                assert_eq!(load_net(&manifest, &verified).unwrap(), trained.dec[agent]);
+            }
+        }
+        let cen = train_policy(
+            || spec.build(),
+            &short(Method::CenDdrqn),
+            Method::CenDdrqn,
+            3,
+            |_| {},
+        )
+        .unwrap();
+        let err = cen
+            .export(&dir.path().join("cen"), &env, spec.into())
+            .unwrap_err();
+        assert!(err.to_string().contains("no decentralized Q-nets"), "{err}");
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! `experiment` (config, runner) -> `algos` (trainer) -> `envs` + `nn` (on `autograd`), and the
 //! results feed `plot` and `deploy`. Lower layers never name higher ones.
 //!
-//! Your own domain: implement [`MacroEnv`] and call [`train`] (see `examples/custom_domain.rs`).
+//! Your own domain: implement [`MacroEnv`] and call [`train`], or [`train_policy`] and
+//! [`TrainedPolicy::export`] to put the trained policy on robots (see `examples/custom_domain.rs`).
 
 pub mod algos;
 pub mod api;
@@ -22,6 +23,7 @@ pub mod render;
 pub use algos::hyper::RunConfig;
 pub use algos::method::Method;
 pub use algos::trainer::EvalPoint;
-pub use api::{train, LibraryTrainError};
+pub use api::{train, train_policy, LibraryTrainError, TrainedPolicy};
+pub use deploy::PolicyEnv;
 pub use envs::{EnvError, EnvRng, EnvSpec, FirstRecordObs, MacroEnv, StepOutcome};
 pub use experiment::paper::paper_defaults;

@@ -408,6 +408,7 @@ fn run() -> Result<()> {
             out,
             frame_ms,
         } => {
+            refuse_policy_dir_as_run(&run)?;
             let returns = macdec::experiment::rollout::render_run(&run, episodes, &out, frame_ms)
                 .with_context(|| format!("rendering {}", run.display()))?;
             eprintln!(
@@ -762,6 +763,28 @@ fn bench_envs() -> Result<()> {
     Ok(())
 }
 
+/// `render --run` takes a run directory; an exported policy directory given instead is refused
+/// with what it is (a custom domain's by name: the binary cannot simulate it).
+fn refuse_policy_dir_as_run(dir: &Path) -> Result<()> {
+    use macdec::deploy::manifest::{Manifest, MANIFEST_FILE};
+    let run_policy = dir.join(macdec::experiment::policy_files::POLICY_DIR);
+    if !dir.join(MANIFEST_FILE).is_file() || run_policy.exists() {
+        return Ok(());
+    }
+    let manifest = Manifest::read(dir).with_context(|| format!("reading {}", dir.display()))?;
+    manifest
+        .env
+        .built_in()
+        .with_context(|| format!("rendering {}", dir.display()))?;
+    bail!(
+        "{} is an exported policy directory, not a run directory: `macdec render --run` takes a \
+         training run's directory (its policy/ files); `macdec eval --policy {}` runs this policy's \
+         episodes",
+        dir.display(),
+        dir.display()
+    )
+}
+
 /// Fresh policies (zero hidden state) for agent `agent`'s robot, one per connection.
 fn policy_factory(
     manifest: &macdec::deploy::Manifest,
@@ -855,10 +878,15 @@ struct EpisodeRun {
 
 impl EpisodeArgs {
     /// The policy (manifest and verified weights) and the evaluation env's stream of the seed.
+    /// Every episode command simulates the domain, so a custom domain's policy is refused here.
     fn load(&self) -> Result<EpisodeRun> {
         use macdec::experiment::seeds::{stream, Role};
         let (manifest, verified) = macdec::deploy::manifest::load_all(&self.policy)
             .with_context(|| format!("loading policy {}", self.policy.display()))?;
+        manifest
+            .env
+            .built_in()
+            .with_context(|| format!("running episodes of {}", self.policy.display()))?;
         let seed = self.seed.unwrap_or(manifest.run.seed);
         Ok(EpisodeRun {
             manifest,

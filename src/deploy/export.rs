@@ -1,12 +1,17 @@
 //! `macdec export`: turn a trained run directory into a policy directory (issue 7): each
 //! agent's decentralized Q-net from the run's policy files (issue 11; written with every
 //! checkpoint) as a safetensors file, and the manifest naming the domain, layout, architecture
-//! and run. Reads nothing of the trainer: no checkpoint, no learner types.
+//! and run. Reads nothing of the trainer: no checkpoint, no learner types. [`export_nets`] writes
+//! the same directory from plain nets and any [`MacroEnv`], for domains defined outside this
+//! binary (the library's `TrainedPolicy::export`).
 
 use crate::deploy::architecture::Architecture;
 use crate::deploy::manifest::{Manifest, ManifestError, RunInfo, MANIFEST_FILE};
+use crate::deploy::policy_env::PolicyEnv;
+use crate::envs::MacroEnv;
 use crate::experiment::policy_files::{read_description, NetRole, PolicyFilesError};
 use crate::nn::safetensors_io::to_safetensors_bytes;
+use crate::nn::QNet;
 use std::path::{Path, PathBuf};
 
 /// Why a run could not be exported.
@@ -16,7 +21,7 @@ pub enum ExportError {
     PolicyFiles(#[from] PolicyFilesError),
     #[error("{dir}: the run trained {method}, which has no decentralized Q-nets to put on robots (export a dec-hddrqn, our1, our1-r or our2 run)")]
     NotDecentralized { dir: PathBuf, method: String },
-    #[error("{dir}: agent {agent}'s net has sizes {found}, the run config says {expected}")]
+    #[error("{dir}: agent {agent}'s net has sizes {found}, expected {expected}")]
     NetSize {
         dir: PathBuf,
         agent: usize,
@@ -29,6 +34,12 @@ pub enum ExportError {
     NotAPolicyDir { dir: PathBuf, file: String },
     #[error("{path}: {message}")]
     Io { path: PathBuf, message: String },
+    #[error("{dir}: {got} decentralized net(s) for a domain of {expected} agent(s)")]
+    NetCount {
+        dir: PathBuf,
+        expected: usize,
+        got: usize,
+    },
 }
 
 /// Whether `name` is a file an export writes (or its atomic-write temp file).
@@ -110,14 +121,91 @@ pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
         episodes_trained: run.episodes_trained,
         config: run.config.clone(),
     };
-    let manifest = Manifest::write_policy(
+    let domain = run
+        .env
+        .build()
+        .map_err(|e| ManifestError::Env(e.to_string()))?;
+    write_export(
         out,
-        run.env,
+        previous,
+        run.env.into(),
+        &domain,
         run.discount,
         Architecture::ddrqn(mlp, hidden),
         info,
         &weights,
-    )?;
+    )
+}
+
+/// Write agent i's decentralized net `nets[i]` of a policy trained on `domain` (any
+/// [`MacroEnv`]; its layout goes into the manifest) to the policy directory `out`, naming the
+/// domain `env` (built-in, or [`PolicyEnv::custom`]). `out` must be new, empty or an earlier
+/// export, as for [`export_run`].
+pub fn export_nets(
+    out: &Path,
+    env: PolicyEnv,
+    domain: &impl MacroEnv,
+    discount: f64,
+    run: RunInfo,
+    nets: &[&QNet],
+) -> Result<Manifest, ExportError> {
+    let previous = previous_export_files(out)?;
+    if nets.is_empty() {
+        return Err(ExportError::NotDecentralized {
+            dir: out.to_path_buf(),
+            method: run.method,
+        });
+    }
+    if nets.len() != domain.n_agents() {
+        return Err(ExportError::NetCount {
+            dir: out.to_path_buf(),
+            expected: domain.n_agents(),
+            got: nets.len(),
+        });
+    }
+    let (mlp, hidden) = (nets[0].config().mlp, nets[0].config().hidden);
+    for (agent, net) in nets.iter().enumerate() {
+        let c = net.config();
+        if (c.mlp, c.hidden) != (mlp, hidden) {
+            return Err(ExportError::NetSize {
+                dir: out.to_path_buf(),
+                agent,
+                found: format!("M = {}, H = {}", c.mlp, c.hidden),
+                expected: format!("M = {mlp}, H = {hidden} (agent 0's)"),
+            });
+        }
+    }
+    let weights: Vec<Vec<u8>> = nets
+        .iter()
+        .map(|n| to_safetensors_bytes(&n.params))
+        .collect();
+    write_export(
+        out,
+        previous,
+        env,
+        domain,
+        discount,
+        Architecture::ddrqn(mlp, hidden),
+        run,
+        &weights,
+    )
+}
+
+/// Write the policy directory and remove what an earlier export there (`previous`) left that
+/// the new manifest no longer names.
+#[allow(clippy::too_many_arguments)]
+fn write_export(
+    out: &Path,
+    previous: Vec<PathBuf>,
+    env: PolicyEnv,
+    domain: &impl MacroEnv,
+    discount: f64,
+    architecture: Architecture,
+    run: RunInfo,
+    weights: &[Vec<u8>],
+) -> Result<Manifest, ExportError> {
+    let manifest =
+        Manifest::write_policy_for(out, env, domain, discount, architecture, run, weights)?;
     // An earlier export with more agents would leave weight files the manifest no longer names.
     let current: Vec<PathBuf> = std::iter::once(out.join(MANIFEST_FILE))
         .chain(manifest.agents.iter().map(|a| out.join(&a.weights)))

@@ -14,9 +14,16 @@
 //!  "agents": [{"index": 0, "weights": "agent-0.safetensors", "sha256": "9f86...",
 //!              "obs_size": 5, "obs_names": [...], "n_actions": 8, "action_names": [...]}, ...]}
 //! ```
+//!
+//! A policy of a domain defined outside this binary names it as
+//! `"env": {"env": "custom", "name": "rendezvous", "horizon": 20}`; its layout is then checked
+//! only for consistency (there is no domain here to compare it with). Built-in domains are written
+//! exactly as before, so `format_version` stays 1: an older build reading a custom manifest
+//! refuses it (unknown variant `custom`) rather than misreading it.
 
 use crate::deploy::architecture::LEAKY_RELU_SLOPE;
 use crate::deploy::architecture::{Architecture, WeightsError};
+use crate::deploy::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::experiment::atomic::write_atomic;
 use crate::experiment::bounded_read::read_regular_file;
@@ -28,7 +35,7 @@ use std::path::{Path, PathBuf};
 pub const MANIFEST_FILE: &str = "manifest.json";
 /// The `format` tag every manifest carries.
 pub const FORMAT: &str = "macdec-policy";
-/// The manifest layout this version reads and writes.
+/// The manifest layout this version reads and writes (unchanged by custom domains, see above).
 pub const FORMAT_VERSION: u32 = 1;
 
 /// `manifest.json`: everything a robot needs besides its weights.
@@ -39,8 +46,10 @@ pub struct Manifest {
     pub format: String,
     /// [`FORMAT_VERSION`] when written by this version.
     pub format_version: u32,
-    /// The domain and its parameters, as in configs and replay files.
-    pub env: EnvSpec,
+    /// The domain: a built-in one and its parameters, as in configs and replay files, or a
+    /// custom one (`{"env": "custom", "name": ..., "horizon": ...}`) whose layout only the agent
+    /// entries record (see [`PolicyEnv`]).
+    pub env: PolicyEnv,
     /// Discount per primitive step of the reported (evaluation) return (quirks Q5, Q13).
     pub discount: f64,
     /// Layer sizes shared by every agent's net.
@@ -197,16 +206,30 @@ impl Manifest {
         weights: &[Vec<u8>],
     ) -> Result<Manifest, ManifestError> {
         let built = env.build().map_err(|e| ManifestError::Env(e.to_string()))?;
-        if weights.len() != built.n_agents() {
+        Manifest::build_for(env.into(), &built, discount, architecture, run, weights)
+    }
+
+    /// [`Self::build`] for any domain: the layout (observation sizes and names, macro-action
+    /// names) is read from `domain` through its [`MacroEnv`] methods, and `env` says which domain
+    /// the manifest names. A built-in `env` is still checked against its own layout.
+    pub fn build_for(
+        env: PolicyEnv,
+        domain: &impl MacroEnv,
+        discount: f64,
+        architecture: Architecture,
+        run: RunInfo,
+        weights: &[Vec<u8>],
+    ) -> Result<Manifest, ManifestError> {
+        if weights.len() != domain.n_agents() {
             return Err(ManifestError::WeightsCount {
-                expected: built.n_agents(),
+                expected: domain.n_agents(),
                 got: weights.len(),
             });
         }
         let mut agents = Vec::with_capacity(weights.len());
         for (index, bytes) in weights.iter().enumerate() {
             let name = weights_file_name(index);
-            let (obs_size, n_actions) = (built.obs_sizes()[index], built.n_actions()[index]);
+            let (obs_size, n_actions) = (domain.obs_sizes()[index], domain.n_actions()[index]);
             architecture
                 .check_weights(bytes, obs_size, n_actions)
                 .map_err(|source| ManifestError::Weights {
@@ -218,9 +241,9 @@ impl Manifest {
                 weights: name,
                 sha256: sha256_hex(bytes),
                 obs_size,
-                obs_names: built.obs_names(index),
+                obs_names: domain.obs_names(index),
                 n_actions,
-                action_names: built
+                action_names: domain
                     .action_names(index)
                     .iter()
                     .map(|s| s.to_string())
@@ -252,14 +275,34 @@ impl Manifest {
         weights: &[Vec<u8>],
     ) -> Result<Manifest, ManifestError> {
         let manifest = Manifest::build(env, discount, architecture, run, weights)?;
-        for (entry, bytes) in manifest.agents.iter().zip(weights) {
+        manifest.write(dir, weights)?;
+        Ok(manifest)
+    }
+
+    /// Write a policy directory of [`Self::build_for`]: any domain, custom ones included.
+    pub fn write_policy_for(
+        dir: &Path,
+        env: PolicyEnv,
+        domain: &impl MacroEnv,
+        discount: f64,
+        architecture: Architecture,
+        run: RunInfo,
+        weights: &[Vec<u8>],
+    ) -> Result<Manifest, ManifestError> {
+        let manifest = Manifest::build_for(env, domain, discount, architecture, run, weights)?;
+        manifest.write(dir, weights)?;
+        Ok(manifest)
+    }
+
+    /// Write `weights` (in agent order) under this manifest's file names, then the manifest.
+    fn write(&self, dir: &Path, weights: &[Vec<u8>]) -> Result<(), ManifestError> {
+        for (entry, bytes) in self.agents.iter().zip(weights) {
             let path = dir.join(&entry.weights);
             write_atomic(&path, bytes).map_err(|e| io_err(&path, e))?;
         }
         let path = dir.join(MANIFEST_FILE);
-        let text = serde_json::to_string_pretty(&manifest).map_err(|e| io_err(&path, e))?;
-        write_atomic(&path, text.as_bytes()).map_err(|e| io_err(&path, e))?;
-        Ok(manifest)
+        let text = serde_json::to_string_pretty(self).map_err(|e| io_err(&path, e))?;
+        write_atomic(&path, text.as_bytes()).map_err(|e| io_err(&path, e))
     }
 
     /// Read and validate `dir/manifest.json` (structure and layout; weight files are checked by
@@ -277,8 +320,8 @@ impl Manifest {
     }
 
     /// Check the manifest against itself and its domain: format and version, sizes, agent order,
-    /// each agent's observation and action layout equal to the domain's, safe file names, and
-    /// well-formed checksums.
+    /// each agent's observation and action layout equal to the domain's (a custom domain's only
+    /// consistent with itself), safe file names, and well-formed checksums.
     pub fn validate(&self) -> Result<(), ManifestError> {
         if self.format != FORMAT {
             return Err(ManifestError::Format {
@@ -319,13 +362,46 @@ impl Manifest {
                 });
             }
         }
-        let env = self
-            .env
+        match &self.env {
+            PolicyEnv::BuiltIn(spec) => self.check_layout_against(spec)?,
+            PolicyEnv::Custom(custom) => self.check_custom_layout(custom)?,
+        }
+        for (position, a) in self.agents.iter().enumerate() {
+            if !is_plain_file_name(&a.weights) {
+                return Err(ManifestError::WeightsName {
+                    agent: position,
+                    name: a.weights.clone(),
+                });
+            }
+            if let Some(first) = self.agents[..position]
+                .iter()
+                .position(|b| b.weights == a.weights)
+            {
+                return Err(ManifestError::SharedWeights {
+                    first,
+                    second: position,
+                    name: a.weights.clone(),
+                });
+            }
+            let hex = |c: char| c.is_ascii_digit() || ('a'..='f').contains(&c);
+            if a.sha256.len() != 64 || !a.sha256.chars().all(hex) {
+                return Err(ManifestError::ChecksumText {
+                    agent: position,
+                    value: a.sha256.clone(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// A built-in domain's agents must be listed in order with exactly its layout.
+    fn check_layout_against(&self, spec: &EnvSpec) -> Result<(), ManifestError> {
+        let env = spec
             .build()
             .map_err(|e| ManifestError::Env(e.to_string()))?;
         if self.agents.len() != env.n_agents() {
             return Err(ManifestError::AgentCount {
-                env: self.env.name(),
+                env: spec.name(),
                 expected: env.n_agents(),
                 got: self.agents.len(),
             });
@@ -369,28 +445,42 @@ impl Manifest {
                 format!("{:?}", env.action_names(position)),
                 format!("{:?}", a.action_names),
             )?;
-            if !is_plain_file_name(&a.weights) {
-                return Err(ManifestError::WeightsName {
-                    agent: position,
-                    name: a.weights.clone(),
+        }
+        Ok(())
+    }
+
+    /// A custom domain is not here to compare with: its agent entries must be consistent among
+    /// themselves (in order, at least one observation element and one macro-action, one name
+    /// for each).
+    fn check_custom_layout(&self, custom: &CustomEnv) -> Result<(), ManifestError> {
+        custom
+            .validate()
+            .map_err(|(key, reason)| ManifestError::InvalidValue { key, reason })?;
+        if self.agents.is_empty() {
+            return Err(ManifestError::InvalidValue {
+                key: "agents",
+                reason: format!("the custom domain `{}` lists no agents", custom.name),
+            });
+        }
+        for (position, a) in self.agents.iter().enumerate() {
+            if a.index != position {
+                return Err(ManifestError::AgentIndex {
+                    position,
+                    index: a.index,
                 });
             }
-            if let Some(first) = self.agents[..position]
-                .iter()
-                .position(|b| b.weights == a.weights)
-            {
-                return Err(ManifestError::SharedWeights {
-                    first,
-                    second: position,
-                    name: a.weights.clone(),
-                });
-            }
-            let hex = |c: char| c.is_ascii_digit() || ('a'..='f').contains(&c);
-            if a.sha256.len() != 64 || !a.sha256.chars().all(hex) {
-                return Err(ManifestError::ChecksumText {
-                    agent: position,
-                    value: a.sha256.clone(),
-                });
+            for (field, size, names) in [
+                ("obs_names", a.obs_size, a.obs_names.len()),
+                ("action_names", a.n_actions, a.action_names.len()),
+            ] {
+                if size == 0 || names != size {
+                    return Err(ManifestError::Layout {
+                        agent: position,
+                        field,
+                        expected: format!("{size} name(s), one per element (and at least one)"),
+                        got: format!("{names} name(s)"),
+                    });
+                }
             }
         }
         Ok(())
@@ -683,6 +773,76 @@ mod tests {
         std::fs::write(dir.path().join("agent-0.safetensors"), &wrong).unwrap();
         let sum = sha256_hex(&wrong);
         rewrite_manifest(dir.path(), |v| v["agents"][0]["sha256"] = sum.into());
+        let err = load_agent(dir.path(), 0).unwrap_err();
+        assert!(matches!(err, ManifestError::Weights { .. }), "{err}");
+    }
+
+    /// Box Pushing 10x10's layout exported as a custom domain named `corridor`.
+    fn export_custom(dir: &Path) -> Manifest {
+        let arch = Architecture::ddrqn(8, 4);
+        let domain = bp10().build().unwrap();
+        let weights: Vec<Vec<u8>> = (0..2)
+            .map(|a| synthetic_weights(&arch, 5, 8, |_, i| (i + a) as f32 * 0.01))
+            .collect();
+        let env = PolicyEnv::custom("corridor", &domain);
+        Manifest::write_policy_for(dir, env, &domain, 0.95, arch, run_info(), &weights).unwrap()
+    }
+
+    #[test]
+    fn a_custom_domain_policy_reads_back_with_its_layout_from_the_env_object() {
+        let dir = tempfile::tempdir().unwrap();
+        let written = export_custom(dir.path());
+        let text = std::fs::read_to_string(dir.path().join(MANIFEST_FILE)).unwrap();
+        assert!(
+            text.contains("\"env\": \"custom\"") && text.contains("\"name\": \"corridor\""),
+            "{text}"
+        );
+        let (read, agents) = load_all(dir.path()).unwrap();
+        assert_eq!(read, written);
+        assert_eq!(agents.len(), 2);
+        assert_eq!((read.env.name(), read.env.horizon()), ("corridor", 100));
+        assert_eq!(read.agents[1].action_names.len(), 8);
+        assert_eq!(
+            read.agents[0].obs_names,
+            bp10().build().unwrap().obs_names(0)
+        );
+    }
+
+    #[test]
+    fn a_custom_domain_policy_must_be_consistent_with_itself() {
+        let dir = tempfile::tempdir().unwrap();
+        type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+        let cases: Vec<(Edit, &str)> = vec![
+            (
+                Box::new(|v| {
+                    v["agents"][0]["obs_names"].as_array_mut().unwrap().pop();
+                }),
+                "agent 0: `obs_names`",
+            ),
+            (
+                Box::new(|v| v["agents"][1]["n_actions"] = 9.into()),
+                "agent 1: `action_names`",
+            ),
+            (
+                Box::new(|v| v["agents"] = serde_json::json!([])),
+                "lists no agents",
+            ),
+            (Box::new(|v| v["env"]["name"] = "".into()), "env.name"),
+            (Box::new(|v| v["env"]["horizon"] = 0.into()), "env.horizon"),
+            (Box::new(|v| v["agents"][1]["index"] = 0.into()), "index 0"),
+        ];
+        for (edit, needle) in cases {
+            export_custom(dir.path());
+            rewrite_manifest(dir.path(), edit);
+            let err = Manifest::read(dir.path()).unwrap_err().to_string();
+            assert!(err.contains(needle), "expected `{needle}` in: {err}");
+        }
+        // The weights are still checked against the manifest's own layout.
+        export_custom(dir.path());
+        rewrite_manifest(dir.path(), |v| {
+            v["agents"][0]["obs_size"] = 4.into();
+            v["agents"][0]["obs_names"].as_array_mut().unwrap().pop();
+        });
         let err = load_agent(dir.path(), 0).unwrap_err();
         assert!(matches!(err, ManifestError::Weights { .. }), "{err}");
     }

@@ -10,7 +10,9 @@
 //! domain`, the ROS bridge of issue 14). Only [`export`] reads a run directory, and only its
 //! policy files ([`crate::experiment::policy_files`]), never its checkpoint; deploy imports nothing
 //! of the learner (`src/algos`). [`import`] builds the same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
-//! any policy directory's greedy episodes in-process, exactly as deployment does.
+//! any policy directory's greedy episodes in-process, exactly as deployment does. A policy may be
+//! of a domain defined outside this binary ([`policy_env`]): robots serve it, the commands that
+//! simulate a domain refuse it by name.
 
 pub mod architecture;
 pub mod deadline;
@@ -22,6 +24,7 @@ pub mod link;
 pub mod local_eval;
 pub mod manifest;
 pub mod mock;
+pub mod policy_env;
 pub mod processes;
 pub mod protocol;
 pub mod qnet_policy;
@@ -32,6 +35,7 @@ pub mod server;
 pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};
 pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
 pub use manifest::{Manifest, ManifestError, VerifiedAgent};
+pub use policy_env::{CustomEnv, NotBuiltIn, PolicyEnv};
 pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};
 pub use server::{serve_tcp, spawn_server, Limits, RobotServer};
 

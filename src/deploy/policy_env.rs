@@ -1,0 +1,277 @@
+//! Which domain an exported policy is for: one built into this binary ([`EnvSpec`], written
+//! exactly as configs and replay files write it), or a custom domain a library user defined in
+//! their own program (`{"env": "custom", "name": "rendezvous", "horizon": 20}`).
+//!
+//! A robot needs only its net and the layout in the manifest, so it serves either. Commands that
+//! simulate the domain (`eval`, `deploy`, `domain`, `render`) can build only a built-in one and
+//! refuse a custom one with [`NotBuiltIn`], naming it.
+
+use crate::envs::{AnyEnv, EnvError, EnvSpec, MacroEnv};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+/// The `env` tag of a custom domain.
+pub const CUSTOM: &str = "custom";
+/// Longest custom domain name (it is shown in messages and `info` replies).
+pub const MAX_NAME_CHARS: usize = 64;
+
+/// The domain of an exported policy.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PolicyEnv {
+    /// Box Pushing or Warehouse: serialized as the bare [`EnvSpec`], byte for byte as before
+    /// custom domains existed, so every existing policy directory reads unchanged.
+    BuiltIn(EnvSpec),
+    /// A domain defined outside this binary (a [`MacroEnv`] of the library user's).
+    Custom(CustomEnv),
+}
+
+/// A custom domain as its policy records it: a name for people and its horizon. Its layout
+/// (observation sizes and names, macro-action names) is in the manifest's agent entries.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CustomEnv {
+    /// The domain's name, e.g. `rendezvous`.
+    pub name: String,
+    /// Its horizon in primitive steps.
+    pub horizon: usize,
+}
+
+/// A command that must simulate the domain was given a policy of a custom domain.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("the policy's domain `{name}` is a custom domain, not built into this binary (it has box-pushing and warehouse): `macdec robot` serves its agents, but running its episodes needs its simulator, so drive the robots from your own program (macdec::deploy::run_episodes with your MacroEnv and JsonLink::connect)")]
+pub struct NotBuiltIn {
+    pub name: String,
+}
+
+impl PolicyEnv {
+    /// A custom domain named `name` with `env`'s horizon.
+    pub fn custom(name: impl Into<String>, env: &impl MacroEnv) -> PolicyEnv {
+        PolicyEnv::Custom(CustomEnv {
+            name: name.into(),
+            horizon: env.horizon(),
+        })
+    }
+
+    /// The domain's name: the built-in `env` tag (`box-pushing`, `warehouse`) or the custom name.
+    pub fn name(&self) -> &str {
+        match self {
+            PolicyEnv::BuiltIn(spec) => spec.name(),
+            PolicyEnv::Custom(c) => &c.name,
+        }
+    }
+
+    /// The horizon in primitive steps.
+    pub fn horizon(&self) -> usize {
+        match self {
+            PolicyEnv::BuiltIn(spec) => spec.horizon(),
+            PolicyEnv::Custom(c) => c.horizon,
+        }
+    }
+
+    /// The built-in domain's spec, or [`NotBuiltIn`] naming the custom domain.
+    pub fn built_in(&self) -> Result<EnvSpec, NotBuiltIn> {
+        match self {
+            PolicyEnv::BuiltIn(spec) => Ok(*spec),
+            PolicyEnv::Custom(c) => Err(NotBuiltIn {
+                name: c.name.clone(),
+            }),
+        }
+    }
+
+    /// Build the domain to simulate it: only a built-in one can be.
+    pub fn build(&self) -> Result<AnyEnv, BuildError> {
+        Ok(self.built_in()?.build()?)
+    }
+}
+
+/// Why [`PolicyEnv::build`] failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BuildError {
+    #[error(transparent)]
+    NotBuiltIn(#[from] NotBuiltIn),
+    #[error(transparent)]
+    Env(#[from] EnvError),
+}
+
+impl CustomEnv {
+    /// The name is 1 to [`MAX_NAME_CHARS`] printable characters and not a built-in domain's (a
+    /// policy saying `box-pushing` must be Box Pushing's); the horizon is positive.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        let n = self.name.chars().count();
+        if n == 0 || n > MAX_NAME_CHARS || self.name.chars().any(char::is_control) {
+            return Err((
+                "env.name",
+                format!(
+                    "must be 1 to {MAX_NAME_CHARS} printable characters, got {:?}",
+                    self.name
+                ),
+            ));
+        }
+        if ["box-pushing", "warehouse", CUSTOM].contains(&self.name.as_str()) {
+            return Err((
+                "env.name",
+                format!(
+                    "`{}` is a built-in domain's name or the custom tag; name your domain differently",
+                    self.name
+                ),
+            ));
+        }
+        if self.horizon == 0 {
+            return Err(("env.horizon", "must be > 0".into()));
+        }
+        Ok(())
+    }
+}
+
+impl PartialEq<EnvSpec> for PolicyEnv {
+    fn eq(&self, other: &EnvSpec) -> bool {
+        matches!(self, PolicyEnv::BuiltIn(spec) if spec == other)
+    }
+}
+
+impl From<EnvSpec> for PolicyEnv {
+    fn from(spec: EnvSpec) -> Self {
+        PolicyEnv::BuiltIn(spec)
+    }
+}
+
+/// The custom form on the wire: the tag, then the fields.
+#[derive(Serialize)]
+struct CustomWire<'a> {
+    env: &'static str,
+    name: &'a str,
+    horizon: usize,
+}
+
+impl Serialize for PolicyEnv {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            PolicyEnv::BuiltIn(spec) => spec.serialize(s),
+            PolicyEnv::Custom(c) => CustomWire {
+                env: CUSTOM,
+                name: &c.name,
+                horizon: c.horizon,
+            }
+            .serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PolicyEnv {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut value = serde_json::Value::deserialize(d)?;
+        let is_custom = value.get("env").and_then(|t| t.as_str()) == Some(CUSTOM);
+        if is_custom {
+            if let Some(object) = value.as_object_mut() {
+                object.remove("env");
+            }
+            return serde_json::from_value(value)
+                .map(PolicyEnv::Custom)
+                .map_err(|e| D::Error::custom(format!("custom env: {e}")));
+        }
+        serde_json::from_value(value)
+            .map(PolicyEnv::BuiltIn)
+            .map_err(|e| {
+                let hint = if e.to_string().contains("unknown variant") {
+                    format!(" (or `{CUSTOM}` for a domain defined outside this binary)")
+                } else {
+                    String::new()
+                };
+                D::Error::custom(format!("{e}{hint}"))
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_built_in_domain_serializes_exactly_as_its_spec() {
+        for spec in [
+            EnvSpec::paper_box_pushing(10),
+            EnvSpec::Warehouse {
+                horizon: 150,
+                tb_m_noisy: 0.25,
+            },
+        ] {
+            let env = PolicyEnv::BuiltIn(spec);
+            assert_eq!(
+                serde_json::to_string_pretty(&env).unwrap(),
+                serde_json::to_string_pretty(&spec).unwrap()
+            );
+            let text = serde_json::to_string(&spec).unwrap();
+            assert_eq!(serde_json::from_str::<PolicyEnv>(&text).unwrap(), spec);
+        }
+        let old: PolicyEnv =
+            serde_json::from_str(r#"{"env": "warehouse", "horizon": 150}"#).unwrap();
+        assert_eq!(old, EnvSpec::paper_warehouse());
+    }
+
+    #[test]
+    fn a_custom_domain_round_trips_with_its_tag() {
+        let env = PolicyEnv::Custom(CustomEnv {
+            name: "rendezvous".into(),
+            horizon: 20,
+        });
+        let text = serde_json::to_string(&env).unwrap();
+        assert_eq!(text, r#"{"env":"custom","name":"rendezvous","horizon":20}"#);
+        assert_eq!(serde_json::from_str::<PolicyEnv>(&text).unwrap(), env);
+        assert_eq!((env.name(), env.horizon()), ("rendezvous", 20));
+    }
+
+    #[test]
+    fn bad_domains_are_named() {
+        let err = serde_json::from_str::<PolicyEnv>(r#"{"env": "boxpushing", "horizon": 1}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("boxpushing") && err.contains("box-pushing") && err.contains("custom"),
+            "{err}"
+        );
+        let err = serde_json::from_str::<PolicyEnv>(
+            r#"{"env": "custom", "name": "x", "horizon": 3, "grid": 4}"#,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("grid"), "{err}");
+        let err = serde_json::from_str::<PolicyEnv>(r#"{"env": "custom", "horizon": 3}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("name"), "{err}");
+    }
+
+    #[test]
+    fn a_custom_domain_cannot_be_built_and_says_so_by_name() {
+        let env = PolicyEnv::Custom(CustomEnv {
+            name: "rendezvous".into(),
+            horizon: 20,
+        });
+        let err = env.build().unwrap_err().to_string();
+        assert!(
+            err.contains("`rendezvous`") && err.contains("not built into this binary"),
+            "{err}"
+        );
+        assert!(PolicyEnv::BuiltIn(EnvSpec::paper_warehouse())
+            .build()
+            .is_ok());
+    }
+
+    #[test]
+    fn custom_names_and_horizons_are_checked() {
+        let c = |name: &str, horizon| CustomEnv {
+            name: name.into(),
+            horizon,
+        };
+        assert!(c("rendezvous", 20).validate().is_ok());
+        for (bad, key) in [
+            (c("", 20), "env.name"),
+            (c("a\nb", 20), "env.name"),
+            (c(&"x".repeat(65), 20), "env.name"),
+            (c("warehouse", 20), "env.name"),
+            (c("rendezvous", 0), "env.horizon"),
+        ] {
+            assert_eq!(bad.validate().unwrap_err().0, key, "{bad:?}");
+        }
+    }
+}
