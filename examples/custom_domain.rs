@@ -1,6 +1,7 @@
 //! Your own domain in one file: a small macro-action task defined here, trained with Our-1 and
-//! Dec-HDDRQN through the library entry point `macdec::train`, learning curves printed, and the
-//! known optimum checked.
+//! Dec-HDDRQN through the library entry point `macdec::train_policy`, learning curves printed, the
+//! known optimum checked, and the Our-1 policy exported as a policy directory that `macdec robot`
+//! serves.
 //!
 //! Rendezvous: two robots on a corridor of 9 cells must meet at one of three waypoints (cells 0,
 //! 4 and 8). Robot 0 starts at cell 1, robot 1 at cell 7. Each macro-action is "go to waypoint k"
@@ -13,9 +14,13 @@
 //! Run: `cargo run --release --example custom_domain [-- OUT_DIR]`. With `OUT_DIR` the curves are
 //! also written as `OUT_DIR/custom_domain/<method>/seed-0/metrics.csv`, which
 //! `macdec plot --results OUT_DIR` draws like any other experiment.
+//!
+//! The Our-1 policy is written to `<temp dir>/macdec-rendezvous-our1` (rewritten on every run);
+//! serve agent 0 with `macdec robot --policy <that dir> --agent 0`. `macdec eval`, `deploy`,
+//! `domain` and `render` refuse it: Rendezvous is not built into the binary.
 
 use macdec::experiment::metrics;
-use macdec::{paper_defaults, EnvError, EnvRng, EnvSpec, MacroEnv, Method, StepOutcome};
+use macdec::{paper_defaults, EnvError, EnvRng, EnvSpec, MacroEnv, Method, PolicyEnv, StepOutcome};
 
 /// Corridor cells.
 const CELLS: usize = 9;
@@ -229,10 +234,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.dec_rnn_h_size = 32;
         config.cen_rnn_h_size = 32;
         config.eval_freq = 200;
-        let evals = macdec::train(Rendezvous::new_ok, &config, method, 0, |_| {})?;
+        let trained = macdec::train_policy(Rendezvous::new_ok, &config, method, 0, |_| {})?;
+        let evals = &trained.evals;
         println!("\n{} ({}):", method.legend(), method);
         println!("  episode   return");
-        for e in &evals {
+        for e in evals {
             println!("  {:>7}  {:>7.3}", e.episode, e.eval_return);
         }
         let last = evals.last().map_or(f64::NEG_INFINITY, |e| e.eval_return);
@@ -245,7 +251,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(dir) = &out_dir {
             let run = dir.join("custom_domain").join(method.name()).join("seed-0");
             std::fs::create_dir_all(&run)?;
-            metrics::write(&run.join(metrics::METRICS_FILE), &evals)?;
+            metrics::write(&run.join(metrics::METRICS_FILE), evals)?;
+        }
+        if method == Method::Our1 {
+            // The layout (observation and macro-action names) comes from the env object.
+            let env = Rendezvous::new();
+            let policy = std::env::temp_dir().join("macdec-rendezvous-our1");
+            trained.export(&policy, &env, PolicyEnv::custom("rendezvous", &env))?;
+            println!(
+                "  policy exported to {}\n  serve agent 0: macdec robot --policy {} --agent 0",
+                policy.display(),
+                policy.display()
+            );
         }
     }
     if !all_reached {
