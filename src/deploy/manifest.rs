@@ -777,6 +777,18 @@ mod tests {
         assert!(matches!(err, ManifestError::Weights { .. }), "{err}");
     }
 
+    #[test]
+    fn a_built_in_domain_is_written_as_before_custom_domains_and_rewrites_byte_for_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        export(dir.path());
+        let text = std::fs::read_to_string(dir.path().join(MANIFEST_FILE)).unwrap();
+        let env = "  \"env\": {\n    \"env\": \"box-pushing\",\n    \"grid\": 10,\n    \"horizon\": 100\n  },\n";
+        assert!(text.contains(env), "{text}");
+        let read = Manifest::read(dir.path()).unwrap();
+        assert_eq!(read.env, bp10());
+        assert_eq!(serde_json::to_string_pretty(&read).unwrap(), text);
+    }
+
     /// Box Pushing 10x10's layout exported as a custom domain named `corridor`.
     fn export_custom(dir: &Path) -> Manifest {
         let arch = Architecture::ddrqn(8, 4);
