@@ -357,3 +357,19 @@ fn deploy_prints_each_episode_as_it_ends() {
     let trace: EpisodeTrace = serde_json::from_str(&line).unwrap();
     assert_eq!(trace.episode, 0);
 }
+
+/// `src/deploy` knows no learner (issue 11): no file there names `src/algos`, so a policy
+/// directory, whatever its domain, is served without the trainer's types.
+#[test]
+fn deploy_imports_nothing_of_the_learner() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/deploy");
+    let mut users = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        if text.contains("crate::algos") || text.contains("macdec::algos") {
+            users.push(path.display().to_string());
+        }
+    }
+    assert!(users.is_empty(), "{users:?}");
+}
