@@ -27,6 +27,7 @@ use crate::deploy::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::experiment::atomic::write_atomic;
 use crate::experiment::bounded_read::read_regular_file;
+use crate::experiment::limits::MAX_NET_WIDTH;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -355,10 +356,10 @@ impl Manifest {
             ),
             ("architecture.rnn_h_size", self.architecture.rnn_h_size),
         ] {
-            if value == 0 {
+            if value == 0 || value > MAX_NET_WIDTH {
                 return Err(ManifestError::InvalidValue {
                     key,
-                    reason: "must be > 0".into(),
+                    reason: format!("must be in 1..={MAX_NET_WIDTH}, got {value}"),
                 });
             }
         }
@@ -499,13 +500,16 @@ impl Manifest {
         let path = dir.join(&entry.weights);
         // Refuse a FIFO, a device or an oversized file before reading it: the architecture says
         // how big the file can be.
-        let floats: usize = self
+        // Saturating: a hand-edited layout cannot overflow the bound, only make it unreachable.
+        let floats = self
             .architecture
             .tensors(entry.obs_size, entry.n_actions)
             .iter()
-            .map(|(_, shape)| shape.iter().product::<usize>())
-            .sum();
-        let max = floats as u64 * 4 + MAX_SAFETENSORS_HEADER_BYTES;
+            .map(|(_, shape)| shape.iter().fold(1u64, |n, &d| n.saturating_mul(d as u64)))
+            .fold(0u64, u64::saturating_add);
+        let max = floats
+            .saturating_mul(4)
+            .saturating_add(MAX_SAFETENSORS_HEADER_BYTES);
         let bytes = read_regular_file(&path, max).map_err(|e| io_err(&path, e))?;
         let got = sha256_hex(&bytes);
         if got != entry.sha256 {
@@ -725,6 +729,10 @@ mod tests {
             (
                 Box::new(|v| v["architecture"]["rnn_h_size"] = 0.into()),
                 "rnn_h_size",
+            ),
+            (
+                Box::new(|v| v["architecture"]["mlp_layer_size"] = u64::MAX.into()),
+                "mlp_layer_size",
             ),
         ];
         for (edit, needle) in cases {

@@ -173,7 +173,10 @@ mod tests {
         let col = header.iter().position(|h| *h == "best_mean").unwrap();
         let cen = csv.lines().find(|l| l.starts_with("cen-ddrqn,")).unwrap();
         let best: f64 = cen.split(',').nth(col).unwrap().parse().unwrap();
-        let expected = curve(20, 85.0, 151).iter().map(|p| p.1).fold(f64::MIN, f64::max);
+        let expected = curve(20, 85.0, 151)
+            .iter()
+            .map(|p| p.1)
+            .fold(f64::MIN, f64::max);
         assert_eq!(best, expected);
         let md = report.markdown();
         assert!(md.contains("| Our-1 | 3 (3) | 1500 |"), "{md}");
