@@ -13,25 +13,16 @@ of the optimal return, between 0 and that, and below 0 (a collapsed snapshot). I
 policy plateaus below the optimum" from "it is near the optimum but sometimes collapses".
 
 Reads `metrics.csv` or `metrics.csv.gz` (column `eval_return`) of every run directory with a
-`finished` marker. Standard library only; tests and CI never run it.
+`finished` marker (a finished run without metrics is an error). Standard library only; tests and CI never run it.
 """
 
 import argparse
-import csv
-import gzip
 import os
 import statistics
 import sys
 
-
-def eval_returns(run_dir):
-    """The run's evaluation returns in episode order, or None without metrics."""
-    for name, opener in (("metrics.csv", open), ("metrics.csv.gz", gzip.open)):
-        path = os.path.join(run_dir, name)
-        if os.path.exists(path):
-            with opener(path, "rt", newline="") as f:
-                return [float(row["eval_return"]) for row in csv.DictReader(f)]
-    return None
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from compare_reference_curves import read_ours  # noqa: E402  (one reader of a run's metrics)
 
 
 def late(returns):
@@ -78,7 +69,7 @@ def main():
             run = os.path.join(curve_dir, seed)
             if not os.path.exists(os.path.join(run, "finished")):
                 continue
-            returns = eval_returns(run)
+            returns = [r for _, r in read_ours(run)]
             if not returns:
                 continue
             values = late(returns)
