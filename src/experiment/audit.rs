@@ -211,8 +211,8 @@ pub fn audit_all(
     jobs: usize,
     report: impl Fn(&Result<RunAudit, (PathBuf, AuditError)>) + Sync,
 ) -> Vec<Result<RunAudit, (PathBuf, AuditError)>> {
-    use rayon::prelude::*;
-    let one = |dir: &PathBuf| {
+    let one = |i: usize| {
+        let dir = &dirs[i];
         let scratch = tempfile::Builder::new()
             .prefix("macdec-audit-")
             .tempdir()
@@ -226,13 +226,8 @@ pub fn audit_all(
         report(&result);
         result
     };
-    match rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.clamp(1, dirs.len().max(1)))
-        .build()
-    {
-        Ok(pool) => pool.install(|| dirs.par_iter().map(one).collect()),
-        Err(_) => dirs.iter().map(one).collect(),
-    }
+    let order: Vec<usize> = (0..dirs.len()).collect();
+    crate::experiment::work_queue::run_in_order(&order, jobs, one)
 }
 
 #[cfg(test)]

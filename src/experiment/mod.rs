@@ -17,3 +17,4 @@ pub mod runner;
 pub mod seeds;
 pub mod slurm;
 pub mod train_run;
+pub mod work_queue;

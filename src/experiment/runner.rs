@@ -1,4 +1,4 @@
-//! Runs every (method, variant, seed) of an experiment as its own job, in parallel with rayon.
+//! Runs every (method, variant, seed) of an experiment as its own job, `--jobs` at a time.
 //!
 //! Parallelism is across runs only, never inside one run's arithmetic, so `--jobs` never changes
 //! a number. A run that fails (bad numbers, I/O, even a panic) reports its error and the others
@@ -9,8 +9,8 @@
 use crate::experiment::config::RunSpec;
 use crate::experiment::limits::worker_threads;
 use crate::experiment::train_run::{existing_run, Existing};
+use crate::experiment::work_queue::run_in_order;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -66,7 +66,18 @@ impl Progress {
     }
 }
 
-/// Run `runs` with `run_one`, `jobs` at a time. Returns each run's status in input order.
+/// `experiment/curve/seed-k`, as progress lines name a run.
+fn run_name(spec: &RunSpec) -> String {
+    format!(
+        "{}/{}/seed-{}",
+        spec.experiment,
+        spec.curve_name(),
+        spec.seed
+    )
+}
+
+/// Run `runs` with `run_one`, `jobs` at a time, each worker taking the next run (lowest seed
+/// first) as soon as it is free. Returns each run's status in input order.
 pub fn run_all<F>(runs: &[RunSpec], opts: &RunnerOptions, run_one: F) -> Vec<RunStatus>
 where
     F: Fn(&RunSpec, &Path, &Progress) -> Result<(), String> + Sync,
@@ -104,78 +115,81 @@ where
         )
         .expect("valid template"),
     );
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(worker_threads(opts.jobs, runs.len()))
-        .build()
-        .expect("a rayon pool with at least one thread");
-    let statuses = pool.install(|| {
-        runs.par_iter()
-            .zip(todo.par_iter())
-            .map(|(spec, todo)| {
-                let name = format!(
-                    "{}/{}/seed-{}",
-                    spec.experiment,
-                    spec.curve_name(),
-                    spec.seed
-                );
-                match todo {
-                    Ok(true) => {}
-                    Ok(false) => return RunStatus::Skipped,
-                    Err(e) => {
-                        let _ = multi.println(format!("FAILED {name}: {e}"));
-                        if opts.quiet {
-                            eprintln!("FAILED {name}: {e}");
-                        }
-                        return RunStatus::Failed(e.clone());
-                    }
+    // Failures of identity are reported at once; the runs to train go through one queue in seed
+    // order, so an interrupted batch leaves every curve with about the same seeds finished.
+    let mut statuses: Vec<Option<RunStatus>> = runs
+        .iter()
+        .zip(&todo)
+        .map(|(spec, todo)| match todo {
+            Ok(true) => None,
+            Ok(false) => Some(RunStatus::Skipped),
+            Err(e) => {
+                let name = run_name(spec);
+                let _ = multi.println(format!("FAILED {name}: {e}"));
+                if opts.quiet {
+                    eprintln!("FAILED {name}: {e}");
                 }
-                let dir = spec.dir(&opts.out);
-                let bar =
-                    multi.insert_before(&total, ProgressBar::new(spec.config.total_epi as u64));
-                bar.set_style(
-                    ProgressStyle::with_template("{prefix:32} {bar:20} {pos}/{len} {msg}")
-                        .expect("valid template"),
-                );
-                bar.set_prefix(format!("{}/seed-{}", spec.curve_name(), spec.seed));
-                let progress = Progress {
-                    bar: bar.clone(),
-                    total: total.clone(),
-                    last: Arc::default(),
-                };
-                let start = std::time::Instant::now();
-                // A panic is a bug, but it fails this run only, not its neighbours.
-                let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    run_one(spec, &dir, &progress)
-                }))
-                .unwrap_or_else(|panic| {
-                    let what = panic
-                        .downcast_ref::<String>()
-                        .cloned()
-                        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                        .unwrap_or_else(|| "unknown".into());
-                    Err(format!("internal error (panic: {what})"))
-                });
-                bar.finish_and_clear();
-                multi.remove(&bar);
-                let seconds = start.elapsed().as_secs_f64();
-                match result {
-                    Ok(()) => {
-                        if opts.quiet {
-                            eprintln!("finished {name} in {seconds:.1} s");
-                        }
-                        RunStatus::Finished { seconds }
-                    }
-                    Err(e) => {
-                        let _ = multi.println(format!("FAILED {name}: {e}"));
-                        if opts.quiet {
-                            eprintln!("FAILED {name}: {e}");
-                        }
-                        RunStatus::Failed(e)
-                    }
+                Some(RunStatus::Failed(e.clone()))
+            }
+        })
+        .collect();
+    let mut order: Vec<usize> = (0..runs.len()).filter(|&i| statuses[i].is_none()).collect();
+    order.sort_by_key(|&i| runs[i].seed);
+    let workers = worker_threads(opts.jobs, order.len());
+    let trained = run_in_order(&order, workers, |i| {
+        let spec = &runs[i];
+        let name = run_name(spec);
+        let dir = spec.dir(&opts.out);
+        let bar = multi.insert_before(&total, ProgressBar::new(spec.config.total_epi as u64));
+        bar.set_style(
+            ProgressStyle::with_template("{prefix:32} {bar:20} {pos}/{len} {msg}")
+                .expect("valid template"),
+        );
+        bar.set_prefix(format!("{}/seed-{}", spec.curve_name(), spec.seed));
+        let progress = Progress {
+            bar: bar.clone(),
+            total: total.clone(),
+            last: Arc::default(),
+        };
+        let start = std::time::Instant::now();
+        // A panic is a bug, but it fails this run only, not its neighbours.
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            run_one(spec, &dir, &progress)
+        }))
+        .unwrap_or_else(|panic| {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown".into());
+            Err(format!("internal error (panic: {what})"))
+        });
+        bar.finish_and_clear();
+        multi.remove(&bar);
+        let seconds = start.elapsed().as_secs_f64();
+        match result {
+            Ok(()) => {
+                if opts.quiet {
+                    eprintln!("finished {name} in {seconds:.1} s");
                 }
-            })
-            .collect()
+                RunStatus::Finished { seconds }
+            }
+            Err(e) => {
+                let _ = multi.println(format!("FAILED {name}: {e}"));
+                if opts.quiet {
+                    eprintln!("FAILED {name}: {e}");
+                }
+                RunStatus::Failed(e)
+            }
+        }
     });
+    for (i, status) in order.into_iter().zip(trained) {
+        statuses[i] = Some(status);
+    }
+    let statuses = statuses
+        .into_iter()
+        .map(|s| s.expect("every run was skipped, failed or trained"))
+        .collect();
     total.finish_and_clear();
     statuses
 }
@@ -226,6 +240,43 @@ mod tests {
         let second = run_all(&runs, &opts, work);
         assert!(matches!(second[0], RunStatus::Skipped));
         assert!(matches!(second[1], RunStatus::Failed(_)));
+    }
+
+    #[test]
+    fn runs_start_in_seed_order_across_methods() {
+        let dir = tempfile::tempdir().unwrap();
+        let opts = RunnerOptions {
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            force: false,
+            quiet: true,
+        };
+        let o = Overrides {
+            seeds: Some(vec![0, 1]),
+            ..Default::default()
+        };
+        let runs = Experiment::parse(
+            "methods = [\"our1\", \"cen-ddrqn\"]",
+            Path::new("t.toml"),
+            "t",
+            &o,
+        )
+        .unwrap()
+        .runs()
+        .unwrap();
+        let started = std::sync::Mutex::new(Vec::new());
+        run_all(&runs, &opts, |spec, dir, _| {
+            started
+                .lock()
+                .unwrap()
+                .push(format!("{}/{}", spec.curve_name(), spec.seed));
+            finish(spec, dir);
+            Ok(())
+        });
+        assert_eq!(
+            *started.lock().unwrap(),
+            ["our1/0", "cen-ddrqn/0", "our1/1", "cen-ddrqn/1"]
+        );
     }
 
     /// What a finished run leaves: its config.toml and the marker.
