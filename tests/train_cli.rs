@@ -121,6 +121,93 @@ fn a_killed_run_resumes_to_the_uninterrupted_metrics() {
 }
 
 #[test]
+fn a_run_being_trained_by_another_process_is_refused_even_with_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(
+        &config,
+        TINY.replace("total_epi = 60", "total_epi = 1000000"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let run = out.join("tiny/our1/seed-0");
+    let args = ["--methods", "our1", "--seeds", "0", "--no-plot"];
+    let mut first = Command::new(BIN)
+        .args(["train", "--quiet", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !run.join("metrics.csv").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let metrics_before = std::fs::read(run.join("metrics.csv")).unwrap();
+    for extra in [&[][..], &["--force"][..]] {
+        let second = train(&config, &out, &[&args[..], extra].concat());
+        let err = String::from_utf8_lossy(&second.stderr);
+        assert!(!second.status.success(), "{extra:?}: {err}");
+        assert!(
+            err.contains("another macdec process is training this run"),
+            "{extra:?}: {err}"
+        );
+    }
+    // The second process touched nothing: the first one's files are still there.
+    assert!(run.join("config.toml").exists());
+    assert!(std::fs::read(run.join("metrics.csv")).unwrap().len() >= metrics_before.len());
+    first.kill().unwrap();
+    first.wait().unwrap();
+    // A killed process holds no lock: the run can be taken over (here replaced with --force).
+    std::fs::write(&config, TINY).unwrap();
+    let after = train(&config, &out, &[&args[..], &["--force"]].concat());
+    assert!(
+        after.status.success(),
+        "{}",
+        String::from_utf8_lossy(&after.stderr)
+    );
+    assert!(run.join("finished").exists());
+}
+
+#[test]
+fn a_symlinked_run_directory_is_refused_and_its_target_is_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let out = dir.path().join("out");
+    let outside = dir.path().join("outside");
+    std::fs::create_dir_all(&outside).unwrap();
+    std::fs::write(outside.join("precious"), "keep").unwrap();
+    std::fs::create_dir_all(out.join("tiny/our1")).unwrap();
+    std::os::unix::fs::symlink(&outside, out.join("tiny/our1/seed-0")).unwrap();
+    for extra in [&[][..], &["--force"][..]] {
+        let o = train(
+            &config,
+            &out,
+            &[
+                &["--methods", "our1", "--seeds", "0", "--no-plot"][..],
+                extra,
+            ]
+            .concat(),
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{extra:?}: {err}");
+        assert!(
+            err.contains("is not a directory (a symlink or a file)"),
+            "{err}"
+        );
+    }
+    let left: Vec<_> = std::fs::read_dir(&outside)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["precious"]);
+}
+
+#[test]
 fn finished_runs_are_not_recomputed() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("tiny.toml");

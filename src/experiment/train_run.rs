@@ -4,7 +4,8 @@
 //! method and seed), `metrics.csv` (see [`crate::experiment::metrics`]), `checkpoint.bin` (the
 //! whole trainer: nets, Adam moments, replay, RNG states, counters; for resuming only),
 //! `policy/` (the nets as safetensors plus `policy.json`, written with every checkpoint; see
-//! [`crate::experiment::policy_files`]) and `finished` once done.
+//! [`crate::experiment::policy_files`]), `finished` once done, and `.lock`, which the training
+//! process holds locked.
 //! Every file is written atomically; a killed run resumes from its last checkpoint and ends with
 //! the metrics an uninterrupted run would have written.
 
@@ -145,18 +146,58 @@ pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
     })
 }
 
-/// Delete a run directory for `--force`: only a real directory (a symlink is refused, so the
-/// deletion cannot reach outside the results root through it).
-fn remove_run_dir(dir: &Path) -> Result<(), RunError> {
+/// The file a training process holds an exclusive lock on while it trains a run.
+pub const LOCK: &str = ".lock";
+
+/// Take the run's lock, creating its directory: two processes training one run (a campaign
+/// started twice, a Slurm task beside a local run) would interleave their checkpoints and
+/// metrics. The lock is the operating system's, so a killed process never leaves it held; the
+/// file itself stays (it is empty). Only a real directory is accepted: through a symlink the run
+/// would write outside the results root.
+fn lock_run_dir(dir: &Path) -> Result<std::fs::File, RunError> {
     match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(io(dir, e)),
-        Ok(m) if m.is_dir() => std::fs::remove_dir_all(dir).map_err(|e| io(dir, e)),
-        Ok(_) => Err(io(
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(io(dir, e)),
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => return Err(io(
             dir,
-            "is not a directory (a symlink or a file); --force only replaces real run directories",
+            "is not a directory (a symlink or a file); a run directory must be a real directory",
         )),
     }
+    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    let path = dir.join(LOCK);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| io(&path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(RunError::Busy {
+            dir: dir.to_path_buf(),
+        }),
+        Err(std::fs::TryLockError::Error(e)) => Err(io(&path, e)),
+    }
+}
+
+/// Empty a locked run directory for `--force`, keeping only the lock file (the run is ours).
+/// Entries are removed without following symlinks, so nothing outside the directory is touched.
+fn clear_run_dir(dir: &Path) -> Result<(), RunError> {
+    for entry in std::fs::read_dir(dir).map_err(|e| io(dir, e))? {
+        let path = entry.map_err(|e| io(dir, e))?.path();
+        if path.file_name() == Some(std::ffi::OsStr::new(LOCK)) {
+            continue;
+        }
+        let meta = std::fs::symlink_metadata(&path).map_err(|e| io(&path, e))?;
+        if meta.is_dir() {
+            std::fs::remove_dir_all(&path)
+        } else {
+            std::fs::remove_file(&path)
+        }
+        .map_err(|e| io(&path, e))?;
+    }
+    Ok(())
 }
 
 /// Why a run could not proceed.
@@ -168,6 +209,8 @@ pub enum RunError {
     UnreadableRun { path: PathBuf, message: String },
     #[error("{path}: {message}")]
     Io { path: PathBuf, message: String },
+    #[error("{dir}: another macdec process is training this run (it holds {dir}/.lock); wait for it or stop it")]
+    Busy { dir: PathBuf },
     #[error("{path}: refused checkpoint: {message} (or rerun with --force)")]
     BadCheckpoint { path: PathBuf, message: String },
     #[error(transparent)]
@@ -287,14 +330,15 @@ pub fn train_run(
     progress: &Progress,
     force: bool,
 ) -> Result<(), RunError> {
+    // Held until this function returns, whatever the outcome.
+    let _lock = lock_run_dir(dir)?;
     if force {
-        remove_run_dir(dir)?;
+        clear_run_dir(dir)?;
     }
     let existing = existing_run(spec, dir)?;
     if existing == Existing::Finished {
         return Ok(());
     }
-    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
     // Temp files of writers killed mid-write (this run's earlier processes) would pile up.
     remove_stale_temp_files(dir).map_err(|e| io(dir, e))?;
     let config_path = dir.join(CONFIG);
