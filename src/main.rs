@@ -498,11 +498,19 @@ fn train(args: TrainArgs) -> Result<()> {
     if skipped > 0 {
         eprintln!("{skipped} run(s) already finished, skipped (use --force to recompute)");
     }
-    // A refused run's directory holds another run's curve: do not show it as this one's.
+    let busy = statuses
+        .iter()
+        .filter(|s| matches!(s, RunStatus::Busy))
+        .count();
+    if busy > 0 {
+        eprintln!("{busy} run(s) left to other processes training them");
+    }
+    // A refused run's directory holds another run's curve, a busy one a curve still growing:
+    // show neither as this command's.
     let shown: Vec<_> = runs
         .iter()
         .zip(&statuses)
-        .filter(|(_, s)| !matches!(s, RunStatus::Failed(_)))
+        .filter(|(_, s)| !matches!(s, RunStatus::Failed(_) | RunStatus::Busy))
         .map(|(r, _)| r.clone())
         .collect();
     macdec::experiment::report::print_curves(&args.out, &shown)?;

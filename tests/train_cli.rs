@@ -121,7 +121,7 @@ fn a_killed_run_resumes_to_the_uninterrupted_metrics() {
 }
 
 #[test]
-fn a_run_being_trained_by_another_process_is_refused_even_with_force() {
+fn a_run_being_trained_by_another_process_is_left_to_it_and_force_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("tiny.toml");
     std::fs::write(
@@ -147,15 +147,22 @@ fn a_run_being_trained_by_another_process_is_refused_even_with_force() {
         std::thread::sleep(Duration::from_millis(5));
     }
     let metrics_before = std::fs::read(run.join("metrics.csv")).unwrap();
-    for extra in [&[][..], &["--force"][..]] {
-        let second = train(&config, &out, &[&args[..], extra].concat());
-        let err = String::from_utf8_lossy(&second.stderr);
-        assert!(!second.status.success(), "{extra:?}: {err}");
-        assert!(
-            err.contains("another macdec process is training this run"),
-            "{extra:?}: {err}"
-        );
-    }
+    // A second process on the same tree leaves the run to the first and says so.
+    let second = train(&config, &out, &args);
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(second.status.success(), "{err}");
+    assert!(
+        err.contains("left tiny/our1/seed-0 to the other process training it"),
+        "{err}"
+    );
+    assert!(err.contains("1 run(s) left to other processes"), "{err}");
+    let forced = train(&config, &out, &[&args[..], &["--force"]].concat());
+    let err = String::from_utf8_lossy(&forced.stderr);
+    assert!(!forced.status.success(), "{err}");
+    assert!(
+        err.contains("another macdec process is training this run"),
+        "{err}"
+    );
     // The second process touched nothing: the first one's files are still there.
     assert!(run.join("config.toml").exists());
     assert!(std::fs::read(run.join("metrics.csv")).unwrap().len() >= metrics_before.len());

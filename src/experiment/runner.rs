@@ -30,11 +30,27 @@ pub struct RunnerOptions {
     pub quiet: bool,
 }
 
+/// How a run that did not fail ended, as the function training it reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunEnd {
+    /// Trained to its end (or the rest of the way from its checkpoint).
+    Trained,
+    /// Already finished when its turn came (another process finished it meanwhile).
+    AlreadyFinished,
+    /// Another process holds the run's lock and is training it: left to that process, so
+    /// several processes (or machines sharing the results tree) can work through one campaign.
+    Busy,
+}
+
 /// What became of one run.
 #[derive(Debug)]
 pub enum RunStatus {
-    Finished { seconds: f64 },
+    Finished {
+        seconds: f64,
+    },
     Skipped,
+    /// Being trained by another process.
+    Busy,
     Failed(String),
 }
 
@@ -80,7 +96,7 @@ fn run_name(spec: &RunSpec) -> String {
 /// first) as soon as it is free. Returns each run's status in input order.
 pub fn run_all<F>(runs: &[RunSpec], opts: &RunnerOptions, run_one: F) -> Vec<RunStatus>
 where
-    F: Fn(&RunSpec, &Path, &Progress) -> Result<(), String> + Sync,
+    F: Fn(&RunSpec, &Path, &Progress) -> Result<RunEnd, String> + Sync,
 {
     let multi = MultiProgress::with_draw_target(if opts.quiet {
         ProgressDrawTarget::hidden()
@@ -168,11 +184,20 @@ where
         multi.remove(&bar);
         let seconds = start.elapsed().as_secs_f64();
         match result {
-            Ok(()) => {
+            Ok(RunEnd::Trained) => {
                 if opts.quiet {
                     eprintln!("finished {name} in {seconds:.1} s");
                 }
                 RunStatus::Finished { seconds }
+            }
+            Ok(RunEnd::AlreadyFinished) => RunStatus::Skipped,
+            Ok(RunEnd::Busy) => {
+                let line = format!("left {name} to the other process training it");
+                let _ = multi.println(&line);
+                if opts.quiet {
+                    eprintln!("{line}");
+                }
+                RunStatus::Busy
             }
             Err(e) => {
                 let _ = multi.println(format!("FAILED {name}: {e}"));
@@ -228,7 +253,7 @@ mod tests {
                 panic!("kaboom");
             }
             finish(spec, dir);
-            Ok(())
+            Ok(RunEnd::Trained)
         };
         let first = run_all(&runs, &opts, work);
         assert!(matches!(first[1], RunStatus::Failed(ref e) if e == "boom"));
@@ -271,7 +296,7 @@ mod tests {
                 .unwrap()
                 .push(format!("{}/{}", spec.curve_name(), spec.seed));
             finish(spec, dir);
-            Ok(())
+            Ok(RunEnd::Trained)
         });
         assert_eq!(
             *started.lock().unwrap(),
@@ -303,7 +328,7 @@ mod tests {
         let work = |spec: &RunSpec, dir: &Path, _: &Progress| {
             ran.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             finish(spec, dir);
-            Ok(())
+            Ok(RunEnd::Trained)
         };
         run_all(&runs, &opts, work);
         let config = runs[0].dir(dir.path()).join(CONFIG);

@@ -21,7 +21,7 @@ use crate::experiment::policy_files::{
     write_policy_files, NetRole, PolicyFilesError, RunPolicyInfo,
 };
 use crate::experiment::provenance::Provenance;
-use crate::experiment::runner::{Progress, FINISHED_MARKER};
+use crate::experiment::runner::{Progress, RunEnd, FINISHED_MARKER};
 use crate::experiment::seeds::{stream, Role};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -323,21 +323,26 @@ fn save_metrics(dir: &Path, trainer: &Trainer) -> Result<(), RunError> {
 }
 
 /// Train one run to completion in `dir`, resuming from its checkpoint if there is one.
-/// With `force`, an existing run in `dir` is discarded first.
+/// With `force`, an existing run in `dir` is discarded first. A run another process is training
+/// is left to it (`RunEnd::Busy`), except with `force`, where it is an error: what was asked
+/// for, replacing the run, cannot be done.
 pub fn train_run(
     spec: &RunSpec,
     dir: &Path,
     progress: &Progress,
     force: bool,
-) -> Result<(), RunError> {
+) -> Result<RunEnd, RunError> {
     // Held until this function returns, whatever the outcome.
-    let _lock = lock_run_dir(dir)?;
+    let _lock = match lock_run_dir(dir) {
+        Err(RunError::Busy { .. }) if !force => return Ok(RunEnd::Busy),
+        lock => lock?,
+    };
     if force {
         clear_run_dir(dir)?;
     }
     let existing = existing_run(spec, dir)?;
     if existing == Existing::Finished {
-        return Ok(());
+        return Ok(RunEnd::AlreadyFinished);
     }
     // Temp files of writers killed mid-write (this run's earlier processes) would pile up.
     remove_stale_temp_files(dir).map_err(|e| io(dir, e))?;
@@ -379,5 +384,5 @@ pub fn train_run(
     save_policy_files(dir, spec, &trainer)?;
     let marker = dir.join(FINISHED_MARKER);
     write_atomic(&marker, b"").map_err(|e| io(&marker, e))?;
-    Ok(())
+    Ok(RunEnd::Trained)
 }
