@@ -5,7 +5,8 @@
 #
 #   scripts/campaign.sh run       # train, in the order Fig 4a; Fig 5/6 seeds 0..10; Fig 4b; then
 #                                 # Fig 5/6 seeds 10..40 in blocks of 5
-#   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it for a commit
+#   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
+#                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
 #
 # MACDEC names the binary (default target/release/macdec; copy it elsewhere before a long run so
@@ -59,6 +60,8 @@ collect)
         fi
         git add -f "$dir/config.toml" "$dir/metrics.csv.gz" "$dir/finished"
     done
+    # A figure that draws another experiment's runs (Figure 6's Our-2) says so here.
+    find "$OUT" -maxdepth 2 -name shared_curves.toml -type f -exec git add -f {} +
     ;;
 status)
     for curve in "$OUT"/*/*/; do
