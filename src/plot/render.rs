@@ -130,12 +130,45 @@ fn dash_dot_segments(x0: f64, x1: f64, units_per_px: f64) -> Vec<(f64, f64)> {
     segs
 }
 
+/// Greedily break `text` at spaces into lines no wider than `max_px` as `width` measures them
+/// (a single word wider than that gets a line of its own).
+fn wrap_words(text: &str, max_px: u32, width: impl Fn(&str) -> u32) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let candidate = if line.is_empty() {
+            word.to_string()
+        } else {
+            format!("{line} {word}")
+        };
+        if line.is_empty() || width(&candidate) <= max_px {
+            line = candidate;
+        } else {
+            lines.push(std::mem::replace(&mut line, word.to_string()));
+        }
+    }
+    if !line.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
     let (w, h) = root.dim_in_pixel();
+    let caption_style = TextStyle::from((FAMILY, CAPTION_PX).into_font())
+        .color(&RGBColor(80, 80, 80))
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    // A caption with provenance notes runs wider than the figure: break it into lines.
+    let caption_lines = wrap_words(&fig.caption, w.saturating_sub(40), |line| {
+        root.estimate_text_size(line, &caption_style)
+            .map_or(u32::MAX, |(width, _)| width)
+    });
+    let line_px = CAPTION_PX + 6;
+    let bottom_px = 20 + line_px * caption_lines.len().max(1) as u32;
     let (top, rest) = root.split_vertically(76);
-    let (main, bottom) = rest.split_vertically(h - 76 - 40);
+    let (main, bottom) = rest.split_vertically(h.saturating_sub(76 + bottom_px));
 
     let title_style =
         TextStyle::from((FAMILY, TITLE_PX).into_font()).pos(Pos::new(HPos::Center, VPos::Center));
@@ -148,12 +181,12 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
         top.draw_text(partial, &style, (w as i32 / 2, 62))
             .map_err(e)?;
     }
-    let caption_style = TextStyle::from((FAMILY, CAPTION_PX).into_font())
-        .color(&RGBColor(80, 80, 80))
-        .pos(Pos::new(HPos::Center, VPos::Center));
-    bottom
-        .draw_text(&fig.caption, &caption_style, (w as i32 / 2, 20))
-        .map_err(e)?;
+    for (i, line) in caption_lines.iter().enumerate() {
+        let y = 20 + (line_px as usize * i) as i32;
+        bottom
+            .draw_text(line, &caption_style, (w as i32 / 2, y))
+            .map_err(e)?;
+    }
 
     let (xr, yr) = ranges(fig);
     let (x_lo, x_hi) = (xr.start, xr.end);
@@ -264,6 +297,18 @@ fn trim_number(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn captions_wrap_at_spaces_within_the_width() {
+        let chars = |l: &str| l.len() as u32;
+        assert_eq!(wrap_words("aa bb cc dd", 5, chars), ["aa bb", "cc dd"]);
+        assert_eq!(
+            wrap_words("a verylongword b", 4, chars),
+            ["a", "verylongword", "b"]
+        );
+        assert_eq!(wrap_words("  one  ", 80, chars), ["one"]);
+        assert!(wrap_words("", 80, chars).is_empty());
+    }
     use crate::plot::stats::CurvePoint;
 
     #[test]
