@@ -41,6 +41,20 @@ fn train(config: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
         .expect("macdec runs")
 }
 
+/// `macdec train --quiet` in the background, output discarded (to be killed mid-run).
+fn spawn_train(config: &Path, out: &Path, extra: &[&str]) -> std::process::Child {
+    Command::new(BIN)
+        .args(["train", "--quiet", "--config"])
+        .arg(config)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("macdec starts")
+}
+
 /// The metrics file without its wall-clock column (the one column that is not reproducible).
 fn metrics_without_time(path: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -84,17 +98,7 @@ fn a_killed_run_resumes_to_the_uninterrupted_metrics() {
 
     let killed = dir.path().join("killed");
     let checkpoint = killed.join("tiny/our1/seed-0/checkpoint.bin");
-    let mut child = Command::new(BIN)
-        .args(["train", "--quiet", "--config"])
-        .arg(&config)
-        .arg("--out")
-        .arg(&killed)
-        .arg("--no-plot")
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_train(&config, &killed, &[&args[..], &["--no-plot"]].concat());
     // Kill it once at least one checkpoint exists, mid-run.
     let start = Instant::now();
     while !checkpoint.exists() && start.elapsed() < Duration::from_secs(60) {
@@ -132,16 +136,7 @@ fn a_run_being_trained_by_another_process_is_left_to_it_and_force_is_refused() {
     let out = dir.path().join("out");
     let run = out.join("tiny/our1/seed-0");
     let args = ["--methods", "our1", "--seeds", "0", "--no-plot"];
-    let mut first = Command::new(BIN)
-        .args(["train", "--quiet", "--config"])
-        .arg(&config)
-        .arg("--out")
-        .arg(&out)
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut first = spawn_train(&config, &out, &args);
     let start = Instant::now();
     while !run.join("metrics.csv").exists() && start.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(5));

@@ -7,7 +7,6 @@
 //! run, naming the keys that differ.
 
 use crate::experiment::config::RunSpec;
-use crate::experiment::limits::worker_threads;
 use crate::experiment::train_run::{existing_run, Existing};
 use crate::experiment::work_queue::run_in_order;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -131,6 +130,13 @@ where
         )
         .expect("valid template"),
     );
+    // A line about one run: above the progress bars, or on stderr when they are hidden.
+    let say = |line: String| {
+        let _ = multi.println(&line);
+        if opts.quiet {
+            eprintln!("{line}");
+        }
+    };
     // Failures of identity are reported at once; the runs to train go through one queue in seed
     // order, so an interrupted batch leaves every curve with about the same seeds finished.
     let mut statuses: Vec<Option<RunStatus>> = runs
@@ -140,19 +146,14 @@ where
             Ok(true) => None,
             Ok(false) => Some(RunStatus::Skipped),
             Err(e) => {
-                let name = run_name(spec);
-                let _ = multi.println(format!("FAILED {name}: {e}"));
-                if opts.quiet {
-                    eprintln!("FAILED {name}: {e}");
-                }
+                say(format!("FAILED {}: {e}", run_name(spec)));
                 Some(RunStatus::Failed(e.clone()))
             }
         })
         .collect();
     let mut order: Vec<usize> = (0..runs.len()).filter(|&i| statuses[i].is_none()).collect();
     order.sort_by_key(|&i| runs[i].seed);
-    let workers = worker_threads(opts.jobs, order.len());
-    let trained = run_in_order(&order, workers, |i| {
+    let trained = run_in_order(&order, opts.jobs, |i| {
         let spec = &runs[i];
         let name = run_name(spec);
         let dir = spec.dir(&opts.out);
@@ -192,18 +193,11 @@ where
             }
             Ok(RunEnd::AlreadyFinished) => RunStatus::Skipped,
             Ok(RunEnd::Busy) => {
-                let line = format!("left {name} to the other process training it");
-                let _ = multi.println(&line);
-                if opts.quiet {
-                    eprintln!("{line}");
-                }
+                say(format!("left {name} to the other process training it"));
                 RunStatus::Busy
             }
             Err(e) => {
-                let _ = multi.println(format!("FAILED {name}: {e}"));
-                if opts.quiet {
-                    eprintln!("FAILED {name}: {e}");
-                }
+                say(format!("FAILED {name}: {e}"));
                 RunStatus::Failed(e)
             }
         }
