@@ -4,8 +4,8 @@
 
 use super::discover::{CurveData, ExperimentData};
 use super::stats::{
-    aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training, smooth,
-    CurvePoint, SMOOTH_HALF_WINDOW,
+    aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training,
+    run_mean_over_training, smooth, CurvePoint, SMOOTH_HALF_WINDOW,
 };
 use super::summary::CurveSummary;
 use crate::algos::method::Method;
@@ -195,6 +195,9 @@ fn summarize(
     };
     let final_returns: Vec<f64> = complete().filter_map(|r| final_return(&r.points)).collect();
     let best: Vec<f64> = complete().filter_map(|r| best_return(&r.points)).collect();
+    let training_means: Vec<f64> = complete()
+        .filter_map(|r| run_mean_over_training(&r.points))
+        .collect();
     let (final_mean, final_se) = mean_and_se(&final_returns).unwrap_or((f64::NAN, f64::NAN));
     let finished: Vec<f64> = curve
         .runs
@@ -218,6 +221,7 @@ fn summarize(
         run_minutes: (!finished.is_empty())
             .then(|| finished.iter().sum::<f64>() / finished.len() as f64 / 60.0),
         final_returns,
+        training_means,
     }
 }
 

@@ -44,9 +44,16 @@ pub struct CurveSummary {
     /// The `final_n` runs' final returns, for the tests between curves.
     #[serde(skip)]
     pub final_returns: Vec<f64>,
+    /// The same runs' own means over training
+    /// ([`crate::curve_stats::run_mean_over_training`]), for the tests of which curve learns
+    /// earlier.
+    #[serde(skip)]
+    pub training_means: Vec<f64>,
 }
 
-/// One-sided Welch t-test between two curves' final returns: H1 is "A above B".
+/// One-sided Welch t-tests between two curves, H1 "A above B": on the runs' final returns (the
+/// first three numbers) and on their means over training (the `_over_training` ones: which
+/// curve learns earlier, per seed rather than from the mean curve).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PairTest {
     pub curve_a: String,
@@ -54,9 +61,12 @@ pub struct PairTest {
     pub t: f64,
     pub df: f64,
     pub p_a_greater: f64,
+    pub t_over_training: f64,
+    pub df_over_training: f64,
+    pub p_a_greater_over_training: f64,
 }
 
-/// Every ordered pair of curves that can be tested (two or more final returns each).
+/// Every ordered pair of curves that can be tested (two or more runs each).
 pub fn pairwise_tests(rows: &[CurveSummary]) -> Vec<PairTest> {
     let mut tests = Vec::new();
     for a in rows {
@@ -64,13 +74,18 @@ pub fn pairwise_tests(rows: &[CurveSummary]) -> Vec<PairTest> {
             if a.curve == b.curve {
                 continue;
             }
-            if let Some(w) = welch_greater(&a.final_returns, &b.final_returns) {
+            let finals = welch_greater(&a.final_returns, &b.final_returns);
+            let training = welch_greater(&a.training_means, &b.training_means);
+            if let (Some(w), Some(v)) = (finals, training) {
                 tests.push(PairTest {
                     curve_a: a.curve.clone(),
                     curve_b: b.curve.clone(),
                     t: w.t,
                     df: w.df,
                     p_a_greater: w.p_greater,
+                    t_over_training: v.t,
+                    df_over_training: v.df,
+                    p_a_greater_over_training: v.p_greater,
                 });
             }
         }
@@ -127,24 +142,48 @@ pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) ->
         ));
     }
     if !tests.is_empty() {
-        s.push_str("\nOne-sided Welch t-tests on final returns: p-value of \"row above column\".\n\n| p(row > column) |");
-        for r in rows {
-            s.push_str(&format!(" {} |", r.legend));
-        }
-        s.push_str(&format!("\n|---|{}\n", "---|".repeat(rows.len())));
-        for a in rows {
-            s.push_str(&format!("| {} |", a.legend));
-            for b in rows {
-                let cell = tests
-                    .iter()
-                    .find(|t| t.curve_a == a.curve && t.curve_b == b.curve)
-                    .map_or("-".to_string(), |t| format_p(t.p_a_greater));
-                s.push_str(&format!(" {cell} |"));
-            }
-            s.push('\n');
-        }
+        p_matrix(
+            &mut s,
+            "One-sided Welch t-tests on final returns: p-value of \"row above column\".",
+            rows,
+            tests,
+            |t| t.p_a_greater,
+        );
+        p_matrix(
+            &mut s,
+            "The same on each run's mean over training (how early a method learns, per seed).",
+            rows,
+            tests,
+            |t| t.p_a_greater_over_training,
+        );
     }
     s
+}
+
+/// Append one matrix of p-values (row above column) under its heading line.
+fn p_matrix(
+    s: &mut String,
+    heading: &str,
+    rows: &[CurveSummary],
+    tests: &[PairTest],
+    p: impl Fn(&PairTest) -> f64,
+) {
+    s.push_str(&format!("\n{heading}\n\n| p(row > column) |"));
+    for r in rows {
+        s.push_str(&format!(" {} |", r.legend));
+    }
+    s.push_str(&format!("\n|---|{}\n", "---|".repeat(rows.len())));
+    for a in rows {
+        s.push_str(&format!("| {} |", a.legend));
+        for b in rows {
+            let cell = tests
+                .iter()
+                .find(|t| t.curve_a == a.curve && t.curve_b == b.curve)
+                .map_or("-".to_string(), |t| format_p(p(t)));
+            s.push_str(&format!(" {cell} |"));
+        }
+        s.push('\n');
+    }
 }
 
 /// A p-value for display: three significant digits, tiny ones in scientific notation.
@@ -169,7 +208,7 @@ pub fn format_return(v: f64) -> String {
 mod tests {
     use super::*;
 
-    fn row(curve: &str, legend: &str, finals: &[f64]) -> CurveSummary {
+    fn row(curve: &str, legend: &str, finals: &[f64], training: &[f64]) -> CurveSummary {
         let (mean, se) = crate::plot::stats::mean_and_se(finals).unwrap();
         CurveSummary {
             curve: curve.into(),
@@ -186,14 +225,15 @@ mod tests {
             optimal: Some(80.71093744250365),
             run_minutes: Some(12.34),
             final_returns: finals.to_vec(),
+            training_means: training.to_vec(),
         }
     }
 
     #[test]
     fn markdown_shows_final_return_reach_area_and_p_values() {
         let rows = [
-            row("our1", "Our-1", &[80.0, 79.0]),
-            row("dec-hddrqn", "Dec-HDDRQN", &[10.0, 30.0]),
+            row("our1", "Our-1", &[80.0, 79.0], &[20.0, 30.0]),
+            row("dec-hddrqn", "Dec-HDDRQN", &[10.0, 30.0], &[60.0, 70.0]),
         ];
         let tests = pairwise_tests(&rows);
         assert_eq!(tests.len(), 2);
@@ -214,13 +254,44 @@ mod tests {
             .unwrap();
         let q: f64 = dec_row.split('|').nth(2).unwrap().trim().parse().unwrap();
         assert!((p + q - 1.0).abs() < 2e-3, "{md}");
+        // The second matrix tests means over training, where Our-1 (25) is below Dec-HDDRQN (65).
+        let over_training = md
+            .split("mean over training (")
+            .nth(1)
+            .expect("second matrix");
+        let our1_row = over_training
+            .lines()
+            .find(|l| l.starts_with("| Our-1 | - |"))
+            .unwrap();
+        let p: f64 = our1_row.split('|').nth(3).unwrap().trim().parse().unwrap();
+        assert!(p > 0.9, "{md}");
+    }
+
+    #[test]
+    fn welch_csv_has_both_tests_per_ordered_pair() {
+        let rows = [
+            row("our1", "Our-1", &[80.0, 79.0], &[20.0, 30.0]),
+            row("cen-ddrqn", "Cen-DDRQN", &[10.0, 30.0], &[60.0, 70.0]),
+        ];
+        let tests = pairwise_tests(&rows);
+        let t = tempfile::tempdir().unwrap();
+        let p = t.path().join("w.csv");
+        write_csv(&p, &tests).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(
+            lines.next(),
+            Some("curve_a,curve_b,t,df,p_a_greater,t_over_training,df_over_training,p_a_greater_over_training")
+        );
+        assert_eq!(lines.count(), 2);
+        assert!(tests[0].p_a_greater < 0.1 && tests[0].p_a_greater_over_training > 0.9);
     }
 
     #[test]
     fn csv_has_a_header_and_empty_fields_for_unknowns() {
         let t = tempfile::tempdir().unwrap();
         let p = t.path().join("s.csv");
-        let mut r = row("our1", "Our-1", &[1.0]);
+        let mut r = row("our1", "Our-1", &[1.0], &[1.0]);
         r.optimal = None;
         r.run_minutes = None;
         r.reach95_episode = None;
