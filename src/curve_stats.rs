@@ -122,29 +122,22 @@ pub fn first_reaching(points: &[CurvePoint], threshold: f64) -> Option<u64> {
 /// The area under a mean curve divided by its episode span (trapezoids): the curve's average
 /// height over training, so curves of one length compare directly. A single point is its value.
 pub fn mean_over_training(points: &[CurvePoint]) -> Option<f64> {
-    average_height(points.iter().map(|p| (p.episode, p.mean)))
+    let heights: Vec<(u64, f64)> = points.iter().map(|p| (p.episode, p.mean)).collect();
+    run_mean_over_training(&heights)
 }
 
-/// One run's own average height over training (the area under its curve over its span): the
-/// per-seed measure of how early a method learns, which the tests between curves compare the way
-/// they compare final returns.
+/// One run's own average height over training (the area under its curve over its span, by the
+/// same trapezoids): the per-seed measure of how early a method learns, which the tests between
+/// curves compare the way they compare final returns.
 pub fn run_mean_over_training(points: &[(u64, f64)]) -> Option<f64> {
-    average_height(points.iter().copied())
-}
-
-/// Trapezoid area under `(episode, value)` points (sorted by episode) over their episode span.
-fn average_height(points: impl Iterator<Item = (u64, f64)> + Clone) -> Option<f64> {
-    let mut it = points.clone();
-    let (first_episode, first_value) = it.next()?;
-    let last_episode = it.last().map_or(first_episode, |p| p.0);
-    let span = (last_episode - first_episode) as f64;
+    let (first, last) = (points.first()?, points.last()?);
+    let span = (last.0 - first.0) as f64;
     if span == 0.0 {
-        return Some(first_value);
+        return Some(first.1);
     }
     let area: f64 = points
-        .clone()
-        .zip(points.skip(1))
-        .map(|(a, b)| (b.0 - a.0) as f64 * (a.1 + b.1) / 2.0)
+        .windows(2)
+        .map(|w| (w[1].0 - w[0].0) as f64 * (w[0].1 + w[1].1) / 2.0)
         .sum();
     Some(area / span)
 }

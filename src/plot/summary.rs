@@ -229,12 +229,17 @@ mod tests {
         }
     }
 
-    #[test]
-    fn markdown_shows_final_return_reach_area_and_p_values() {
-        let rows = [
+    /// Our-1 ends above Dec-HDDRQN but learns later (means over training 25 against 65).
+    fn ends_higher_learns_later() -> [CurveSummary; 2] {
+        [
             row("our1", "Our-1", &[80.0, 79.0], &[20.0, 30.0]),
             row("dec-hddrqn", "Dec-HDDRQN", &[10.0, 30.0], &[60.0, 70.0]),
-        ];
+        ]
+    }
+
+    #[test]
+    fn markdown_shows_final_return_reach_area_and_p_values() {
+        let rows = ends_higher_learns_later();
         let tests = pairwise_tests(&rows);
         assert_eq!(tests.len(), 2);
         let md = markdown_table("fig4a", &rows, &tests);
@@ -269,11 +274,7 @@ mod tests {
 
     #[test]
     fn welch_csv_has_both_tests_per_ordered_pair() {
-        let rows = [
-            row("our1", "Our-1", &[80.0, 79.0], &[20.0, 30.0]),
-            row("cen-ddrqn", "Cen-DDRQN", &[10.0, 30.0], &[60.0, 70.0]),
-        ];
-        let tests = pairwise_tests(&rows);
+        let tests = pairwise_tests(&ends_higher_learns_later());
         let t = tempfile::tempdir().unwrap();
         let p = t.path().join("w.csv");
         write_csv(&p, &tests).unwrap();
