@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use macdec::algos::method::Method;
 use macdec::bench::nets;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
+use macdec::experiment::policy_files::NetRole;
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
 use macdec::experiment::slurm::{job_script, SlurmOptions};
@@ -69,6 +70,10 @@ enum Command {
         /// Milliseconds per primitive step.
         #[arg(long, default_value_t = 150)]
         frame_ms: u32,
+        /// Which nets act: `cen` (the centralized Q-net, which Our-1, Our-1-R and Our-2 also
+        /// train) or `dec` (one Q-net per agent). Default: the nets the run's evaluations used.
+        #[arg(long, value_parser = parse_net_role)]
+        net: Option<NetRole>,
     },
     /// Write a Slurm job-array script (one task per run) to stdout.
     Slurm(SlurmArgs),
@@ -364,6 +369,15 @@ fn at_least_one(text: &str) -> Result<usize, String> {
     }
 }
 
+/// `--net`: `cen` or `dec`, the names policy.json uses for the two kinds of net.
+fn parse_net_role(text: &str) -> Result<NetRole, String> {
+    match text {
+        "cen" => Ok(NetRole::Cen),
+        "dec" => Ok(NetRole::Dec),
+        other => Err(format!("expected `cen` or `dec`, got `{other}`")),
+    }
+}
+
 fn main() -> std::process::ExitCode {
     match run() {
         Ok(()) => std::process::ExitCode::SUCCESS,
@@ -407,10 +421,12 @@ fn run() -> Result<()> {
             episodes,
             out,
             frame_ms,
+            net,
         } => {
             refuse_policy_dir_as_run(&run)?;
-            let returns = macdec::experiment::rollout::render_run(&run, episodes, &out, frame_ms)
-                .with_context(|| format!("rendering {}", run.display()))?;
+            let returns =
+                macdec::experiment::rollout::render_run(&run, net, episodes, &out, frame_ms)
+                    .with_context(|| format!("rendering {}", run.display()))?;
             eprintln!(
                 "wrote {} ({} episode(s), team returns {returns:?})",
                 out.display(),

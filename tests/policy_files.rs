@@ -56,8 +56,14 @@ fn returns(out: &std::process::Output) -> String {
 }
 
 fn render(run: &Path, out: &Path) -> std::process::Output {
+    render_net(run, out, &[])
+}
+
+/// `render` with extra flags (`--net cen`, ...).
+fn render_net(run: &Path, out: &Path, flags: &[&str]) -> std::process::Output {
     let mut cmd = Command::new(BIN);
     cmd.args(["render", "--run"]).arg(run).arg("--out").arg(out);
+    cmd.args(flags);
     cmd.output().unwrap()
 }
 
@@ -106,7 +112,44 @@ fn policy_files_outlive_the_checkpoint_and_tolerate_added_and_missing_keys() {
     // Export and render need no checkpoint.
     let gif_before = dir.path().join("before.gif");
     let returns_before = returns(&render(&our1, &gif_before));
-    returns(&render(&cen, &dir.path().join("cen.gif")));
+    let cen_returns = returns(&render(&cen, &dir.path().join("cen.gif")));
+
+    // --net picks the nets: Our-1's centralized net acts as Cen-DDRQN's does; `dec` is Our-1's
+    // default; a Cen-DDRQN run has no decentralized nets to pick, and says so.
+    let our1_cen_gif = dir.path().join("our1-cen.gif");
+    let our1_cen = returns(&render_net(&our1, &our1_cen_gif, &["--net", "cen"]));
+    let our1_dec_gif = dir.path().join("our1-dec.gif");
+    assert_eq!(
+        returns(&render_net(&our1, &our1_dec_gif, &["--net", "dec"])),
+        returns_before
+    );
+    assert_eq!(
+        std::fs::read(&our1_dec_gif).unwrap(),
+        std::fs::read(&gif_before).unwrap()
+    );
+    assert_ne!(
+        std::fs::read(&our1_cen_gif).unwrap(),
+        std::fs::read(&gif_before).unwrap(),
+        "the centralized net acts differently ({our1_cen} vs {returns_before})"
+    );
+    assert_eq!(
+        returns(&render_net(
+            &cen,
+            &dir.path().join("c.gif"),
+            &["--net", "cen"]
+        )),
+        cen_returns
+    );
+    let out = render_net(&cen, &dir.path().join("d.gif"), &["--net", "dec"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("has no decentralized Q-net (method cen-ddrqn)"),
+        "{err}"
+    );
+    let out = render_net(&our1, &dir.path().join("x.gif"), &["--net", "joint"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected `cen` or `dec`"));
     for run in [&our1, &cen] {
         std::fs::remove_file(run.join(CHECKPOINT)).unwrap();
     }

@@ -21,13 +21,20 @@ pub enum RolloutError {
     Env(String, crate::envs::EnvError),
     #[error("{0}: the policy files' nets do not fit the domain: {1}")]
     NetSize(String, String),
+    #[error("{0}: the run has no {1} Q-net (method {2}); leave out --net to show the nets its evaluations used")]
+    NoNet(String, &'static str, String),
 }
 
 /// Render `episodes` greedy episodes of the run in `run_dir` (its policy files, as of its last
 /// checkpoint) into one GIF.
+///
+/// `net` picks which nets act: `None` the ones the run's evaluations used; `Some(Cen)` the
+/// centralized net that Our-1, Our-1-R and Our-2 train beside their decentralized ones, so their
+/// joint policy can be set against what decentralized execution reached.
 /// Returns each episode's undiscounted team return.
 pub fn render_run(
     run_dir: &Path,
+    net: Option<NetRole>,
     episodes: usize,
     out: &Path,
     frame_ms: u32,
@@ -39,9 +46,13 @@ pub fn render_run(
         .build()
         .map_err(|e| RolloutError::Env(run_dir.display().to_string(), e))?;
     let dec: Vec<&QNet> = run.dec.iter().collect();
-    let policy = match (run.run.evaluated, &run.cen) {
+    let missing =
+        |what| RolloutError::NoNet(run_dir.display().to_string(), what, run.run.method.clone());
+    let policy = match (net.unwrap_or(run.run.evaluated), &run.cen) {
         (NetRole::Cen, Some(cen)) => GreedyPolicy::Cen(cen),
-        _ => GreedyPolicy::Dec(&dec),
+        (NetRole::Cen, None) => return Err(missing("centralized")),
+        (NetRole::Dec, _) if dec.is_empty() => return Err(missing("decentralized")),
+        (NetRole::Dec, _) => GreedyPolicy::Dec(&dec),
     };
     check_sizes(&env, policy)
         .map_err(|m| RolloutError::NetSize(run_dir.display().to_string(), m))?;
