@@ -63,7 +63,7 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
 /// x W^T, once per pass instead of once per product).
 ///
 /// Every LSTM forward transposes both its weights, and ndarray's element-by-element strided
-/// copy took 3-8% of a Warehouse run; a contiguous source goes through 16 x 16 register
+/// copy took 3-6% of a Warehouse run; a contiguous source goes through 16 x 16 register
 /// transposes instead (about 4x faster). Values are moved, never computed, so no number
 /// depends on the path.
 pub fn transposed(src: ArrayView2<f32>) -> Array2<f32> {
