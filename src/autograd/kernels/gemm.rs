@@ -45,7 +45,9 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
                 // (it is borrowed mutably while they are borrowed).
                 unsafe { avx512::gemm_views(a, b, c, mode) };
             } else {
-                let bt = standard_layout(b);
+                // b in standard layout, as the transpose of b^T: x · W^T passes W.t(), so
+                // W is contiguous and takes the register-block path of `transposed`.
+                let bt = transposed(b.t());
                 // SAFETY: as above; `bt` is a fresh standard-layout array.
                 unsafe { avx512::gemm_views(a, bt.view(), c, mode) };
             }
@@ -88,17 +90,6 @@ fn transpose_portable(s: &[f32], rows: usize, cols: usize, out: &mut [f32]) {
         for (i, v) in column.iter_mut().enumerate() {
             *v = s[i * cols + j];
         }
-    }
-}
-
-/// b in standard layout for the kernel: a transposed contiguous matrix (x · W^T passes
-/// `W.t()`) through [`transposed`], anything else through ndarray's copy.
-#[cfg(target_arch = "x86_64")]
-fn standard_layout(b: ArrayView2<f32>) -> Array2<f32> {
-    if b.t().is_standard_layout() {
-        transposed(b.t())
-    } else {
-        b.as_standard_layout().into_owned()
     }
 }
 
