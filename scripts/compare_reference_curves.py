@@ -6,7 +6,8 @@ Usage:
         [--bin 250] [--until 3000] [--csv OUT.csv]
 
 --ours: macdec run directories (each with metrics.csv or metrics.csv.gz); --reference:
-directories written by scripts/reference_curve.py (each with curve.csv). A shell glob works, e.g.
+directories written by scripts/reference_curve.py (each with curve.csv), or such curve.csv files
+themselves (e.g. docs/reference_runs/our2_wtd_seed*.csv). A shell glob works, e.g.
 `--ours "$(ls -d reproduction/fig5_wtd/our2/seed-* | paste -sd,)"`.
 
 Each run's evaluations are averaged within episode bins ([0, bin), [bin, 2 bin), ...), then the
@@ -33,7 +34,9 @@ def read_ours(run):
 
 
 def read_reference(run):
-    path = os.path.join(run, "curve.csv")
+    """A reference_curve.py output directory, or one of its curve.csv files kept elsewhere
+    (docs/reference_runs/ keeps them as single files)."""
+    path = run if os.path.isfile(run) else os.path.join(run, "curve.csv")
     if not os.path.exists(path):
         sys.exit(f"{run}: no curve.csv (written by scripts/reference_curve.py)")
     with open(path, newline="") as f:
