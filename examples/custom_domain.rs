@@ -251,7 +251,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(dir) = &out_dir {
             let run = dir.join("custom_domain").join(method.name()).join("seed-0");
             std::fs::create_dir_all(&run)?;
-            metrics::write(&run.join(metrics::METRICS_FILE), evals)?;
+            metrics::write(
+                &run.join(metrics::METRICS_FILE),
+                trained.metric_columns,
+                evals,
+            )?;
         }
         if method == Method::Our1 {
             // The layout (observation and macro-action names) comes from the env object.

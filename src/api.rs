@@ -3,13 +3,14 @@
 //! the command line, result directories or checkpoints. [`TrainedPolicy::export`] writes the
 //! decentralized nets as a policy directory `macdec robot` serves, whatever the domain.
 //!
-//! The command line's `macdec train` drives the same [`Trainer`] with the same per-seed random
+//! The command line's `macdec train` drives the same training loop ([`AnyLoop`]) with the same per-seed random
 //! streams, so a run through [`train`] on Box Pushing or Warehouse gives exactly the numbers of
 //! `macdec train` with that config, method and seed.
 
+use crate::algos::any_loop::AnyLoop;
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::algos::trainer::{Advance, EvalPoint, TrainError, Trainer};
+use crate::algos::training_loop::{Advance, EvalPoint, TrainError};
 use crate::deploy::export::{export_nets, ExportError};
 use crate::deploy::manifest::{Manifest, RunInfo};
 use crate::deploy::policy_env::PolicyEnv;
@@ -52,7 +53,7 @@ pub fn train<E: MacroEnv>(
     config: &RunConfig,
     method: Method,
     seed: u64,
-    on_episode: impl FnMut(&Trainer<E>),
+    on_episode: impl FnMut(&AnyLoop<E>),
 ) -> Result<Vec<EvalPoint>, LibraryTrainError> {
     train_policy(make_env, config, method, seed, on_episode).map(|p| p.evals)
 }
@@ -68,6 +69,8 @@ pub struct TrainedPolicy {
     pub config: RunConfig,
     /// Every evaluation point, as [`train`] returns them.
     pub evals: Vec<EvalPoint>,
+    /// The names of the evaluation points' family columns ([`EvalPoint::family`]).
+    pub metric_columns: &'static [&'static str],
     /// Agent i's decentralized Q-net is `dec[i]` (empty for Cen-DDRQN, which has none).
     pub dec: Vec<QNet>,
     /// The centralized Q-net, for the methods that train one.
@@ -80,12 +83,12 @@ pub fn train_policy<E: MacroEnv>(
     config: &RunConfig,
     method: Method,
     seed: u64,
-    mut on_episode: impl FnMut(&Trainer<E>),
+    mut on_episode: impl FnMut(&AnyLoop<E>),
 ) -> Result<TrainedPolicy, LibraryTrainError> {
     validate(config, method)
         .and_then(|()| check_sizes(config))
         .map_err(|(key, message)| LibraryTrainError::Config { key, message })?;
-    let mut trainer = Trainer::with_env(config.clone(), method, seed, run_rngs(seed), make_env)?;
+    let mut trainer = AnyLoop::new(config, method, seed, run_rngs(seed), make_env)?;
     while trainer.advance()? != Advance::Finished {
         on_episode(&trainer);
     }
@@ -95,8 +98,9 @@ pub fn train_policy<E: MacroEnv>(
         episodes_trained: trainer.episodes(),
         config: config.clone(),
         evals: trainer.evals().to_vec(),
-        dec: trainer.dec_policies().into_iter().cloned().collect(),
-        cen: trainer.cen_policy().cloned(),
+        metric_columns: trainer.metric_columns(),
+        dec: trainer.saved_nets().dec.into_iter().cloned().collect(),
+        cen: trainer.saved_nets().cen.cloned(),
     })
 }
 
@@ -156,7 +160,9 @@ mod tests {
             let c = short(method);
             let spec = c.env;
             let evals = train(|| spec.build(), &c, method, 5, |_| {}).unwrap();
-            let mut t: Trainer<AnyEnv> = Trainer::new(c, method, 5, run_rngs(5)).unwrap();
+            let env = c.env;
+            let mut t: AnyLoop<AnyEnv> =
+                AnyLoop::new(&c, method, 5, run_rngs(5), || env.build()).unwrap();
             while t.advance().unwrap() != Advance::Finished {}
             assert_eq!(evals.len(), 4);
             for (a, b) in evals.iter().zip(t.evals()) {
@@ -164,7 +170,10 @@ mod tests {
                     (a.episode, a.env_steps, a.updates, a.eval_return.to_bits()),
                     (b.episode, b.env_steps, b.updates, b.eval_return.to_bits())
                 );
-                assert_eq!(a.loss.map(f64::to_bits), b.loss.map(f64::to_bits));
+                let bits = |p: &EvalPoint| -> Vec<Option<u64>> {
+                    p.family.iter().map(|v| v.map(f64::to_bits)).collect()
+                };
+                assert_eq!(bits(a), bits(b));
             }
         }
     }
@@ -181,7 +190,7 @@ mod tests {
             e.iter()
                 .map(|p| EvalPoint {
                     wall_seconds: 0.0,
-                    ..*p
+                    ..p.clone()
                 })
                 .collect()
         };

@@ -20,9 +20,10 @@ pub mod nn;
 pub mod plot;
 pub mod render;
 
+pub use algos::any_loop::AnyLoop;
 pub use algos::hyper::RunConfig;
 pub use algos::method::Method;
-pub use algos::trainer::EvalPoint;
+pub use algos::training_loop::EvalPoint;
 pub use api::{train, train_policy, LibraryTrainError, TrainedPolicy};
 pub use deploy::PolicyEnv;
 pub use envs::{EnvError, EnvRng, EnvSpec, FirstRecordObs, MacroEnv, StepOutcome};

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{robot_process, run};
-use macdec::algos::evaluate::{greedy_episode, GreedyPolicy};
+use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
 use macdec::deploy::link::JsonLink;
 use macdec::deploy::manifest::Manifest;
 use macdec::deploy::protocol::Reply;

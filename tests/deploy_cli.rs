@@ -243,7 +243,7 @@ checkpoint_freq = 40
 
 #[test]
 fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluation() {
-    use macdec::algos::evaluate::{greedy_episode, GreedyPolicy};
+    use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
     use macdec::envs::MacroEnv;
     use macdec::experiment::train_run::{load_checkpoint, CHECKPOINT};
 
@@ -307,7 +307,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
 
     // In-process greedy evaluation of the checkpoint's nets, same seed (the run's), same stream.
     let trainer = load_checkpoint(&run.join(CHECKPOINT)).unwrap();
-    let nets = trainer.dec_policies();
+    let nets = trainer.saved_nets().dec;
     let mut env = manifest.env.build().unwrap();
     let mut rng = stream(3, Role::EvalEnv);
     for trace in &deployed {

@@ -3,7 +3,7 @@
 //! links, of an independently written greedy loop, and of the learner's `greedy_episode`; robots
 //! at addresses (`macdec deploy --robots`) likewise, refused by name when misordered.
 
-use macdec::algos::evaluate::{greedy_episode, GreedyPolicy};
+use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
 use macdec::deploy::architecture::Architecture;
 use macdec::deploy::driver::{run_episodes, EpisodeTrace};
 use macdec::deploy::link::{JsonLink, LocalLink};
@@ -31,7 +31,7 @@ fn rng(seed: u64) -> EnvRng {
 }
 
 /// Greedy decentralized execution written out independently of the driver (as
-/// `algos::evaluate::greedy_episode` with `select_dec`): free agents, in index order, query
+/// `algos::value::evaluate::greedy_episode` with `select_dec`): free agents, in index order, query
 /// their own policy on their own observation and take the first maximal Q.
 fn reference_episode(env_spec: EnvSpec, seed_rng: &mut EnvRng) -> (f64, Vec<Vec<usize>>, Vec<f64>) {
     let manifest = mock_manifest(env_spec);
@@ -212,7 +212,7 @@ fn deploy_speed() {
 }
 
 /// Robot server threads running real (randomly initialized) Q-nets, reached over loopback
-/// TCP, give exactly what `algos::evaluate::greedy_episode` gives in-process.
+/// TCP, give exactly what `algos::value::evaluate::greedy_episode` gives in-process.
 #[test]
 fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
     let env_spec = EnvSpec::Warehouse {

@@ -18,10 +18,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use macdec::algos::method::Method;
-use macdec::algos::record::{Episode, Layout, RecordRef};
-use macdec::algos::replay::{Batch, Sequence};
-use macdec::algos::squeeze::squeeze_agent;
-use macdec::algos::update::{train_iteration_traced, IterationParams, NetTrace, Nets};
+use macdec::algos::value::record::{Episode, Layout, RecordRef};
+use macdec::algos::value::replay::{Batch, Sequence};
+use macdec::algos::value::squeeze::squeeze_agent;
+use macdec::algos::value::update::{train_iteration_traced, IterationParams, NetTrace, Nets};
 use macdec::nn::{Adam, AdamConfig, QNet, QNetParams};
 use safetensors::tensor::Dtype;
 use safetensors::SafeTensors;

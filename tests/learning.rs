@@ -42,7 +42,7 @@ fn bp10_methods_reach_the_optimum_in_four_of_five_seeds() {
             .iter()
             .filter(|r| r.method == method)
             .map(|r| {
-                let rows = read(&r.dir(&opts.out).join(METRICS_FILE)).unwrap();
+                let rows = read(&r.dir(&opts.out).join(METRICS_FILE)).unwrap().rows;
                 rows.last().unwrap().eval_return
             })
             .collect();

@@ -96,8 +96,8 @@ fn policy_files_outlive_the_checkpoint_and_tolerate_added_and_missing_keys() {
     let trainer = load_checkpoint(&our1.join(CHECKPOINT)).unwrap();
     let policy = read_policy_files(&our1).unwrap();
     let dec: Vec<_> = policy.dec.iter().collect();
-    assert_eq!(dec, trainer.dec_policies());
-    assert_eq!(policy.cen.as_ref(), trainer.cen_policy());
+    assert_eq!(dec, trainer.saved_nets().dec);
+    assert_eq!(policy.cen.as_ref(), trainer.saved_nets().cen);
     assert_eq!(
         (
             policy.run.method.as_str(),

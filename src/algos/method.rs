@@ -2,7 +2,7 @@
 //! (spec `algorithms.md` 4.6 and 5): which nets exist, who picks the action inside each target,
 //! how the training env(s) explore, and whether a loss is hysteretic.
 
-use crate::algos::schedule::HysteresisSchedule;
+use crate::algos::value::schedule::HysteresisSchedule;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -22,6 +22,15 @@ pub enum Method {
     Our1R,
     /// Parallel-MacDec-MADDRQN, "Our-2": separate centralized and decentralized envs (spec 5.5).
     Our2,
+}
+
+/// A method family: the learner type the training loop drives for a method (see
+/// [`crate::algos::learner::Learner`]). Runs, checkpoints and policy files pick the learner by
+/// matching on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Family {
+    /// The ICRA 2020 Q-learning methods ([`crate::algos::value::learner::ValueLearner`]).
+    Value,
 }
 
 /// Who chooses a*_i inside agent i's decentralized target.
@@ -53,6 +62,15 @@ impl Method {
         Method::Our1R,
         Method::Our2,
     ];
+
+    /// The family whose learner trains this method.
+    pub fn family(self) -> Family {
+        match self {
+            Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => {
+                Family::Value
+            }
+        }
+    }
 
     /// The command-line and directory name.
     pub fn name(self) -> &'static str {

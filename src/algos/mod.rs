@@ -1,61 +1,18 @@
-//! The five learning methods (spec `algorithms.md`): replay, squeezing, exploration, targets and
-//! the training loop. Methods differ only where the paper says ([`method::Method`]).
+//! Learning: one training loop ([`training_loop::TrainingLoop`]) over a learner interface
+//! ([`learner::Learner`]) that each method family implements in its own folder.
 //!
-//! Flow: [`recorder::Recorder`] turns every primitive step into a [`record::Episode`] row (spec 1.2);
-//! a finished episode goes into a [`replay::ReplayBuffer`] (windows for Box Pushing, whole episodes
-//! for Warehouse, spec 3.1/3.2); a sampled [`replay::Batch`] is squeezed by [`squeeze`] into each
-//! agent's macro-level sequences and the joint one (spec 3.3); [`cond_argmax`] picks joint actions
-//! under the conditioning of busy agents (spec 4.5); [`schedule`] gives epsilon and the hysteresis
-//! value from the episode count (spec 4.1, 5.6).
+//! The loop owns what every family shares: the lanes of environments and their random streams,
+//! the evaluation schedule, the counters (episodes, primitive steps, updates), the metrics rows
+//! and the wall clock; a checkpoint is the whole loop. A family owns what its papers define: its
+//! nets, how they act while training and when evaluated, what it records and replays, and what a
+//! training iteration and a target sync do. [`method::Method`] names the methods and picks each
+//! one's family ([`method::Family`]); within a family, methods differ in exhaustive `match`es.
+//!
+//! Families: [`value`] (the ICRA 2020 Q-learning methods).
 
-pub mod acting;
-pub mod cond_argmax;
-pub mod episode_buffer;
-pub mod evaluate;
+pub mod any_loop;
 pub mod hyper;
+pub mod learner;
 pub mod method;
-pub mod record;
-pub mod recorder;
-pub mod replay;
-pub mod schedule;
-pub mod squeeze;
-pub mod trainer;
-pub mod update;
-pub mod window_buffer;
-
-/// Why a record, an episode, a buffer or a squeeze request was refused. Messages name the
-/// offending quantity and what was expected.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ReplayError {
-    #[error("{what}: expected length {expected}, got {got}")]
-    WrongLength {
-        what: &'static str,
-        expected: usize,
-        got: usize,
-    },
-    #[error("an episode must hold at least one record")]
-    EmptyEpisode,
-    #[error("cannot sample from an empty replay buffer")]
-    EmptyBuffer,
-    #[error("`{name}` must be > 0")]
-    Zero { name: &'static str },
-    #[error("agent {agent} is out of range 0..{n_agents}")]
-    AgentOutOfRange { agent: usize, n_agents: usize },
-    #[error("agent {agent}: executed macro-action {action} is out of range 0..{n_actions}")]
-    ActionOutOfRange {
-        agent: usize,
-        action: usize,
-        n_actions: usize,
-    },
-    #[error("episode shape ({n_agents} agents, joint observation {joint_obs}) does not match the layout ({expected_agents} agents, joint observation {expected_obs})")]
-    LayoutMismatch {
-        n_agents: usize,
-        joint_obs: usize,
-        expected_agents: usize,
-        expected_obs: usize,
-    },
-    #[error("step recorded before the episode started (call `begin` after every env reset)")]
-    EpisodeNotStarted,
-    #[error("inconsistent replay state: {0}")]
-    Corrupt(String),
-}
+pub mod training_loop;
+pub mod value;

@@ -4,8 +4,9 @@
 //! The reference's figures quoted in the issues were taken the same way (first 200 episodes of
 //! Box Pushing 10x10, all costs included), so the rates compare like for like.
 
+use crate::algos::any_loop::AnyLoop;
 use crate::algos::method::Method;
-use crate::algos::trainer::{Advance, TrainError, Trainer};
+use crate::algos::training_loop::{Advance, TrainError};
 use crate::envs::EnvSpec;
 use crate::experiment::paper::paper_defaults;
 use crate::experiment::train_run::run_rngs;
@@ -58,7 +59,7 @@ pub fn bench_train(
     let mut config = paper_defaults(env, method);
     config.total_epi = episodes;
     let start = Instant::now();
-    let mut trainer = Trainer::new(config, method, 0, run_rngs(0))?;
+    let mut trainer = AnyLoop::new(&config, method, 0, run_rngs(0), || env.build())?;
     while trainer.advance()? != Advance::Finished {}
     let seconds = start.elapsed().as_secs_f64();
     Ok(TrainBench {

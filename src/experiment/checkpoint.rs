@@ -11,16 +11,18 @@
 //! `b"MACDECCK"`, `u32` version, `u32` identity length, identity (JSON), `u64` payload length,
 //! 32-byte SHA-256 of the payload, payload.
 
+use crate::algos::any_loop::AnyLoop;
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::algos::trainer::Trainer;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 /// First bytes of every checkpoint.
 pub const MAGIC: &[u8; 8] = b"MACDECCK";
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
+/// Version 2: the payload is the family-tagged training loop (`AnyLoop`); version 1 held the
+/// value-based trainer alone.
+pub const VERSION: u32 = 2;
 /// Longest identity header accepted (names are at most 200 bytes each).
 const MAX_IDENTITY_BYTES: usize = 4096;
 
@@ -99,7 +101,7 @@ pub enum CheckpointError {
 }
 
 /// Encode `trainer` as a checkpoint of the run `identity`.
-pub fn encode(identity: &CheckpointIdentity, trainer: &Trainer) -> Result<Vec<u8>, String> {
+pub fn encode(identity: &CheckpointIdentity, trainer: &AnyLoop) -> Result<Vec<u8>, String> {
     let header = serde_json::to_vec(identity).map_err(|e| e.to_string())?;
     let payload = bincode::serialize(trainer).map_err(|e| e.to_string())?;
     let mut out = Vec::with_capacity(8 + 4 + 4 + header.len() + 8 + 32 + payload.len());
@@ -161,14 +163,14 @@ pub fn read_header(bytes: &[u8]) -> Result<(CheckpointIdentity, &[u8]), Checkpoi
 pub fn decode(
     bytes: &[u8],
     expected: Option<&CheckpointIdentity>,
-) -> Result<Trainer, CheckpointError> {
+) -> Result<AnyLoop, CheckpointError> {
     let (identity, payload) = read_header(bytes)?;
     if let Some(expected) = expected {
         if &identity != expected {
             return Err(CheckpointError::OtherRun(identity.differences(expected)));
         }
     }
-    let trainer: Trainer =
+    let trainer: AnyLoop =
         bincode::deserialize(payload).map_err(|e| CheckpointError::Decode(e.to_string()))?;
     // The payload must be the run its header names (a defect otherwise, but cheap to check).
     let inner = CheckpointIdentity {
@@ -193,11 +195,12 @@ mod tests {
     use crate::experiment::paper::paper_defaults;
     use crate::experiment::train_run::run_rngs;
 
-    fn tiny() -> (CheckpointIdentity, Trainer) {
+    fn tiny() -> (CheckpointIdentity, AnyLoop) {
         let mut c = paper_defaults(EnvSpec::paper_box_pushing(8), Method::Our1);
         c.batch_size = 4;
         c.replay_buffer_size = 50;
-        let t = Trainer::new(c.clone(), Method::Our1, 3, run_rngs(3)).unwrap();
+        let env = c.env;
+        let t = AnyLoop::new(&c, Method::Our1, 3, run_rngs(3), || env.build()).unwrap();
         (CheckpointIdentity::new("e", Method::Our1, "", 3, &c), t)
     }
 
@@ -270,11 +273,14 @@ mod tests {
         assert_eq!(e, CheckpointError::NoHeader);
         assert!(e.to_string().contains("older macdec"), "{e}");
         assert!(e.to_string().contains("delete it"), "{e}");
-        let mut v2 = encode(&tiny().0, &t).unwrap();
-        v2[8] = 2;
-        assert_eq!(
-            decode(&v2, None).unwrap_err(),
-            CheckpointError::Version { found: 2 }
-        );
+        // Version 1 (the value-based trainer before the learner seam) and any future version.
+        for found in [1, 3] {
+            let mut other = encode(&tiny().0, &t).unwrap();
+            other[8] = found as u8;
+            assert_eq!(
+                decode(&other, None).unwrap_err(),
+                CheckpointError::Version { found }
+            );
+        }
     }
 }

@@ -2,17 +2,26 @@
 //!
 //! Columns (stable names other tools read): `episode` (training episodes completed),
 //! `env_steps` (primitive steps taken by the training env(s)), `updates` (training iterations),
-//! `eval_return` (mean greedy discounted return, spec `algorithms.md` 7.1), `epsilon`,
-//! `hysteresis`, `loss` (mean total TD loss over the iterations since the previous row; empty
-//! before the first), `wall_seconds` (time since the run started, including resumed segments; the
-//! only column that is not reproducible bit for bit).
+//! `eval_return` (mean return of the evaluated policy, discounted per primitive step, spec
+//! `algorithms.md` 7.1), then the method family's own columns, then `wall_seconds` (time since
+//! the run started, including resumed segments; the only column that is not reproducible bit for
+//! bit). The value-based family's columns are `epsilon`, `hysteresis` and `loss` (mean total TD
+//! loss over the iterations since the previous row; empty before the first), see
+//! [`crate::algos::value::learner::METRIC_COLUMNS`]. A reader takes any family columns between
+//! `eval_return` and `wall_seconds` by their header names.
 
+use serde::Serialize;
 use std::path::Path;
 
 /// The file name of a run's learning curve.
 pub const METRICS_FILE: &str = "metrics.csv";
 /// The same curve gzip-compressed, as committed results store it (`scripts/campaign.sh collect`).
 pub const METRICS_FILE_GZ: &str = "metrics.csv.gz";
+
+/// The columns every family writes before its own.
+pub const LEADING_COLUMNS: [&str; 4] = ["episode", "env_steps", "updates", "eval_return"];
+/// The column every family writes after its own.
+pub const WALL_SECONDS: &str = "wall_seconds";
 
 /// The metrics file of the run in `dir`: `metrics.csv` (what a run writes as it goes) if present,
 /// else the committed `metrics.csv.gz`; `None` when neither exists.
@@ -23,8 +32,38 @@ pub fn locate(dir: &Path) -> Option<std::path::PathBuf> {
         .find(|p| p.is_file())
 }
 
-/// One evaluation point of a run: the trainer's own record, written as one CSV row.
-pub use crate::algos::trainer::EvalPoint as MetricsRow;
+/// One evaluation point of a run: the training loop's own record, written as one CSV row.
+pub use crate::algos::training_loop::EvalPoint as MetricsRow;
+
+/// A whole metrics file: the family's column names and every row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MetricsTable {
+    /// The names of the rows' [`MetricsRow::family`] values, in order.
+    pub family_columns: Vec<String>,
+    pub rows: Vec<MetricsRow>,
+}
+
+impl MetricsTable {
+    /// Every row's value of column `name` (a leading, family or `wall_seconds` column); `None`
+    /// when the file has no such column. Empty cells are `None`.
+    pub fn column(&self, name: &str) -> Option<Vec<Option<f64>>> {
+        let leading = |r: &MetricsRow| -> Option<f64> {
+            Some(match name {
+                "episode" => r.episode as f64,
+                "env_steps" => r.env_steps as f64,
+                "updates" => r.updates as f64,
+                "eval_return" => r.eval_return,
+                WALL_SECONDS => r.wall_seconds,
+                _ => return None,
+            })
+        };
+        if LEADING_COLUMNS.contains(&name) || name == WALL_SECONDS {
+            return Some(self.rows.iter().map(leading).collect());
+        }
+        let at = self.family_columns.iter().position(|c| c == name)?;
+        Some(self.rows.iter().map(|r| r.family[at]).collect())
+    }
+}
 
 /// Why a metrics file could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -36,33 +75,62 @@ pub enum MetricsError {
         path: String,
         source: std::io::Error,
     },
+    #[error("{path}: {message}")]
+    Layout { path: String, message: String },
 }
 
-/// The rows as CSV text, header first.
-pub fn to_csv(rows: &[MetricsRow]) -> Result<Vec<u8>, csv::Error> {
+/// One CSV cell, written exactly as the csv crate writes the field's type (integers as
+/// integers, floats by `ryu`, a missing value as an empty cell).
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Cell {
+    Count(u64),
+    Value(f64),
+    Missing(Option<f64>),
+}
+
+/// The rows as CSV text, header first. Every row must have one family value per
+/// `family_columns` entry (panics otherwise: a learner defect).
+pub fn to_csv(family_columns: &[&str], rows: &[MetricsRow]) -> Result<Vec<u8>, csv::Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    if rows.is_empty() {
-        w.write_record([
-            "episode",
-            "env_steps",
-            "updates",
-            "eval_return",
-            "epsilon",
-            "hysteresis",
-            "loss",
-            "wall_seconds",
-        ])?;
-    }
+    let header: Vec<&str> = LEADING_COLUMNS
+        .iter()
+        .chain(family_columns)
+        .chain(std::iter::once(&WALL_SECONDS))
+        .copied()
+        .collect();
+    w.write_record(&header)?;
     for r in rows {
-        w.serialize(r)?;
+        assert_eq!(
+            r.family.len(),
+            family_columns.len(),
+            "a metrics row has one value per family column"
+        );
+        let mut cells = vec![
+            Cell::Count(r.episode),
+            Cell::Count(r.env_steps),
+            Cell::Count(r.updates),
+            Cell::Value(r.eval_return),
+        ];
+        cells.extend(r.family.iter().map(|v| match v {
+            Some(v) => Cell::Value(*v),
+            None => Cell::Missing(None),
+        }));
+        cells.push(Cell::Value(r.wall_seconds));
+        w.serialize(cells)?;
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 
 /// Write the whole curve atomically.
-pub fn write(path: &Path, rows: &[MetricsRow]) -> Result<(), MetricsError> {
+pub fn write(
+    path: &Path,
+    family_columns: &[&str],
+    rows: &[MetricsRow],
+) -> Result<(), MetricsError> {
     let p = || path.display().to_string();
-    let bytes = to_csv(rows).map_err(|source| MetricsError::Csv { path: p(), source })?;
+    let bytes =
+        to_csv(family_columns, rows).map_err(|source| MetricsError::Csv { path: p(), source })?;
     super::atomic::write_atomic(path, &bytes)
         .map_err(|source| MetricsError::Io { path: p(), source })
 }
@@ -82,14 +150,78 @@ pub fn read_text(path: &Path) -> Result<Vec<u8>, MetricsError> {
     }
 }
 
-/// Read a curve written by [`write`] (or its gzip-compressed copy).
-pub fn read(path: &Path) -> Result<Vec<MetricsRow>, MetricsError> {
+/// Read a curve written by [`write`] (or its gzip-compressed copy), whatever the family: the
+/// columns between `eval_return` and `wall_seconds` are the family's. A missing leading column,
+/// a cell that is not a number, or a row of the wrong length is an error naming it.
+pub fn read(path: &Path) -> Result<MetricsTable, MetricsError> {
     let p = || path.display().to_string();
     let text = read_text(path)?;
+    let csv_err = |source| MetricsError::Csv { path: p(), source };
+    let layout = |message: String| MetricsError::Layout { path: p(), message };
     let mut r = csv::Reader::from_reader(&text[..]);
-    r.deserialize()
-        .collect::<Result<_, _>>()
-        .map_err(|source| MetricsError::Csv { path: p(), source })
+    let header: Vec<String> = r
+        .headers()
+        .map_err(csv_err)?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let n = header.len();
+    if n < LEADING_COLUMNS.len() + 1
+        || !header
+            .iter()
+            .take(LEADING_COLUMNS.len())
+            .eq(LEADING_COLUMNS.iter())
+        || header[n - 1] != WALL_SECONDS
+    {
+        return Err(layout(format!(
+            "the header must start with `{}` and end with `{WALL_SECONDS}`, got `{}`",
+            LEADING_COLUMNS.join(","),
+            header.join(",")
+        )));
+    }
+    let family_columns = header[LEADING_COLUMNS.len()..n - 1].to_vec();
+    let mut rows = Vec::new();
+    for (i, record) in r.records().enumerate() {
+        let record = record.map_err(csv_err)?;
+        let line = i + 2;
+        let cell = |k: usize| record.get(k).unwrap_or("");
+        let number = |k: usize| -> Result<f64, MetricsError> {
+            cell(k).parse::<f64>().map_err(|_| {
+                layout(format!(
+                    "line {line}: `{}` is not a number: {:?}",
+                    header[k],
+                    cell(k)
+                ))
+            })
+        };
+        let count = |k: usize| -> Result<u64, MetricsError> {
+            cell(k).parse::<u64>().map_err(|_| {
+                layout(format!(
+                    "line {line}: `{}` is not a count: {:?}",
+                    header[k],
+                    cell(k)
+                ))
+            })
+        };
+        let family = (LEADING_COLUMNS.len()..n - 1)
+            .map(|k| match cell(k) {
+                "" => Ok(None),
+                _ => number(k).map(Some),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        rows.push(MetricsRow {
+            episode: count(0)?,
+            env_steps: count(1)?,
+            updates: count(2)?,
+            eval_return: number(3)?,
+            family,
+            wall_seconds: number(n - 1)?,
+        });
+    }
+    Ok(MetricsTable {
+        family_columns,
+        rows,
+    })
 }
 
 #[cfg(test)]
@@ -104,9 +236,7 @@ mod tests {
                 env_steps: 0,
                 updates: 0,
                 eval_return: -4.5,
-                epsilon: 1.0,
-                hysteresis: 1.0,
-                loss: None,
+                family: vec![Some(1.0), Some(1.0), None],
                 wall_seconds: 0.1,
             },
             MetricsRow {
@@ -114,16 +244,20 @@ mod tests {
                 env_steps: 900,
                 updates: 50,
                 eval_return: 80.7,
-                epsilon: 0.99,
-                hysteresis: 1.0,
-                loss: Some(0.25),
+                family: vec![Some(0.99), Some(1.0), Some(0.25)],
                 wall_seconds: 1.5,
             },
         ];
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("metrics.csv");
-        write(&p, &rows).unwrap();
-        assert_eq!(read(&p).unwrap(), rows);
+        let columns = ["epsilon", "hysteresis", "loss"];
+        write(&p, &columns, &rows).unwrap();
+        let table = read(&p).unwrap();
+        assert_eq!(table.rows, rows);
+        assert_eq!(table.family_columns, columns);
+        assert_eq!(table.column("loss"), Some(vec![None, Some(0.25)]));
+        assert_eq!(table.column("episode"), Some(vec![Some(0.0), Some(10.0)]));
+        assert_eq!(table.column("q_loss"), None);
         let text = std::fs::read_to_string(&p).unwrap();
         assert!(text.starts_with(
             "episode,env_steps,updates,eval_return,epsilon,hysteresis,loss,wall_seconds\n"
@@ -137,8 +271,61 @@ mod tests {
         std::fs::write(&gz, enc.finish().unwrap()).unwrap();
         std::fs::remove_file(&p).unwrap();
         assert_eq!(locate(dir.path()), Some(gz.clone()));
-        assert_eq!(read(&gz).unwrap(), rows);
+        assert_eq!(read(&gz).unwrap().rows, rows);
         std::fs::write(&gz, b"not gzip").unwrap();
         assert!(matches!(read(&gz), Err(MetricsError::Io { .. })));
+    }
+
+    #[test]
+    fn any_family_columns_round_trip_and_an_empty_curve_keeps_its_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("metrics.csv");
+        write(&p, &["actor_loss", "critic_loss"], &[]).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&p).unwrap(),
+            "episode,env_steps,updates,eval_return,actor_loss,critic_loss,wall_seconds\n"
+        );
+        let row = MetricsRow {
+            episode: 96,
+            env_steps: 9600,
+            updates: 12,
+            eval_return: 1e20,
+            family: vec![None, Some(-0.5)],
+            wall_seconds: 2.0,
+        };
+        write(
+            &p,
+            &["actor_loss", "critic_loss"],
+            std::slice::from_ref(&row),
+        )
+        .unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.ends_with("\n96,9600,12,1e20,,-0.5,2.0\n"), "{text}");
+        let table = read(&p).unwrap();
+        assert_eq!(table.family_columns, ["actor_loss", "critic_loss"]);
+        assert_eq!(table.rows, vec![row]);
+    }
+
+    #[test]
+    fn a_file_without_the_leading_columns_or_with_a_bad_cell_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("metrics.csv");
+        std::fs::write(&p, "episode,eval_return\n0,1.5\n").unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("must start with"), "{e}");
+        std::fs::write(
+            &p,
+            "episode,env_steps,updates,eval_return,loss,wall_seconds\n0,0,0,1.5,abc,0.1\n",
+        )
+        .unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("`loss`"), "{e}");
+        std::fs::write(
+            &p,
+            "episode,env_steps,updates,eval_return,wall_seconds\n-1,0,0,1.5,0.1\n",
+        )
+        .unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("`episode` is not a count"), "{e}");
     }
 }

@@ -17,7 +17,7 @@ pub fn print_curves(results: &Path, runs: &[RunSpec]) -> Result<(), metrics::Met
         let Some(path) = metrics::locate(&run.dir(results)) else {
             continue;
         };
-        let rows = metrics::read(&path)?;
+        let rows = metrics::read(&path)?.rows;
         by_curve
             .entry(format!("{}/{}", run.experiment, run.curve_name()))
             .or_default()

@@ -1,8 +1,8 @@
 //! Animated rollouts of a trained run's greedy policy (`macdec render`).
 
-use crate::algos::acting::ActScratch;
-use crate::algos::evaluate::GreedyActor;
-use crate::algos::evaluate::GreedyPolicy;
+use crate::algos::value::acting::ActScratch;
+use crate::algos::value::evaluate::GreedyActor;
+use crate::algos::value::evaluate::GreedyPolicy;
 use crate::envs::MacroEnv;
 use crate::experiment::policy_files::{read_policy_files, NetRole, PolicyFilesError};
 use crate::experiment::seeds::{stream, Role};

@@ -9,10 +9,10 @@
 //! Every file is written atomically; a killed run resumes from its last checkpoint and ends with
 //! the metrics an uninterrupted run would have written.
 
-use crate::algos::evaluate::GreedyPolicy;
+use crate::algos::any_loop::AnyLoop;
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::algos::trainer::{Advance, RunRngs, TrainError, Trainer};
+use crate::algos::training_loop::{Advance, RunRngs, TrainError};
 use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
 use crate::experiment::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::config::RunSpec;
@@ -257,7 +257,7 @@ fn read_checkpoint_bytes(path: &Path) -> Result<Vec<u8>, RunError> {
 
 /// Load a run's trainer from its checkpoint, verified (format, checksum, exact length) and, when
 /// the run's `config.toml` sits beside it, checked to be that run's.
-pub fn load_checkpoint(path: &Path) -> Result<Trainer, RunError> {
+pub fn load_checkpoint(path: &Path) -> Result<AnyLoop, RunError> {
     let expected = match path.parent().map(|d| d.join(CONFIG)) {
         Some(config) if config.exists() => {
             let text = std::fs::read_to_string(&config).map_err(|e| io(&config, e))?;
@@ -275,7 +275,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Trainer, RunError> {
 fn load_checkpoint_of(
     path: &Path,
     expected: Option<&CheckpointIdentity>,
-) -> Result<Trainer, RunError> {
+) -> Result<AnyLoop, RunError> {
     let bytes = read_checkpoint_bytes(path)?;
     checkpoint::decode(&bytes, expected).map_err(|e| RunError::BadCheckpoint {
         path: path.to_path_buf(),
@@ -286,7 +286,7 @@ fn load_checkpoint_of(
 fn save_checkpoint(
     path: &Path,
     identity: &CheckpointIdentity,
-    trainer: &mut Trainer,
+    trainer: &mut AnyLoop,
 ) -> Result<(), RunError> {
     trainer.mark_time();
     let bytes = checkpoint::encode(identity, trainer).map_err(|e| io(path, e))?;
@@ -294,11 +294,12 @@ fn save_checkpoint(
 }
 
 /// Write the trainer's nets as the run's policy files (see [`crate::experiment::policy_files`]).
-fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &Trainer) -> Result<(), RunError> {
-    let dec = trainer.dec_policies();
-    let evaluated = match trainer.greedy_policy(&dec) {
-        GreedyPolicy::Dec(_) => NetRole::Dec,
-        GreedyPolicy::Cen(_) => NetRole::Cen,
+fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<(), RunError> {
+    let nets = trainer.saved_nets();
+    let evaluated = if nets.evaluated_is_centralized {
+        NetRole::Cen
+    } else {
+        NetRole::Dec
     };
     let config = trainer.config();
     let info = RunPolicyInfo {
@@ -312,14 +313,13 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &Trainer) -> Result<()
         evaluated,
         config: serde_json::to_value(config).map_err(|e| io(dir, e))?,
     };
-    write_policy_files(dir, info, &dec, trainer.cen_policy())?;
+    write_policy_files(dir, info, &nets.dec, nets.cen)?;
     Ok(())
 }
 
-fn save_metrics(dir: &Path, trainer: &Trainer) -> Result<(), RunError> {
-    let rows = trainer.evals();
+fn save_metrics(dir: &Path, trainer: &AnyLoop) -> Result<(), RunError> {
     let path = dir.join(METRICS_FILE);
-    metrics::write(&path, rows).map_err(|e| io(&path, e))
+    metrics::write(&path, trainer.metric_columns(), trainer.evals()).map_err(|e| io(&path, e))
 }
 
 /// Train one run to completion in `dir`, resuming from its checkpoint if there is one.
@@ -357,19 +357,21 @@ pub fn train_run(
     let mut trainer = if checkpoint.exists() {
         load_checkpoint_of(&checkpoint, Some(&identity))?
     } else {
-        Trainer::new(
-            spec.config.clone(),
+        let env = spec.config.env;
+        AnyLoop::new(
+            &spec.config,
             spec.method,
             spec.seed,
             run_rngs(spec.seed),
+            || env.build(),
         )?
     };
     while let Advance::Episode { checkpoint_due } = trainer.advance()? {
         progress.update(
             trainer.episodes(),
             format!(
-                "eps {:.3} return {:.2}",
-                trainer.epsilon(),
+                "{} return {:.2}",
+                trainer.progress(),
                 trainer.evals().last().map_or(f64::NAN, |e| e.eval_return)
             ),
         );

@@ -223,12 +223,15 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
         return Err(RunProblem::Skip(format!("no {METRICS_FILE}")));
     };
     let bad = |why: String| RunProblem::Malformed(metrics_path.clone(), why);
-    let rows = metrics::read(&metrics_path).map_err(|e| {
-        bad(match e {
-            MetricsError::Csv { source, .. } => source.to_string(),
-            MetricsError::Io { source, .. } => source.to_string(),
-        })
-    })?;
+    let rows = metrics::read(&metrics_path)
+        .map_err(|e| {
+            bad(match e {
+                MetricsError::Csv { source, .. } => source.to_string(),
+                MetricsError::Io { source, .. } => source.to_string(),
+                MetricsError::Layout { message, .. } => message,
+            })
+        })?
+        .rows;
     if rows.is_empty() {
         // A header alone is a run before its first evaluation, unless it is not our header.
         let header = metrics::read_text(&metrics_path).unwrap_or_default();
@@ -334,13 +337,12 @@ pub(crate) mod tests {
                 env_steps: episode * 50,
                 updates: episode / 2,
                 eval_return,
-                epsilon: 1.0,
-                hysteresis: 1.0,
-                loss: None,
+                family: vec![Some(1.0), Some(1.0), None],
                 wall_seconds: episode as f64 * 0.5,
             })
             .collect();
-        metrics::write(&dir.join(METRICS_FILE), &rows).unwrap();
+        let columns = crate::algos::value::learner::METRIC_COLUMNS;
+        metrics::write(&dir.join(METRICS_FILE), &columns, &rows).unwrap();
         let config = paper_defaults(env, Method::Our1);
         std::fs::write(dir.join(CONFIG_FILE), toml::to_string(&config).unwrap()).unwrap();
         if finished {

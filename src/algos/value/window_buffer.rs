@@ -228,7 +228,7 @@ impl WindowBuffer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::record::RecordRef;
+    use crate::algos::value::record::RecordRef;
     use rand::SeedableRng;
 
     fn layout() -> Layout {

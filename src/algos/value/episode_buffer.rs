@@ -123,8 +123,8 @@ impl EpisodeBuffer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::record::RecordRef;
-    use crate::algos::replay::ReplayBuffer;
+    use crate::algos::value::record::RecordRef;
+    use crate::algos::value::replay::ReplayBuffer;
     use rand::SeedableRng;
 
     fn layout() -> Layout {

@@ -6,7 +6,7 @@
 //! flat vectors run over the K kept records in (sequence, time) order, the order in which a net
 //! unrolled over `inputs` with `lengths` emits its outputs (see [`packed_rows`]). Padding past a
 //! sequence's length is zero. Zero-padding records of the reference never reach this point
-//! ([`crate::algos::replay`]), and they would be dropped here anyway (all v_i = 0).
+//! ([`crate::algos::value::replay`]), and they would be dropped here anyway (all v_i = 0).
 
 use ndarray::Array3;
 
@@ -321,8 +321,8 @@ impl Kept {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::record::RecordRef;
-    use crate::algos::replay::Sequence;
+    use crate::algos::value::record::RecordRef;
+    use crate::algos::value::replay::Sequence;
     use ndarray::s;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -589,7 +589,7 @@ mod tests {
     #[test]
     #[ignore]
     fn squeeze_speed() {
-        use crate::algos::replay::ReplayBuffer;
+        use crate::algos::value::replay::ReplayBuffer;
         use std::time::Instant;
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         let mut run = |name: &str,

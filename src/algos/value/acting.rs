@@ -1,7 +1,7 @@
 //! Choosing macro-actions: decentralized and centralized epsilon-greedy (spec `algorithms.md` 4.2,
 //! 4.3), and the greedy policies evaluation and deployment run (epsilon = 0, state carried).
 
-use crate::algos::cond_argmax::{cond_argmax, unravel};
+use crate::algos::value::cond_argmax::{cond_argmax, unravel};
 use crate::envs::MacroEnv;
 use crate::nn::{LstmState, QNet};
 use ndarray::ArrayView1;

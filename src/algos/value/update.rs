@@ -5,14 +5,14 @@
 //! with the just-updated centralized net (Our-1, Our-2; quirk Q2); C, one TD step per agent, whose
 //! target action comes from B or from the agent's own double-Q selection.
 
-use crate::algos::cond_argmax::{cond_argmax_rows, unravel_component, CondArgmaxError};
 use crate::algos::method::{DecTargetAction, Method};
-use crate::algos::record::Layout;
-use crate::algos::replay::Batch;
-use crate::algos::squeeze::{
+use crate::algos::value::cond_argmax::{cond_argmax_rows, unravel_component, CondArgmaxError};
+use crate::algos::value::record::Layout;
+use crate::algos::value::replay::Batch;
+use crate::algos::value::squeeze::{
     joint_rows_of_agent, squeeze_agent_min, squeeze_joint, AgentView, JointView,
 };
-use crate::algos::ReplayError;
+use crate::algos::value::ReplayError;
 use crate::autograd::SeqPacking;
 use crate::nn::{flatten_padded, Adam, AdamConfig, QNet, QNetParams, TdBatch, Updater};
 use ndarray::{Array1, Array2, Array3};
@@ -333,7 +333,7 @@ pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
     q.rows()
         .into_iter()
         .map(|row| {
-            crate::algos::acting::argmax(
+            crate::algos::value::acting::argmax(
                 row.as_slice()
                     .expect("rows of a standard-layout array are contiguous"),
             )
@@ -377,9 +377,9 @@ pub enum UpdateError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::record::{Episode, RecordRef};
-    use crate::algos::replay::Sequence;
-    use crate::algos::squeeze::squeeze_agent;
+    use crate::algos::value::record::{Episode, RecordRef};
+    use crate::algos::value::replay::Sequence;
+    use crate::algos::value::squeeze::squeeze_agent;
     use ndarray::array;
 
     /// Two agents with one observation value and two macro-actions each. Step 0: agent 0 ran

@@ -1,7 +1,7 @@
 //! Greedy evaluation (spec `algorithms.md` 7.1): the learned policies on a separate env copy, no
 //! exploration, hidden state carried through the episode, return discounted per primitive step.
 
-use crate::algos::acting::{select_cen, select_dec, ActScratch};
+use crate::algos::value::acting::{select_cen, select_dec, ActScratch};
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use crate::nn::{LstmState, QNet};
 

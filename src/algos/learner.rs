@@ -1,0 +1,131 @@
+//! The seam between the training loop and a method family: what the loop asks of a learner.
+//!
+//! The loop ([`crate::algos::training_loop::TrainingLoop`]) owns the environments, their random
+//! streams, the counters, the evaluation schedule, the metrics rows and the checkpoint; it knows
+//! nothing of nets, replay or losses. A family (the value-based methods of
+//! [`crate::algos::value`], the actor-critic methods next) implements [`Learner`]: how its
+//! training lanes act and what they record, what one training iteration and a target sync do,
+//! how its evaluated policy acts, which metrics columns it adds and which nets it saves.
+//!
+//! Adding a family is a folder under `src/algos/` with one type implementing this trait, a
+//! [`crate::algos::method::Family`] variant, and one arm in each `match` on the family (the run
+//! on disk and the checkpoint pick the loop's learner type there).
+
+use crate::algos::hyper::RunConfig;
+use crate::algos::method::Method;
+use crate::algos::training_loop::TrainError;
+use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use crate::nn::QNet;
+use rand_chacha::ChaCha8Rng;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+/// When the loop trains and syncs targets, in terms of its own counters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Schedule {
+    /// The ICRA main loop (spec `algorithms.md` 6): every main-loop step advances each lane by one
+    /// primitive step; a training iteration runs every `train_freq` steps once `start_train`
+    /// training episodes are done; targets are hard-copied every `target_update_freq` steps.
+    EveryStep {
+        train_freq: u64,
+        start_train: u64,
+        target_update_freq: u64,
+    },
+}
+
+/// One training lane a learner asks for: an environment the loop steps and resets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LanePlan {
+    /// Whether the lane's finished episodes are training episodes (`total_epi`, `eval_freq` and
+    /// `checkpoint_freq` count them). Our-2's centralized-exploring lane does not count (spec 5.5).
+    pub counts_episodes: bool,
+}
+
+/// The random streams a learner draws from (one per role, spec `algorithms.md` 8); the loop keeps
+/// the environments' streams.
+#[derive(Debug, Clone)]
+pub struct LearnerRngs {
+    /// Net initialisation.
+    pub init: ChaCha8Rng,
+    /// Exploration draws while training.
+    pub explore: ChaCha8Rng,
+    /// Replay sampling.
+    pub replay: ChaCha8Rng,
+}
+
+/// The nets a learner saves as the run's policy files, and which of them the evaluated policy is.
+pub struct SavedNets<'a> {
+    /// Agent i's decentralized Q-net is `dec[i]` (empty when the method has none).
+    pub dec: Vec<&'a QNet>,
+    /// The centralized Q-net, when the method trains one.
+    pub cen: Option<&'a QNet>,
+    /// Whether evaluation acts with the centralized net (Cen-DDRQN) or the decentralized ones.
+    pub evaluated_is_centralized: bool,
+}
+
+/// A method family, as the training loop drives it. The learner is saved inside every checkpoint
+/// (with its lanes' state), so a resumed run continues with exactly the numbers of an
+/// uninterrupted one.
+pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwned {
+    /// What the learner keeps per training lane besides the environment: hidden states, the
+    /// episode being recorded, the lane's replay.
+    type Lane: Clone + std::fmt::Debug + Serialize + DeserializeOwned;
+
+    /// Build the nets and buffers of `method` for the domain `env` is an instance of (its sizes,
+    /// horizon and first-record rule; `env` is in its reset state). Errors name the bad setting.
+    fn new<E: MacroEnv>(
+        config: &RunConfig,
+        method: Method,
+        seed: u64,
+        env: &E,
+        rngs: LearnerRngs,
+    ) -> Result<Self, TrainError>;
+
+    /// The method being trained.
+    fn method(&self) -> Method;
+    /// The run's seed.
+    fn seed(&self) -> u64;
+    /// The run's configuration.
+    fn config(&self) -> &RunConfig;
+
+    /// When the loop calls [`Self::train_iteration`] and [`Self::sync_targets`].
+    fn schedule(&self) -> Schedule;
+    /// The training lanes, in the order the loop steps them within one main-loop step.
+    fn lanes(&self) -> Vec<LanePlan>;
+    /// The state of lane `lane` at the start of its first episode (`env` just reset).
+    fn begin_lane<E: MacroEnv>(&self, lane: usize, env: &E) -> Result<Self::Lane, TrainError>;
+
+    /// Choose the free agents' macro-actions for the next primitive step of a training lane.
+    fn act<E: MacroEnv>(&mut self, lane: &mut Self::Lane, env: &E, actions: &mut [usize]);
+    /// Record the step `env` just took. Returns whether the episode ended; the loop then resets
+    /// the environment and calls [`Self::begin_episode`].
+    fn record<E: MacroEnv>(
+        &mut self,
+        lane: &mut Self::Lane,
+        env: &E,
+        outcome: StepOutcome,
+    ) -> Result<bool, TrainError>;
+    /// Start a lane's next episode (`env` just reset).
+    fn begin_episode<E: MacroEnv>(&self, lane: &mut Self::Lane, env: &E) -> Result<(), TrainError>;
+
+    /// One training iteration on what the lanes collected (in [`Self::lanes`] order);
+    /// `episodes` is the number of training episodes done.
+    fn train_iteration(&mut self, lanes: &[&Self::Lane], episodes: u64) -> Result<(), TrainError>;
+    /// Copy the online nets into their targets.
+    fn sync_targets(&mut self);
+
+    /// The evaluated policy's mean return over `config().eval_num_epi` episodes of `env`
+    /// (one if the domain is deterministic), discounted per primitive step.
+    fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng) -> Result<f64, EnvError>;
+
+    /// The family's own `metrics.csv` columns, after `eval_return` and before `wall_seconds`.
+    fn metric_columns(&self) -> &'static [&'static str];
+    /// The values of [`Self::metric_columns`] at an evaluation (`None` writes an empty cell);
+    /// running means restart afterwards.
+    fn metric_values(&mut self) -> Vec<Option<f64>>;
+    /// A few words of training state for progress lines (e.g. `eps 0.512`).
+    fn progress(&self) -> String;
+
+    /// The nets written as the run's policy files.
+    fn saved_nets(&self) -> SavedNets<'_>;
+}
