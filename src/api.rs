@@ -16,16 +16,13 @@ use crate::deploy::manifest::{Manifest, RunInfo};
 use crate::deploy::policy_env::PolicyEnv;
 use crate::envs::{EnvError, MacroEnv};
 use crate::experiment::config::validate;
-use crate::experiment::limits::check_sizes;
+use crate::experiment::run_settings::RunSettings;
 use crate::experiment::train_run::run_rngs;
 use crate::nn::QNet;
 use std::path::Path;
 
 /// The `experiment` an exported library policy names in its manifest's `run`.
 pub const LIBRARY_EXPERIMENT: &str = "library";
-/// The config keys that name the built-in domain (`config.toml`'s); a custom domain's exported
-/// config leaves them out, since the library trained on the caller's domain instead.
-const DOMAIN_KEYS: [&str; 4] = ["env_name", "grid_dim", "env_terminate_step", "tb_m_noisy"];
 
 /// Why [`train`] refused or stopped.
 #[derive(Debug, thiserror::Error)]
@@ -42,11 +39,11 @@ pub enum LibraryTrainError {
 /// point (the rows `metrics.csv` would hold; write them with [`crate::experiment::metrics::write`]
 /// to plot them with `macdec plot`).
 ///
-/// `make_env` is called once per environment the method needs (evaluation, training, Our-2's
-/// second training env); each call must build the same domain. What the learner needs to know
-/// about the domain comes from its [`MacroEnv`] implementation, horizon included; the config's
-/// `env` (the spec `macdec train` would build) is not read, only validated like the rest of the
-/// config (every key named on error). `on_episode` is called after every training episode with
+/// `make_env` is called once to check the config against the domain's horizon, then once per
+/// environment the method needs (evaluation, training, Our-2's second training env); each call
+/// must build the same domain. What the learner needs to know about the domain comes from its
+/// [`MacroEnv`] implementation, horizon included; the config names no domain and is validated
+/// like a config file's (every key named on error). `on_episode` is called after every training episode with
 /// the trainer, e.g. for progress output. [`train_policy`] also gives back the trained nets.
 pub fn train<E: MacroEnv>(
     make_env: impl Fn() -> Result<E, EnvError>,
@@ -85,8 +82,9 @@ pub fn train_policy<E: MacroEnv>(
     seed: u64,
     mut on_episode: impl FnMut(&AnyLoop<E>),
 ) -> Result<TrainedPolicy, LibraryTrainError> {
-    validate(config, method)
-        .and_then(|()| check_sizes(config))
+    // The domain's horizon bounds the episode buffer's sequences: ask one instance.
+    let horizon = make_env().map_err(TrainError::from)?.horizon();
+    validate(config, method, horizon)
         .map_err(|(key, message)| LibraryTrainError::Config { key, message })?;
     let mut trainer = AnyLoop::new(config, method, seed, run_rngs(seed), make_env)?;
     while trainer.advance()? != Advance::Finished {
@@ -118,16 +116,16 @@ impl TrainedPolicy {
         env: &E,
         domain: PolicyEnv,
     ) -> Result<Manifest, ExportError> {
-        let mut config = self.config.clone();
-        if let PolicyEnv::BuiltIn(spec) = &domain {
-            config.env = *spec;
+        // A built-in domain is recorded as a run's config.toml records it; a custom one by the
+        // manifest's `env` alone.
+        let config = match &domain {
+            PolicyEnv::BuiltIn(spec) => serde_json::to_value(RunSettings {
+                env: *spec,
+                config: self.config.clone(),
+            }),
+            PolicyEnv::Custom(_) => serde_json::to_value(&self.config),
         }
-        let mut config = serde_json::to_value(&config).expect("a RunConfig serializes to JSON");
-        if let (PolicyEnv::Custom(_), Some(keys)) = (&domain, config.as_object_mut()) {
-            for key in DOMAIN_KEYS {
-                keys.remove(key);
-            }
-        }
+        .expect("a config serializes to JSON");
         let run = RunInfo {
             experiment: LIBRARY_EXPERIMENT.to_string(),
             method: self.method.name().to_string(),
@@ -147,8 +145,14 @@ mod tests {
     use crate::envs::{AnyEnv, EnvSpec};
     use crate::experiment::paper::paper_defaults;
 
+    /// The library trains on BP 10x10 here.
+    const SPEC: EnvSpec = EnvSpec::BoxPushing {
+        grid: 10,
+        horizon: 100,
+    };
+
     fn short(method: Method) -> RunConfig {
-        let mut c = paper_defaults(EnvSpec::paper_box_pushing(10), method);
+        let mut c = paper_defaults(SPEC, method);
         c.total_epi = 12;
         c.eval_freq = 4;
         c
@@ -158,9 +162,9 @@ mod tests {
     fn library_training_gives_the_numbers_of_the_command_lines_trainer() {
         for method in [Method::Our1, Method::DecHddrqn] {
             let c = short(method);
-            let spec = c.env;
+            let spec = SPEC;
             let evals = train(|| spec.build(), &c, method, 5, |_| {}).unwrap();
-            let env = c.env;
+            let env = SPEC;
             let mut t: AnyLoop<AnyEnv> =
                 AnyLoop::new(&c, method, 5, run_rngs(5), || env.build()).unwrap();
             while t.advance().unwrap() != Advance::Finished {}
@@ -183,7 +187,7 @@ mod tests {
         use crate::deploy::manifest::load_agent;
         use crate::deploy::qnet_policy::load_net;
         let c = short(Method::Our1);
-        let spec = c.env;
+        let spec = SPEC;
         let trained = train_policy(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
         let evals = train(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
         let no_wall = |e: &[EvalPoint]| -> Vec<EvalPoint> {
@@ -232,7 +236,7 @@ mod tests {
     fn a_bad_config_key_is_named_before_training() {
         let mut c = short(Method::Our1);
         c.batch_size = 0;
-        let spec = c.env;
+        let spec = SPEC;
         let err = train(|| spec.build(), &c, Method::Our1, 0, |_| {}).unwrap_err();
         assert!(err.to_string().contains("batch_size"), "{err}");
     }

@@ -61,7 +61,7 @@ fn bp30_uses_longer_windows_and_horizon() {
     let runs = load("fig4b_bp30.toml").runs().unwrap();
     let c = &runs[0].config;
     assert_eq!(
-        c.env,
+        runs[0].env,
         macdec::envs::EnvSpec::BoxPushing {
             grid: 30,
             horizon: 200

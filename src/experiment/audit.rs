@@ -155,7 +155,8 @@ pub fn audit_run(dir: &Path, scratch: &Path) -> Result<RunAudit, AuditError> {
         method: manifest.method,
         variant: manifest.variant.clone(),
         seed: manifest.seed,
-        config: manifest.config.clone(),
+        env: manifest.config.env,
+        config: manifest.config.config.clone(),
     };
     let run_dir = scratch.join("run");
     train_run(&spec, &run_dir, &Progress::hidden(), true)?;

@@ -12,8 +12,8 @@
 //! 32-byte SHA-256 of the payload, payload.
 
 use crate::algos::any_loop::AnyLoop;
-use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
+use crate::experiment::run_settings::RunSettings;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -34,13 +34,19 @@ pub struct CheckpointIdentity {
     pub method: String,
     pub variant: String,
     pub seed: u64,
-    /// SHA-256 (hex) of the resolved config as JSON.
+    /// SHA-256 (hex) of the resolved domain and config ([`RunSettings`]) as JSON.
     pub config_sha256: String,
 }
 
 impl CheckpointIdentity {
     /// The identity of a run.
-    pub fn new(experiment: &str, method: Method, variant: &str, seed: u64, c: &RunConfig) -> Self {
+    pub fn new(
+        experiment: &str,
+        method: Method,
+        variant: &str,
+        seed: u64,
+        c: &RunSettings,
+    ) -> Self {
         CheckpointIdentity {
             experiment: experiment.to_string(),
             method: method.name().to_string(),
@@ -69,9 +75,9 @@ impl CheckpointIdentity {
     }
 }
 
-/// SHA-256 (hex) of a resolved config, the config part of a checkpoint's identity.
-pub fn config_sha256(c: &RunConfig) -> String {
-    let json = serde_json::to_vec(c).expect("RunConfig serializes to JSON");
+/// SHA-256 (hex) of a resolved domain and config, the config part of a checkpoint's identity.
+pub fn config_sha256(c: &RunSettings) -> String {
+    let json = serde_json::to_vec(c).expect("RunSettings serializes to JSON");
     hex(&Sha256::digest(json))
 }
 
@@ -159,7 +165,7 @@ pub fn read_header(bytes: &[u8]) -> Result<(CheckpointIdentity, &[u8]), Checkpoi
 }
 
 /// Decode checkpoint bytes, refusing anything that is not exactly a checkpoint of `expected`
-/// (or, with `None`, of the run the trainer inside says it is: method, seed and config).
+/// (or, with `None`, of the run the loop inside says it is: method and seed).
 pub fn decode(
     bytes: &[u8],
     expected: Option<&CheckpointIdentity>,
@@ -176,7 +182,6 @@ pub fn decode(
     let inner = CheckpointIdentity {
         method: trainer.method().name().to_string(),
         seed: trainer.seed(),
-        config_sha256: config_sha256(trainer.config()),
         ..identity.clone()
     };
     if inner != identity {
@@ -192,15 +197,14 @@ pub fn decode(
 mod tests {
     use super::*;
     use crate::envs::EnvSpec;
-    use crate::experiment::paper::paper_defaults;
     use crate::experiment::train_run::run_rngs;
 
     fn tiny() -> (CheckpointIdentity, AnyLoop) {
-        let mut c = paper_defaults(EnvSpec::paper_box_pushing(8), Method::Our1);
-        c.batch_size = 4;
-        c.replay_buffer_size = 50;
+        let mut c = RunSettings::paper(EnvSpec::paper_box_pushing(8), Method::Our1);
+        c.config.batch_size = 4;
+        c.config.replay_buffer_size = 50;
         let env = c.env;
-        let t = AnyLoop::new(&c, Method::Our1, 3, run_rngs(3), || env.build()).unwrap();
+        let t = AnyLoop::new(&c.config, Method::Our1, 3, run_rngs(3), || env.build()).unwrap();
         (CheckpointIdentity::new("e", Method::Our1, "", 3, &c), t)
     }
 

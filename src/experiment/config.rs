@@ -9,9 +9,10 @@
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::envs::flags::{check_spec, EnvName, DEFAULT_GRID_DIM};
+use crate::envs::EnvSpec;
 use crate::experiment::limits;
 use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
-use crate::experiment::paper::paper_defaults;
+use crate::experiment::run_settings::RunSettings;
 use crate::experiment::seeds::{check_seed_list, parse_seeds, SeedsError};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -96,6 +97,9 @@ pub struct RunSpec {
     /// Empty when the experiment has no sweep; else e.g. `trace_len=10,l_rate=0.001`.
     pub variant: String,
     pub seed: u64,
+    /// The domain the run trains on.
+    pub env: EnvSpec,
+    /// The run's hyperparameters.
     pub config: RunConfig,
 }
 
@@ -294,20 +298,20 @@ impl Experiment {
     }
 
     /// One method's sweep points: (variant name, resolved config), checked and deduplicated.
-    fn method_points(&self, method: Method) -> Result<Vec<(String, RunConfig)>, ConfigError> {
+    fn method_points(&self, method: Method) -> Result<Vec<(String, RunSettings)>, ConfigError> {
         let mut table = self.params.clone();
         if let Some(extra) = self.per_method.get(&method) {
             for (k, v) in extra {
                 table.insert(k.clone(), v.clone());
             }
         }
-        let mut points: Vec<(String, RunConfig)> = Vec::new();
+        let mut points: Vec<(String, RunSettings)> = Vec::new();
         // Keyed by the resolved config's TOML text: `1e-3` and `0.001`, or `1` and `1.0`, are
         // one point and would race in one directory's worth of work twice.
         let mut seen: std::collections::HashMap<String, String> = Default::default();
         for (variant, point) in expand_grid(&self.path, &table)? {
             let config = resolve(&self.path, method, &point)?;
-            let key = toml::to_string(&config).expect("RunConfig serializes to TOML");
+            let key = toml::to_string(&config).expect("RunSettings serializes to TOML");
             if let Some(other) = seen.insert(key, variant.clone()) {
                 return Err(ConfigError::DuplicatePoint {
                     path: self.path.clone(),
@@ -358,7 +362,8 @@ impl Experiment {
                         method,
                         variant: variant.clone(),
                         seed,
-                        config: config.clone(),
+                        env: config.env,
+                        config: config.config.clone(),
                     });
                 }
             }
@@ -485,7 +490,7 @@ fn value_label(v: &toml::Value) -> String {
 }
 
 /// Resolve one sweep point for one method: paper defaults, then the user's keys, then checks.
-fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig, ConfigError> {
+fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettings, ConfigError> {
     let p = || path.to_path_buf();
     let bad = |key: &str, message: String| ConfigError::BadValue {
         path: p(),
@@ -519,8 +524,8 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
         }
         None => DEFAULT_GRID_DIM,
     };
-    let defaults = paper_defaults(env.paper_spec(grid_dim), method);
-    let mut table = toml::Table::try_from(&defaults).expect("RunConfig serializes to a table");
+    let defaults = RunSettings::paper(env.paper_spec(grid_dim), method);
+    let mut table = toml::Table::try_from(&defaults).expect("RunSettings serializes to a table");
     for (key, value) in point {
         if !table.contains_key(key) {
             return Err(ConfigError::UnknownKey {
@@ -548,13 +553,13 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
         }
         table.insert(key.clone(), value);
     }
-    let config: RunConfig = toml::Value::Table(table.clone())
+    let config: RunSettings = toml::Value::Table(table.clone())
         .try_into()
         .map_err(|e: toml::de::Error| bad("config", e.message().to_string()))?;
     // A domain key the chosen domain does not use (`grid_dim` for OSD_S_4, `tb_m_noisy` for
     // BP_MA) would be dropped and recorded as its default: refuse it instead of ignoring it.
     // (`env_name` itself is recorded by its reference name even when written as an alias.)
-    let recorded = toml::Table::try_from(&config).expect("RunConfig serializes to a table");
+    let recorded = toml::Table::try_from(&config).expect("RunSettings serializes to a table");
     for (key, value) in &table {
         if key != "env_name" && recorded.get(key) != Some(value) {
             return Err(bad(
@@ -566,15 +571,23 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunConfig
             ));
         }
     }
-    validate(&config, method).map_err(|(key, message)| bad(key, message))?;
+    // The domain checks its own parameters, named by the keys that set them.
+    check_spec(&config.env).map_err(|(key, message)| bad(key, message))?;
+    validate(&config.config, method, config.env.horizon())
+        .map_err(|(key, message)| bad(key, message))?;
     Ok(config)
 }
 
-/// Range checks that types cannot express. Returns the offending key and why. The library entry
-/// point [`crate::train`] runs them too, so a config built in code is held to the same rules.
-pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, String)> {
+/// Range checks that types cannot express, for a domain whose episodes last at most `horizon`
+/// primitive steps. Returns the offending key and why. The library entry point [`crate::train`]
+/// runs them too, so a config built in code is held to the same rules.
+pub fn validate(
+    c: &RunConfig,
+    method: Method,
+    horizon: usize,
+) -> Result<(), (&'static str, String)> {
     let positive = [
-        ("env_terminate_step", c.env.horizon()),
+        ("env_terminate_step", horizon),
         ("total_epi", c.total_epi),
         ("replay_buffer_size", c.replay_buffer_size),
         ("h_stable_at", c.h_stable_at),
@@ -597,8 +610,6 @@ pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, Stri
             return Err((key, "must be > 0, got 0".into()));
         }
     }
-    // The domain checks its own parameters, named by the keys that set them.
-    check_spec(&c.env)?;
     if c.start_train == 0 {
         return Err((
             "start_train",
@@ -616,7 +627,7 @@ pub fn validate(c: &RunConfig, method: Method) -> Result<(), (&'static str, Stri
             ),
         ));
     }
-    limits::check_sizes(c)?;
+    limits::check_sizes(c, horizon)?;
     let unit = [
         ("eps_end", c.eps_end),
         ("discount", c.discount),
@@ -777,9 +788,13 @@ mod tests {
     #[test]
     fn env_name_aliases_resolve_to_the_reference_names() {
         let e = parse("[params]\nenv_name = \"box-pushing\"\ngrid_dim = 30", &[]).unwrap();
-        let c = &e.runs().unwrap()[0].config;
-        assert_eq!(c.env, crate::envs::EnvSpec::paper_box_pushing(30));
-        let text = toml::to_string(c).unwrap();
+        let run = &e.runs().unwrap()[0];
+        assert_eq!(run.env, crate::envs::EnvSpec::paper_box_pushing(30));
+        let text = toml::to_string(&RunSettings {
+            env: run.env,
+            config: run.config.clone(),
+        })
+        .unwrap();
         assert!(
             text.starts_with("env_name = \"BP_MA\"\ngrid_dim = 30\n"),
             "{text}"

@@ -13,6 +13,7 @@ pub mod policy_files;
 pub mod provenance;
 pub mod report;
 pub mod rollout;
+pub mod run_settings;
 pub mod runner;
 pub mod seeds;
 pub mod slurm;

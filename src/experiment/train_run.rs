@@ -10,7 +10,6 @@
 //! the metrics an uninterrupted run would have written.
 
 use crate::algos::any_loop::AnyLoop;
-use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::algos::training_loop::{Advance, RunRngs, TrainError};
 use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
@@ -21,6 +20,7 @@ use crate::experiment::policy_files::{
     write_policy_files, NetRole, PolicyFilesError, RunPolicyInfo,
 };
 use crate::experiment::provenance::Provenance;
+use crate::experiment::run_settings::RunSettings;
 use crate::experiment::runner::{Progress, RunEnd, FINISHED_MARKER};
 use crate::experiment::seeds::{stream, Role};
 use serde::{Deserialize, Serialize};
@@ -39,7 +39,8 @@ pub struct RunManifest {
     pub method: Method,
     pub variant: String,
     pub seed: u64,
-    pub config: RunConfig,
+    /// The domain and hyperparameters, written as one table.
+    pub config: RunSettings,
     /// The build and machine that started the run (absent in runs from before it was recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub provenance: Option<Provenance>,
@@ -53,7 +54,10 @@ impl RunManifest {
             method: spec.method,
             variant: spec.variant.clone(),
             seed: spec.seed,
-            config: spec.config.clone(),
+            config: RunSettings {
+                env: spec.env,
+                config: spec.config.clone(),
+            },
             provenance: Some(Provenance::current()),
         }
     }
@@ -308,10 +312,14 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<()
         variant: spec.variant.clone(),
         seed: trainer.seed(),
         episodes_trained: trainer.episodes(),
-        env: config.env,
+        env: spec.env,
         discount: config.discount,
         evaluated,
-        config: serde_json::to_value(config).map_err(|e| io(dir, e))?,
+        config: serde_json::to_value(RunSettings {
+            env: spec.env,
+            config: config.clone(),
+        })
+        .map_err(|e| io(dir, e))?,
     };
     write_policy_files(dir, info, &nets.dec, nets.cen)?;
     Ok(())
@@ -357,7 +365,7 @@ pub fn train_run(
     let mut trainer = if checkpoint.exists() {
         load_checkpoint_of(&checkpoint, Some(&identity))?
     } else {
-        let env = spec.config.env;
+        let env = spec.env;
         AnyLoop::new(
             &spec.config,
             spec.method,

@@ -313,7 +313,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::envs::EnvSpec;
     use crate::experiment::metrics::MetricsRow;
-    use crate::experiment::paper::paper_defaults;
+    use crate::experiment::run_settings::RunSettings;
 
     /// Write a synthetic run: returns at the given episodes, a config, and optionally the marker.
     pub(crate) fn write_run(
@@ -343,7 +343,7 @@ pub(crate) mod tests {
             .collect();
         let columns = crate::algos::value::learner::METRIC_COLUMNS;
         metrics::write(&dir.join(METRICS_FILE), &columns, &rows).unwrap();
-        let config = paper_defaults(env, Method::Our1);
+        let config = RunSettings::paper(env, Method::Our1);
         std::fs::write(dir.join(CONFIG_FILE), toml::to_string(&config).unwrap()).unwrap();
         if finished {
             std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();

@@ -90,10 +90,10 @@ impl EnvSetting {
 mod tests {
     use super::*;
     use crate::algos::method::Method;
-    use crate::experiment::paper::paper_defaults;
+    use crate::experiment::run_settings::RunSettings;
 
     fn setting_of(env: EnvSpec) -> EnvSetting {
-        let text = toml::to_string(&paper_defaults(env, Method::Our1)).unwrap();
+        let text = toml::to_string(&RunSettings::paper(env, Method::Our1)).unwrap();
         EnvSetting::from_config_toml(&text).unwrap()
     }
 
@@ -104,7 +104,7 @@ mod tests {
             method: Method::Our1,
             variant: String::new(),
             seed: 3,
-            config: paper_defaults(EnvSpec::paper_box_pushing(30), Method::Our1),
+            config: RunSettings::paper(EnvSpec::paper_box_pushing(30), Method::Our1),
             provenance: None,
         };
         let s = EnvSetting::from_config_toml(&toml::to_string(&manifest).unwrap()).unwrap();
