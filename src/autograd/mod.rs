@@ -2,7 +2,8 @@
 //!
 //! A [`Tape`] records the forward pass as an arena of nodes addressed by `Copy` ids ([`Var`]);
 //! [`Tape::backward`] replays it in reverse, accumulating gradients with `+=`. Each op is defined
-//! once, its backward beside its forward (`ops/`), and has a central-difference gradient check.
+//! once, its backward beside its forward (`ops/`, which lists them all), is public, and has a
+//! central-difference gradient check.
 //! The LSTM is one fused op over a batch of variable-length sequences (`ops/lstm.rs`), checked
 //! against its unfused composition. The numeric kernels (`kernels/`) are shared with the no-tape
 //! paths used for acting and for target values. Nothing here knows about layers or nets.
