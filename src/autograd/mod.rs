@@ -4,8 +4,8 @@
 //! [`Tape::backward`] replays it in reverse, accumulating gradients with `+=`. Each op is defined
 //! once, its backward beside its forward (`ops/`, which lists them all), is public, and has a
 //! central-difference gradient check.
-//! The LSTM is one fused op over a batch of variable-length sequences (`ops/lstm.rs`), checked
-//! against its unfused composition. The numeric kernels (`kernels/`) are shared with the no-tape
+//! The LSTM and the GRU are each one fused op over a batch of variable-length sequences
+//! (`ops/lstm.rs`, `ops/gru.rs`), checked against their unfused compositions. The numeric kernels (`kernels/`) are shared with the no-tape
 //! paths used for acting and for target values. Nothing here knows about layers or nets.
 
 pub mod kernels;
@@ -15,7 +15,7 @@ mod pool;
 mod tape;
 
 pub use kernels::dense::Activation;
-pub use ops::LstmVars;
+pub use ops::{GruVars, LstmVars};
 pub use packing::SeqPacking;
 pub use pool::Pool;
 pub use tape::{Tape, Var};

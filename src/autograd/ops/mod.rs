@@ -11,14 +11,17 @@
 //! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows` |
 //! | `reduce.rs` | `sum`, `mean`, `masked_mean` |
 //! | `lstm.rs` | `lstm`, `lstm_packed` (fused, over packed sequences) |
+//! | `gru.rs` | `gru`, `gru_packed` (fused, over packed sequences) |
 
 mod elementwise;
+mod gru;
 mod lstm;
 mod matmul;
 mod reduce;
 mod shape;
 mod softmax;
 
+pub use gru::GruVars;
 pub use lstm::LstmVars;
 
 use ndarray::Array2;
@@ -122,6 +125,7 @@ pub(crate) enum Op {
         mask: Var,
     },
     Lstm(Box<lstm::LstmNode>),
+    Gru(Box<gru::GruNode>),
 }
 
 impl Op {
@@ -156,6 +160,7 @@ impl Op {
             Op::Mean { x } => reduce::mean_backward(*x, g, cx),
             Op::MaskedMean { x, mask } => reduce::masked_mean_backward(*x, *mask, g, cx),
             Op::Lstm(node) => node.backward(g, cx),
+            Op::Gru(node) => node.backward(g, cx),
         }
     }
 }
