@@ -17,9 +17,9 @@
 //!
 //! The backward mirrors it: per step one fused pass computes the input-side gate gradients
 //! dA = [da_r, da_z, da_n] and the recurrent-side ones dB = [da_r, da_z, r * da_n] (they differ
-//! only in the n block), then dh_prev = z * dh + dB W_hh. All weight and input gradients are
-//! one product each over all steps (dW_ih = dA^T x, dW_hh = dB^T h_prev, dx = dA W_ih; see
-//! `ops/gru.rs`).
+//! only in the n block, so both live in one [K, 4H] buffer, see [`DG_BLOCKS`]), then
+//! dh_prev = z * dh + dB W_hh. All weight and input gradients are one product each over all
+//! steps (dW_ih = dA^T x, dW_hh = dB^T h_prev, dx = dA W_ih; see `ops/gru.rs`).
 
 use ndarray::{s, Array2, ArrayView2};
 
@@ -247,14 +247,31 @@ simd_dispatch! {
 /// `BACKWARD_CHUNK_ROWS`): enough for efficient products, few enough to still be in L2.
 pub const BACKWARD_CHUNK_ROWS: usize = 256;
 
+/// Column blocks of the backward's gate-gradient buffer `dg` [K, 4H]: [da_n, da_r, da_z, r da_n].
+/// The input side's gradients dA are its first three blocks (in the row order n, r, z of
+/// [`permute_nrz`]`(W_ih)`), the recurrent side's dB = [da_r, da_z, r da_n] its last three (in
+/// W_hh's own order r, z, n). One buffer instead of two saves writing the shared r and z
+/// blocks twice, so the GRU's backward moves no more memory per gate than the LSTM's.
+pub const DG_BLOCKS: [&str; 4] = ["a_n", "r", "z", "b_n"];
+
+/// The rows of a [3H, c] matrix reordered from (r, z, n) to (n, r, z): the right operand of
+/// dx = dA [`permute_nrz`](W_ih), and (applied to dA^T x) W_ih's gradient in that order.
+pub fn permute_nrz(w: ArrayView2<f32>) -> Array2<f32> {
+    let h = w.nrows() / 3;
+    assert_eq!(w.nrows(), 3 * h, "permute_nrz: rows must be 3H");
+    let mut out = Array2::zeros(w.dim());
+    out.slice_mut(s![..h, ..]).assign(&w.slice(s![2 * h.., ..]));
+    out.slice_mut(s![h.., ..]).assign(&w.slice(s![..2 * h, ..]));
+    out
+}
+
 /// Gradients of the gate pre-activations given dy = dL/dh, all in packed order, and the
-/// forward's cache (`h_prev`, `gates`, `hn`, see [`GruCache`]). `da` (input side, [da_r, da_z, da_n]) and `db_rec`
-/// (recurrent side, [da_r, da_z, r da_n]): [K, 3H], overwritten; `dh_rec`: [batch_size(0), H]
-/// scratch; `dbias` [4H] receives the column sums [da_r, da_z, da_n, r da_n] (b_ih's gradient
-/// is its first 3H entries, b_hh's the first 2H and the last H).
+/// forward's cache (`h_prev`, `gates`, `hn`, see [`GruCache`]). `dg`: [K, 4H] (overwritten,
+/// blocks as [`DG_BLOCKS`]); `dh_rec`: [batch_size(0), H] scratch; `dbias` [4H] receives the
+/// column sums of dg (b_ih's gradient is blocks r, z, a_n; b_hh's is blocks r, z, b_n).
 /// Steps are processed last to first; whenever at least [`BACKWARD_CHUNK_ROWS`] rows are
-/// complete (and at the end), `on_rows(rows, da, db_rec)` is called with their packed row
-/// range (descending, disjoint, covering 0..K), so the caller can use them while in cache.
+/// complete (and at the end), `on_rows(rows, dg)` is called with their packed row range
+/// (descending, disjoint, covering 0..K), so the caller can use them while they are in cache.
 #[allow(clippy::too_many_arguments)]
 pub fn gru_backward(
     dy: ArrayView2<f32>,
@@ -263,28 +280,22 @@ pub fn gru_backward(
     h_prev: &Array2<f32>,
     gates: &Array2<f32>,
     hn: &Array2<f32>,
-    da: &mut Array2<f32>,
-    db_rec: &mut Array2<f32>,
+    dg: &mut Array2<f32>,
     dh_rec: &mut Array2<f32>,
     dbias: &mut [f32],
-    mut on_rows: impl FnMut(std::ops::Range<usize>, &Array2<f32>, &Array2<f32>),
+    mut on_rows: impl FnMut(std::ops::Range<usize>, &Array2<f32>),
 ) {
     let (k, h) = (packing.total(), w_hh.ncols());
     assert_eq!(dy.dim(), (k, h), "gru backward: dy must be [K, H]");
-    assert_eq!(da.dim(), (k, 3 * h), "gru backward: da must be [K, 3H]");
-    assert_eq!(
-        db_rec.dim(),
-        (k, 3 * h),
-        "gru backward: db_rec must be [K, 3H]"
-    );
+    assert_eq!(dg.dim(), (k, 4 * h), "gru backward: dg must be [K, 4H]");
     assert_eq!(dbias.len(), 4 * h, "gru backward: dbias must be [4H]");
     let n0 = packing.batch_size(0);
     assert_eq!(dh_rec.dim(), (n0, h));
-    let dy = dy.as_standard_layout();
-    let dy = dy.as_slice().expect("standard layout");
     for (buf, shape) in [h_prev, gates, hn].into_iter().zip(GruCache::shapes(k, h)) {
         assert_eq!(buf.dim(), shape, "gru backward: cache buffer shape");
     }
+    let dy = dy.as_standard_layout();
+    let dy = dy.as_slice().expect("standard layout");
     let gates = gates.as_slice().expect("contiguous");
     let hp_all = h_prev.as_slice().expect("contiguous");
     let hn_all = hn.as_slice().expect("contiguous");
@@ -297,60 +308,57 @@ pub fn gru_backward(
     for t in (0..packing.n_steps()).rev() {
         let (n, o) = (packing.batch_size(t), packing.offset(t));
         let cell = o * h..(o + n) * h;
-        let row3 = o * 3 * h..(o + n) * 3 * h;
         backward_cells(
             &dy[cell.clone()],
             &mut dh_rec.as_slice_mut().expect("contiguous")[..n * h],
-            &gates[row3.clone()],
+            &gates[o * 3 * h..(o + n) * 3 * h],
             &hp_all[cell.clone()],
             &hn_all[cell],
-            &mut da.as_slice_mut().expect("contiguous")[row3.clone()],
-            &mut db_rec.as_slice_mut().expect("contiguous")[row3],
+            &mut dg.as_slice_mut().expect("contiguous")[o * 4 * h..(o + n) * 4 * h],
             dbias,
             h,
         );
         if t > 0 {
-            // dh_rec holds z dh (the direct path); add the path through the gates.
+            // dh_rec holds z dh (the direct path); add the path through the gates, dB W_hh.
             gemm(
-                db_rec.slice(s![o..o + n, ..]),
+                dg.slice(s![o..o + n, h..]),
                 w_hh,
                 dh_rec.slice_mut(s![..n, ..]),
                 Mode::Accumulate,
             );
         }
         if chunk_end - o >= BACKWARD_CHUNK_ROWS || t == 0 {
-            on_rows(o..chunk_end, da, db_rec);
+            on_rows(o..chunk_end, dg);
             chunk_end = o;
         }
     }
 }
 
 /// The backward of the cell for L lanes: dL/dh (output plus recurrent part) and the forward's
-/// gates [r, z, n], h_prev and b_n in; the input-side pre-activation gradients [da_r, da_z,
-/// da_n], the recurrent n-block gradient r da_n, and the direct part z dh of dL/dh_prev out.
+/// gates [r, z, n], h_prev and b_n in; the gate gradients in [`DG_BLOCKS`] order
+/// [da_n, da_r, da_z, r da_n] and the direct part z dh of dL/dh_prev out.
 #[inline(always)]
-#[allow(clippy::type_complexity)]
 fn cell_grad_lanes<const L: usize>(
     dh: [f32; L],
     gates: [[f32; L]; 3],
     hp: [f32; L],
     hn: [f32; L],
-) -> ([[f32; L]; 3], [f32; L], [f32; L]) {
+) -> ([[f32; L]; 4], [f32; L]) {
     let [r, z, n] = gates;
-    let mut d = [[0.0; L]; 3];
-    let (mut d_bn, mut dhp) = ([0.0; L], [0.0; L]);
+    let mut d = [[0.0; L]; 4];
+    let mut dhp = [0.0; L];
     for l in 0..L {
         // h = n + z (h_prev - n)
         let dn = dh[l] * (1.0 - z[l]);
         let dz = dh[l] * (hp[l] - n[l]);
         let dan = dn * (1.0 - n[l] * n[l]);
-        d[0][l] = dan * hn[l] * r[l] * (1.0 - r[l]);
-        d[1][l] = dz * z[l] * (1.0 - z[l]);
-        d[2][l] = dan;
-        d_bn[l] = dan * r[l];
+        d[0][l] = dan;
+        d[1][l] = dan * hn[l] * r[l] * (1.0 - r[l]);
+        d[2][l] = dz * z[l] * (1.0 - z[l]);
+        d[3][l] = dan * r[l];
         dhp[l] = dh[l] * z[l];
     }
-    (d, d_bn, dhp)
+    (d, dhp)
 }
 
 /// One row's gate gradients over lanes q0, q0 + L, ... (see [`backward_cells`]).
@@ -364,8 +372,7 @@ fn backward_row<const L: usize>(
     gates: &[f32],
     h_prev: &[f32],
     hn: &[f32],
-    da: &mut [f32],
-    db_rec: &mut [f32],
+    dg: &mut [f32],
     dbias: &mut [f32],
 ) {
     let mut q0 = q.start;
@@ -376,23 +383,15 @@ fn backward_row<const L: usize>(
             dh[l] = dyv[l] + dhr[l];
         }
         let g = [rd(gates, q0), rd(gates, h + q0), rd(gates, 2 * h + q0)];
-        let (d, d_bn, dhp) = cell_grad_lanes::<L>(dh, g, rd(h_prev, q0), rd(hn, q0));
+        let (d, dhp) = cell_grad_lanes::<L>(dh, g, rd(h_prev, q0), rd(hn, q0));
         for (blk, dv) in d.iter().enumerate() {
-            wr(da, blk * h + q0, dv);
+            wr(dg, blk * h + q0, dv);
             let mut sum: [f32; L] = rd(dbias, blk * h + q0);
             for l in 0..L {
                 sum[l] += dv[l];
             }
             wr(dbias, blk * h + q0, &sum);
         }
-        wr(db_rec, q0, &d[0]);
-        wr(db_rec, h + q0, &d[1]);
-        wr(db_rec, 2 * h + q0, &d_bn);
-        let mut sum: [f32; L] = rd(dbias, 3 * h + q0);
-        for l in 0..L {
-            sum[l] += d_bn[l];
-        }
-        wr(dbias, 3 * h + q0, &sum);
         wr(dh_rec, q0, &dhp);
         q0 += L;
     }
@@ -402,16 +401,15 @@ simd_dispatch! {
     /// The pointwise part of one backward step for its n rows. dL/dh of row j is its output
     /// gradient dy[j] plus dh_rec[j], the part through the next step (zero for sequences that
     /// ended here); dh_rec[j] is then overwritten with z dh, the direct part of dL/dh_prev.
-    /// Writes da and db_rec [n, 3H] and adds their column sums to dbias [4H] (see
-    /// [`gru_backward`]). gates: [n, 3H]; h_prev, hn: [n, H].
+    /// Writes dg [n, 4H] (see [`DG_BLOCKS`]) and adds its column sums to dbias [4H].
+    /// gates: [n, 3H]; h_prev, hn: [n, H].
     pub fn backward_cells(
         dy: &[f32],
         dh_rec: &mut [f32],
         gates: &[f32],
         h_prev: &[f32],
         hn: &[f32],
-        da: &mut [f32],
-        db_rec: &mut [f32],
+        dg: &mut [f32],
         dbias: &mut [f32],
         hidden: usize,
     ) {
@@ -419,12 +417,12 @@ simd_dispatch! {
         let full = h - h % LANES;
         for j in 0..dy.len() / h {
             let cell = j * h..(j + 1) * h;
-            let row3 = j * 3 * h..(j + 1) * 3 * h;
             let (dyj, dhj) = (&dy[cell.clone()], &mut dh_rec[cell.clone()]);
             let (hpj, hnj) = (&h_prev[cell.clone()], &hn[cell]);
-            let (gj, daj, dbj) = (&gates[row3.clone()], &mut da[row3.clone()], &mut db_rec[row3]);
-            backward_row::<LANES>(0..full, h, dyj, dhj, gj, hpj, hnj, daj, dbj, dbias);
-            backward_row::<1>(full..h, h, dyj, dhj, gj, hpj, hnj, daj, dbj, dbias);
+            let gj = &gates[j * 3 * h..(j + 1) * 3 * h];
+            let dgj = &mut dg[j * 4 * h..(j + 1) * 4 * h];
+            backward_row::<LANES>(0..full, h, dyj, dhj, gj, hpj, hnj, dgj, dbias);
+            backward_row::<1>(full..h, h, dyj, dhj, gj, hpj, hnj, dgj, dbias);
         }
     }
 }

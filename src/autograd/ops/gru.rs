@@ -7,7 +7,7 @@ use ndarray::{s, Array2};
 
 use super::Op;
 use crate::autograd::kernels::gemm::{gemm, Mode};
-use crate::autograd::kernels::gru::{gru_backward, gru_forward, GruCache, GruWeights};
+use crate::autograd::kernels::gru::{gru_backward, gru_forward, permute_nrz, GruCache, GruWeights};
 use crate::autograd::tape::{GradCx, Tape, Var};
 use crate::autograd::SeqPacking;
 
@@ -102,15 +102,17 @@ impl GruNode {
         let input = x.ncols();
         let wants_w = cx.wants(self.w.w_ih) || cx.wants(self.w.w_hh);
 
-        let mut da = cx.pool.array(k, 3 * h);
-        let mut db_rec = cx.pool.array(k, 3 * h);
+        let mut dg = cx.pool.array(k, 4 * h);
         let mut dh_rec = cx.pool.array(p.batch_size(0), h);
         let mut dbias = cx.pool.array(1, 4 * h);
-        let mut dw_ih = cx.pool.array(3 * h, input);
+        // W_ih's gate blocks in dg's order (n, r, z), and its gradient in that order.
+        let w_ih_nrz = permute_nrz(w_ih.view());
+        let mut dw_ih_nrz = cx.pool.array(3 * h, input);
         let mut dw_hh = cx.pool.array(3 * h, h);
         let mut dx = cx.slot(self.x);
         // Each gradient is a product over all steps, dW_ih = dA^T x, dW_hh = dB^T h_prev,
-        // dx = dA W_ih, computed chunk by chunk while the chunk's rows are still in cache.
+        // dx = dA W_ih, computed chunk by chunk while the chunk's rows are still in cache;
+        // dA = dg[:, ..3H], dB = dg[:, H..] (see DG_BLOCKS).
         let mut first = true;
         gru_backward(
             g.view(),
@@ -119,21 +121,25 @@ impl GruNode {
             h_prev,
             gates,
             hn,
-            &mut da,
-            &mut db_rec,
+            &mut dg,
             &mut dh_rec,
             dbias.as_slice_mut().expect("pool arrays are contiguous"),
-            |r, da, db_rec| {
-                let da = da.slice(s![r.clone(), ..]);
+            |r, dg| {
+                let da = dg.slice(s![r.clone(), ..3 * h]);
                 if wants_w {
                     let mode = if first {
                         Mode::Overwrite
                     } else {
                         Mode::Accumulate
                     };
-                    gemm(da.t(), x.slice(s![r.clone(), ..]), dw_ih.view_mut(), mode);
                     gemm(
-                        db_rec.slice(s![r.clone(), ..]).t(),
+                        da.t(),
+                        x.slice(s![r.clone(), ..]),
+                        dw_ih_nrz.view_mut(),
+                        mode,
+                    );
+                    gemm(
+                        dg.slice(s![r.clone(), h..]).t(),
                         h_prev.slice(s![r.clone(), ..]),
                         dw_hh.view_mut(),
                         mode,
@@ -141,28 +147,31 @@ impl GruNode {
                 }
                 first = false;
                 if let Some((d, mode)) = dx.as_mut() {
-                    gemm(da, w_ih.view(), d.slice_mut(s![r, ..]), *mode);
+                    gemm(da, w_ih_nrz.view(), d.slice_mut(s![r, ..]), *mode);
                 }
             },
         );
-        for (v, dw) in [(self.w.w_ih, &dw_ih), (self.w.w_hh, &dw_hh)] {
-            if let Some((d, mode)) = cx.slot(v) {
-                super::put!(mode, d, dw; |g| g);
-            }
+        if let Some((d, mode)) = cx.slot(self.w.w_ih) {
+            // Back from (n, r, z) to W_ih's (r, z, n) rows.
+            super::put!(mode, d.slice_mut(s![..2 * h, ..]), dw_ih_nrz.slice(s![h.., ..]); |g| g);
+            super::put!(mode, d.slice_mut(s![2 * h.., ..]), dw_ih_nrz.slice(s![..h, ..]); |g| g);
         }
-        // dbias = [da_r, da_z, da_n, r da_n] summed over rows: b_ih gets the first three
-        // blocks, b_hh the first two and the last.
+        if let Some((d, mode)) = cx.slot(self.w.w_hh) {
+            super::put!(mode, d, &dw_hh; |g| g);
+        }
+        // dbias = column sums of dg, blocks [a_n, r, z, b_n]: b_ih gets (r, z, a_n), b_hh gets
+        // (r, z, b_n), each in its (r, z, n) order.
         let sums = dbias.as_slice().expect("pool arrays are contiguous");
         if let Some((d, mode)) = cx.slot(self.w.b_ih) {
             let d = d.as_slice_mut().expect("tape arrays are contiguous");
-            super::put!(mode, d, &sums[..3 * h]; |g| g);
+            super::put!(mode, &mut d[..2 * h], &sums[h..3 * h]; |g| g);
+            super::put!(mode, &mut d[2 * h..], &sums[..h]; |g| g);
         }
         if let Some((d, mode)) = cx.slot(self.w.b_hh) {
             let d = d.as_slice_mut().expect("tape arrays are contiguous");
-            super::put!(mode, &mut d[..2 * h], &sums[..2 * h]; |g| g);
-            super::put!(mode, &mut d[2 * h..], &sums[3 * h..]; |g| g);
+            super::put!(mode, d, &sums[h..]; |g| g);
         }
-        for a in [da, db_rec, dh_rec, dbias, dw_ih, dw_hh] {
+        for a in [dg, dh_rec, dbias, dw_ih_nrz, dw_hh] {
             cx.pool.give_array(a);
         }
     }
