@@ -132,6 +132,9 @@ enum BenchTarget {
     /// Whole training (first --episodes episodes) of every method on BP 10x10 and WTD, 1 thread;
     /// then two BP Our-1 runs at once on two threads against one alone.
     Train,
+    /// The recurrent layer alone: GRU beside LSTM, forward + backward over sequences at the
+    /// nets' shapes, 1 thread, time per step and per flop.
+    Gru,
 }
 
 #[derive(clap::Args)]
@@ -444,6 +447,10 @@ fn run() -> Result<()> {
         } => match what {
             BenchTarget::Train => bench_train(only.as_deref(), episodes),
             BenchTarget::Envs => bench_envs(),
+            BenchTarget::Gru => {
+                print!("{}", macdec::bench::gru::run(only.as_deref(), iters));
+                Ok(())
+            }
             BenchTarget::Nets => {
                 let results: Vec<_> = nets::SHAPES
                     .iter()

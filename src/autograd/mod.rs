@@ -1,11 +1,12 @@
 //! Reverse-mode automatic differentiation over `ndarray`, in f32.
 //!
 //! A [`Tape`] records the forward pass as an arena of nodes addressed by `Copy` ids ([`Var`]);
-//! [`Tape::backward`] replays it in reverse, accumulating gradients with `+=`. Each op is defined
-//! once, its backward beside its forward (`ops/`), and has a central-difference gradient check.
-//! The LSTM is one fused op over a batch of variable-length sequences (`ops/lstm.rs`), checked
-//! against its unfused composition. The numeric kernels (`kernels/`) are shared with the no-tape
-//! paths used for acting and for target values. Nothing here knows about layers or nets.
+//! [`Tape::backward`] replays it in reverse, accumulating gradients with `+=`. Each op is public,
+//! defined once with its backward beside its forward (`ops/`, which lists them all), and has a
+//! central-difference gradient check. The LSTM and the GRU are each one fused op over a batch of
+//! variable-length sequences (`ops/lstm.rs`, `ops/gru.rs`), checked against their unfused
+//! compositions. The numeric kernels (`kernels/`) are shared with the no-tape paths used for
+//! acting and for target values. Nothing here knows about layers or nets.
 
 pub mod kernels;
 mod ops;
@@ -14,7 +15,7 @@ mod pool;
 mod tape;
 
 pub use kernels::dense::Activation;
-pub use ops::LstmVars;
+pub use ops::{GruVars, LstmVars};
 pub use packing::SeqPacking;
 pub use pool::Pool;
 pub use tape::{Tape, Var};

@@ -154,7 +154,7 @@ pub fn bench_shape(shape: &NetShape, iters: usize, warmup: usize) -> NetBench {
 /// Nanoseconds of CPU time this thread has used (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, from
 /// the C library std already links; no extra dependency).
 #[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-fn thread_cpu_ns() -> Option<u64> {
+pub(crate) fn thread_cpu_ns() -> Option<u64> {
     #[repr(C)]
     struct Timespec {
         tv_sec: i64,
@@ -174,7 +174,7 @@ fn thread_cpu_ns() -> Option<u64> {
 }
 
 #[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-fn thread_cpu_ns() -> Option<u64> {
+pub(crate) fn thread_cpu_ns() -> Option<u64> {
     None
 }
 

@@ -3,12 +3,16 @@
 //! - [`QNet`]: fc1 -> fc2 -> LSTM -> fc3 -> fc4 with leaky ReLU (spec `algorithms.md` 2.1),
 //!   run on a tape over a batch of sequences (training), without a tape (targets), or one step
 //!   at a time with an [`LstmState`] (acting).
+//! - [`GruParams`]: a one-layer GRU as PyTorch's `nn.GRU` (gate order, init, state_dict
+//!   names), run on a tape over packed sequences (`Tape::gru_packed`) or one step at a time
+//!   with a [`GruState`] (acting).
 //! - [`Adam`]: PyTorch's Adam (spec 2.4); [`Updater::td_step`]: one full TD gradient step.
 //! - `safetensors_io`: weight files with PyTorch's state_dict names.
 
 mod adam;
 pub mod argmax;
 pub mod demo;
+mod gru;
 pub mod init;
 mod linear;
 pub mod loss;
@@ -20,9 +24,10 @@ mod update;
 
 pub use adam::{Adam, AdamConfig};
 pub use argmax::argmax;
+pub use gru::{GruState, GRU_TENSOR_NAMES};
 pub use linear::LinearVars;
 pub use lstm::LstmState;
-pub use params::{LinearParams, LstmParams, Params};
+pub use params::{GruParams, LinearParams, LstmParams, Params};
 pub use qnet::{
     flatten_padded, Dim, QNet, QNetConfig, QNetParams, QNetVars, TensorSpec, TENSORS, TENSOR_NAMES,
 };

@@ -57,6 +57,58 @@ impl LstmParams {
     }
 }
 
+/// A one-layer GRU's parameters (PyTorch `nn.GRU`, gate order r, z, n):
+/// weight_ih [3H, in], weight_hh [3H, H], bias_ih [3H], bias_hh [3H].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GruParams {
+    pub weight_ih: Array2<f32>,
+    pub weight_hh: Array2<f32>,
+    pub bias_ih: Array1<f32>,
+    pub bias_hh: Array1<f32>,
+}
+
+impl GruParams {
+    /// All-zero parameters for `input` features and hidden size `hidden` (a gradient buffer).
+    pub fn zeros(input: usize, hidden: usize) -> Self {
+        GruParams {
+            weight_ih: Array2::zeros((3 * hidden, input)),
+            weight_hh: Array2::zeros((3 * hidden, hidden)),
+            bias_ih: Array1::zeros(3 * hidden),
+            bias_hh: Array1::zeros(3 * hidden),
+        }
+    }
+
+    /// Hidden size H.
+    pub fn hidden(&self) -> usize {
+        self.weight_hh.ncols()
+    }
+
+    /// Input size.
+    pub fn input(&self) -> usize {
+        self.weight_ih.ncols()
+    }
+}
+
+impl Params for GruParams {
+    fn slices(&self) -> Vec<&[f32]> {
+        vec![
+            flat(&self.weight_ih),
+            flat(&self.weight_hh),
+            flat(&self.bias_ih),
+            flat(&self.bias_hh),
+        ]
+    }
+
+    fn slices_mut(&mut self) -> Vec<&mut [f32]> {
+        vec![
+            flat_mut(&mut self.weight_ih),
+            flat_mut(&mut self.weight_hh),
+            flat_mut(&mut self.bias_ih),
+            flat_mut(&mut self.bias_hh),
+        ]
+    }
+}
+
 /// Flat, contiguous view of an owned array (ours are always in standard layout).
 pub(crate) fn flat<D: ndarray::Dimension>(a: &ndarray::Array<f32, D>) -> &[f32] {
     a.as_slice_memory_order()

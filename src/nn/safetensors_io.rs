@@ -1,12 +1,16 @@
 //! Q-net parameters as safetensors files with the reference's PyTorch state_dict names and shapes
 //! (`fc1.weight` [M, in], ..., `lstm.weight_ih_l0` [4H, H], ...), so
-//! `net.load_state_dict(safetensors.torch.load_file(path))` accepts them.
+//! `net.load_state_dict(safetensors.torch.load_file(path))` accepts them; and a GRU's, with a
+//! bare `nn.GRU`'s names (`weight_ih_l0` [3H, in], ...), both ways
+//! (`safetensors.torch.save_file(gru.state_dict(), path)` gives a file we read).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 
+use super::gru::GRU_TENSOR_NAMES;
+use super::params::{GruParams, Params};
 use super::qnet::{QNet, QNetConfig, QNetParams, TENSOR_NAMES};
 
 /// Why a weights file could not be written or read. Every message names the file, and the
@@ -40,10 +44,12 @@ pub enum WeightsError {
         name: String,
         found: String,
     },
-    #[error("{path}: unexpected tensor `{name}`; a Q-net has exactly {expected}")]
+    #[error("{path}: unexpected tensor `{name}`; a {what} has exactly {expected}")]
     Unexpected {
         path: PathBuf,
         name: String,
+        /// What the file should hold ("Q-net", "GRU").
+        what: &'static str,
         expected: String,
     },
 }
@@ -87,16 +93,14 @@ pub fn from_safetensors_bytes(
             return Err(WeightsError::Unexpected {
                 path,
                 name: name.clone(),
+                what: "Q-net",
                 expected: TENSOR_NAMES.join(", "),
             });
         }
     }
     let mut params = QNetParams::zeros(cfg);
     let shapes = cfg.tensor_shapes();
-    let mut slots = {
-        use super::params::Params;
-        params.slices_mut()
-    };
+    let mut slots = params.slices_mut();
     for ((name, expected), slot) in TENSOR_NAMES.iter().zip(shapes).zip(slots.iter_mut()) {
         let view = st.tensor(name).map_err(|_| WeightsError::Missing {
             path: path.clone(),
@@ -159,6 +163,126 @@ pub fn config_of_safetensors(bytes: &[u8], origin: &Path) -> Result<QNetConfig, 
         hidden: hh[1],
         output: fc4[0],
     })
+}
+
+/// The file's bytes for a GRU's parameters, under `nn.GRU`'s state_dict names
+/// ([`GRU_TENSOR_NAMES`]), with PyTorch's `{"format": "pt"}` metadata.
+pub fn gru_to_safetensors_bytes(params: &GruParams) -> Vec<u8> {
+    let data: Vec<(&str, Vec<usize>, Vec<u8>)> = params
+        .named()
+        .into_iter()
+        .map(|(name, a)| {
+            let bytes = a.iter().flat_map(|v| v.to_le_bytes()).collect();
+            (name, a.shape().to_vec(), bytes)
+        })
+        .collect();
+    let views = data.iter().map(|(name, shape, bytes)| {
+        let view = TensorView::new(Dtype::F32, shape.clone(), bytes)
+            .expect("shape and byte length agree by construction");
+        (*name, view)
+    });
+    let meta = Some(HashMap::from([("format".to_string(), "pt".to_string())]));
+    safetensors::serialize(views, &meta).expect("serializing in-memory f32 tensors cannot fail")
+}
+
+/// Parse a bare `nn.GRU` state_dict (one layer, with biases) from a file's bytes, taking the
+/// sizes from `weight_ih_l0` [3H, in] and `weight_hh_l0` [3H, H]. Exactly the four tensors of
+/// [`GRU_TENSOR_NAMES`] must be present, F32, of consistent shapes (an `nn.LSTM` file, with
+/// 4H rows, is rejected). `origin` only labels errors.
+pub fn gru_from_safetensors_bytes(bytes: &[u8], origin: &Path) -> Result<GruParams, WeightsError> {
+    let path = origin.to_path_buf();
+    let st = SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Format {
+        path: path.clone(),
+        reason: e.to_string(),
+    })?;
+    let mut names: Vec<String> = st.names().into_iter().cloned().collect();
+    names.sort();
+    for name in names {
+        if !GRU_TENSOR_NAMES.contains(&name.as_str()) {
+            return Err(WeightsError::Unexpected {
+                path,
+                name,
+                what: "GRU",
+                expected: GRU_TENSOR_NAMES.join(", "),
+            });
+        }
+    }
+    let tensor = |name: &'static str| {
+        st.tensor(name).map_err(|_| WeightsError::Missing {
+            path: path.clone(),
+            name,
+            expected: vec![],
+        })
+    };
+    let shape_error = |name: &str, found: &[usize], expected: Vec<usize>| WeightsError::Shape {
+        path: path.clone(),
+        name: name.to_string(),
+        found: found.to_vec(),
+        expected,
+    };
+    let [ih, hh, _, _] = GRU_TENSOR_NAMES;
+    let (w_ih, w_hh) = (tensor(ih)?, tensor(hh)?);
+    let (s_ih, s_hh) = (w_ih.shape(), w_hh.shape());
+    let hidden = s_hh.get(1).copied().unwrap_or(0);
+    if s_hh.len() != 2 || s_hh[0] != 3 * hidden {
+        return Err(shape_error(hh, s_hh, vec![3 * hidden, hidden]));
+    }
+    let input = s_ih.get(1).copied().unwrap_or(0);
+    let mut params = GruParams::zeros(input, hidden);
+    let expected: Vec<Vec<usize>> = params
+        .named()
+        .iter()
+        .map(|(_, a)| a.shape().to_vec())
+        .collect();
+    let mut slots = params.slices_mut();
+    for ((name, expected), slot) in GRU_TENSOR_NAMES
+        .into_iter()
+        .zip(expected)
+        .zip(slots.iter_mut())
+    {
+        let view = tensor(name)?;
+        if view.dtype() != Dtype::F32 {
+            return Err(WeightsError::Dtype {
+                path,
+                name: name.to_string(),
+                found: format!("{:?}", view.dtype()),
+            });
+        }
+        if view.shape() != expected.as_slice() {
+            return Err(shape_error(name, view.shape(), expected));
+        }
+        for (d, b) in slot.iter_mut().zip(view.data().chunks_exact(4)) {
+            *d = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        }
+    }
+    drop(slots);
+    Ok(params)
+}
+
+impl GruParams {
+    /// Write the parameters to `path` under `nn.GRU`'s names (via a temporary file and a
+    /// rename), so `gru.load_state_dict(safetensors.torch.load_file(path))` accepts them.
+    pub fn save_safetensors(&self, path: &Path) -> Result<(), WeightsError> {
+        let io = |source| WeightsError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut tmp = path.as_os_str().to_owned();
+        tmp.push(".tmp");
+        std::fs::write(&tmp, gru_to_safetensors_bytes(self)).map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
+    }
+
+    /// Read a GRU from a safetensors file of a bare `nn.GRU` state_dict, e.g. written by
+    /// `safetensors.torch.save_file(gru.state_dict(), path)`; sizes come from the file (see
+    /// [`gru_from_safetensors_bytes`] for the checks).
+    pub fn load_safetensors(path: &Path) -> Result<GruParams, WeightsError> {
+        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        gru_from_safetensors_bytes(&bytes, path)
+    }
 }
 
 impl QNet {

@@ -155,7 +155,7 @@ pub fn lstm_forward(
 /// chunks copied into fixed-size local arrays (so the compiler sees no aliasing and emits plain
 /// vector code), then the H % LANES rest one lane at a time through the same function, so
 /// every lane gets bit-identical arithmetic.
-const LANES: usize = 16;
+pub(super) const LANES: usize = 16;
 
 /// The cell update for L lanes: gate pre-activations (with their bias) in, activated gates,
 /// c, tanh(c) and h out.
@@ -183,13 +183,13 @@ fn cell_lanes<const L: usize>(
 
 /// Read L values at `at`.
 #[inline(always)]
-fn rd<const L: usize>(src: &[f32], at: usize) -> [f32; L] {
+pub(super) fn rd<const L: usize>(src: &[f32], at: usize) -> [f32; L] {
     src[at..at + L].try_into().expect("slice of length L")
 }
 
 /// Write L values at `at`.
 #[inline(always)]
-fn wr<const L: usize>(dst: &mut [f32], at: usize, v: &[f32; L]) {
+pub(super) fn wr<const L: usize>(dst: &mut [f32], at: usize, v: &[f32; L]) {
     dst[at..at + L].copy_from_slice(v);
 }
 

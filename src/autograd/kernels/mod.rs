@@ -3,6 +3,7 @@
 pub mod activations;
 pub mod dense;
 pub mod gemm;
+pub mod gru;
 pub mod lstm;
 
 /// The arithmetic path this CPU takes: `avx512` (our GEMM and activations), `avx2` (matrixmultiply

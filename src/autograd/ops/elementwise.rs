@@ -1,10 +1,9 @@
-//! Elementwise ops on same-shaped arrays: sub, leaky ReLU and square (the TD loss), and add, mul,
-//! sigmoid and tanh for the tests' unfused LSTM.
+//! Elementwise ops on same-shaped arrays: add, sub, mul, scale, the activations (sigmoid, tanh,
+//! leaky ReLU), square (the TD loss), exp and log.
 
 use ndarray::{Array2, Zip};
 
 use super::{put, Op};
-#[cfg(test)]
 use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace};
 use crate::autograd::tape::{GradCx, Tape, Var};
 
@@ -30,10 +29,6 @@ impl Tape {
     }
 
     /// y = a + b (same shapes; see [`Tape::add_bias`] for broadcasting a row).
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn add(&mut self, a: Var, b: Var) -> Var {
         let y = self.binary(a, b, "add", |a, b| a + b);
         self.push_op(y, Op::Add { a, b }, &[a, b])
@@ -46,20 +41,12 @@ impl Tape {
     }
 
     /// y = a * b elementwise (same shapes).
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn mul(&mut self, a: Var, b: Var) -> Var {
         let y = self.binary(a, b, "mul", |a, b| a * b);
         self.push_op(y, Op::Mul { a, b }, &[a, b])
     }
 
     /// y = 1 / (1 + e^-x). Backward reuses the output: dy/dx = y (1 - y).
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn sigmoid(&mut self, x: Var) -> Var {
         let mut y = self.copy_of(x);
         sigmoid_inplace(y.as_slice_mut().expect("tape arrays are contiguous"));
@@ -67,10 +54,6 @@ impl Tape {
     }
 
     /// y = tanh(x). Backward reuses the output: dy/dx = 1 - y^2.
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn tanh(&mut self, x: Var) -> Var {
         let mut y = self.copy_of(x);
         tanh_inplace(y.as_slice_mut().expect("tape arrays are contiguous"));
@@ -91,10 +74,34 @@ impl Tape {
         y.mapv_inplace(|v| v * v);
         self.push_op(y, Op::Square { x }, &[x])
     }
+
+    /// y = c * x elementwise, for a constant c (a loss coefficient, a discount): x, y: [m, n].
+    pub fn scale(&mut self, x: Var, c: f32) -> Var {
+        let mut y = self.copy_of(x);
+        y.mapv_inplace(|v| c * v);
+        self.push_op(y, Op::Scale { x, c }, &[x])
+    }
+
+    /// y = e^x elementwise (libm's `f32::exp`), x, y: [m, n]. Backward reuses the output:
+    /// dy/dx = y. Overflows to +inf above x ~ 88.7; for probabilities from logits use
+    /// [`Tape::softmax`], which is stable.
+    pub fn exp(&mut self, x: Var) -> Var {
+        let mut y = self.copy_of(x);
+        y.mapv_inplace(f32::exp);
+        self.push_op(y, Op::Exp { x }, &[x])
+    }
+
+    /// y = ln(x) elementwise, x, y: [m, n]; dy/dx = 1 / x. Follows IEEE: ln(0) = -inf and a
+    /// negative x gives NaN (with an infinite or NaN gradient), so keep x > 0 (for the log of
+    /// probabilities use [`Tape::log_softmax`], which never forms them).
+    pub fn log(&mut self, x: Var) -> Var {
+        let mut y = self.copy_of(x);
+        y.mapv_inplace(f32::ln);
+        self.push_op(y, Op::Log { x }, &[x])
+    }
 }
 
 // d(a + b) = da + db
-#[cfg(test)]
 pub(super) fn add_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     for v in [a, b] {
         if let Some((d, mode)) = cx.slot(v) {
@@ -114,7 +121,6 @@ pub(super) fn sub_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
 }
 
 // d(a * b) = b da + a db (a fan-out mul(x, x) gets both terms: 2 x dx)
-#[cfg(test)]
 pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     let (va, vb) = (cx.value(a), cx.value(b));
     if let Some((d, mode)) = cx.slot(a) {
@@ -126,7 +132,6 @@ pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
 }
 
 // dy/dx = y (1 - y)
-#[cfg(test)]
 pub(super) fn sigmoid_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         put!(mode, d, g, y; |g, y| g * y * (1.0 - y));
@@ -134,7 +139,6 @@ pub(super) fn sigmoid_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mu
 }
 
 // dy/dx = 1 - y^2
-#[cfg(test)]
 pub(super) fn tanh_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         put!(mode, d, g, y; |g, y| g * (1.0 - y * y));
@@ -154,6 +158,28 @@ pub(super) fn square_backward(x: Var, g: &Array2<f32>, cx: &mut GradCx) {
     let vx = cx.value(x);
     if let Some((d, mode)) = cx.slot(x) {
         put!(mode, d, g, vx; |g, x| 2.0 * x * g);
+    }
+}
+
+// dy/dx = c
+pub(super) fn scale_backward(x: Var, c: f32, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g; |g| c * g);
+    }
+}
+
+// dy/dx = e^x = y
+pub(super) fn exp_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g, y; |g, y| g * y);
+    }
+}
+
+// dy/dx = 1 / x
+pub(super) fn log_backward(x: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    let vx = cx.value(x);
+    if let Some((d, mode)) = cx.slot(x) {
+        put!(mode, d, g, vx; |g, x| g / x);
     }
 }
 
@@ -255,6 +281,81 @@ mod tests {
             &[(3, 2)],
             Inputs::AwayFromZero,
         );
+    }
+
+    #[test]
+    fn scale_matches_finite_differences() {
+        grad_check(|t, v| t.scale(v[0], -2.5), &[(3, 4)], Inputs::Any);
+    }
+
+    #[test]
+    fn exp_matches_finite_differences() {
+        grad_check(|t, v| t.exp(v[0]), &[(3, 4)], Inputs::Any);
+    }
+
+    #[test]
+    fn log_matches_finite_differences() {
+        // ln needs x > 0: take the log of e^x, which is x again (d/dx = 1 through both ops),
+        // and of x^2 + 0.5 away from zero: d/dx ln(x^2 + 0.5) = 2x / (x^2 + 0.5).
+        grad_check(
+            |t, v| {
+                let e = t.exp(v[0]);
+                t.log(e)
+            },
+            &[(2, 3)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let sq = t.square(v[0]);
+                let half = t.constant(ndarray::Array2::from_elem((3, 2), 0.5).view());
+                let pos = t.add(sq, half);
+                t.log(pos)
+            },
+            &[(3, 2)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn exp_log_and_scale_fan_out_match_finite_differences() {
+        // y = e^x * x, ln(e^x) - x (= 0, the terms cancel), c x + x.
+        grad_check(
+            |t, v| {
+                let e = t.exp(v[0]);
+                t.mul(e, v[0])
+            },
+            &[(3, 3)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let e = t.exp(v[0]);
+                let l = t.log(e);
+                t.sub(l, v[0])
+            },
+            &[(2, 3)],
+            Inputs::Any,
+        );
+        grad_check(
+            |t, v| {
+                let s = t.scale(v[0], 0.3);
+                t.add(s, v[0])
+            },
+            &[(2, 2)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn log_of_zero_is_minus_infinity_and_exp_inverts_log() {
+        let mut t = crate::autograd::Tape::new();
+        let x = t.constant(ndarray::arr2(&[[0.0f32, 1.0, 2.0]]).view());
+        let l = t.log(x);
+        assert_eq!(t.value(l)[[0, 0]], f32::NEG_INFINITY);
+        assert_eq!(t.value(l)[[0, 1]], 0.0);
+        let e = t.exp(l);
+        assert!((t.value(e)[[0, 2]] - 2.0).abs() < 1e-6);
     }
 
     #[test]

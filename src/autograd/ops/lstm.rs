@@ -40,12 +40,8 @@ impl Tape {
     /// h for every valid position of every sequence, each unrolled from a zero state
     /// (spec `algorithms.md` 2.3). x: [K, in] in flat (sequence, time) order with
     /// K = packing.total(); result [K, H] in the same order. Reorders rows around
-    /// [`Tape::lstm_packed`].
-    ///
-    /// Test-only: the Q-net stays in packed order throughout and calls `lstm_packed` itself;
-    /// this flat-order form is what the tests compare with the step-by-step LSTM and the
-    /// unfused composition.
-    #[cfg(test)]
+    /// [`Tape::lstm_packed`] (the Q-net stays in packed order throughout and calls
+    /// `lstm_packed` itself, saving the two gathers).
     pub fn lstm(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {
         let xp = self.gather_rows(x, packing.packed_to_flat());
         let yp = self.lstm_packed(xp, w, packing);

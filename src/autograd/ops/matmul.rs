@@ -1,25 +1,26 @@
-//! The fused linear layer act(x · W^T + b) the nets use, and for the tests' unfused compositions
-//! its parts: the product against a transposed weight and the broadcast bias add.
+//! Matrix products: plain a · b, a · w^T against PyTorch's weight layout, the broadcast bias
+//! add, and the fused linear layer act(x · W^T + b) the nets use (checked against its parts).
 
-use ndarray::Array2;
-#[cfg(test)]
-use ndarray::{ArrayView2, Axis};
+use ndarray::{Array2, ArrayView2, Axis};
 
 use super::{put, Op};
 use crate::autograd::kernels::dense::{act_backward_rows, add_column_sums, linear_forward};
-use crate::autograd::kernels::gemm::gemm;
-#[cfg(test)]
-use crate::autograd::kernels::gemm::Mode;
+use crate::autograd::kernels::gemm::{gemm, Mode};
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 use crate::autograd::kernels::dense::Activation;
 
 impl Tape {
+    /// y = a · b with a: [m, k], b: [k, n], y: [m, n]. Panics if the inner sizes differ.
+    pub fn matmul(&mut self, a: Var, b: Var) -> Var {
+        let ((m, k), (k2, n)) = (self.shape(a), self.shape(b));
+        assert_eq!(k, k2, "matmul: [{m}, {k}] · [{k2}, {n}]");
+        let mut y = self.pool().array(m, n);
+        gemm(self.value(a), self.value(b), y.view_mut(), Mode::Overwrite);
+        self.push_op(y, Op::MatMul { a, b }, &[a, b])
+    }
+
     /// y = a · w^T with a: [m, k], w: [n, k] (PyTorch's Linear weight layout).
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn matmul_nt(&mut self, a: Var, w: Var) -> Var {
         let ((m, k), (n, k2)) = (self.shape(a), self.shape(w));
         assert_eq!(k, k2, "matmul_nt: [{m}, {k}] · [{n}, {k2}]^T");
@@ -34,10 +35,6 @@ impl Tape {
     }
 
     /// y = x + bias, the [1, n] row `bias` added to every row of x: [m, n].
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn add_bias(&mut self, x: Var, bias: Var) -> Var {
         let ((m, n), bs) = (self.shape(x), self.shape(bias));
         assert_eq!(bs, (1, n), "add_bias: bias must be [1, {n}], got {bs:?}");
@@ -66,8 +63,18 @@ impl Tape {
     }
 }
 
+// y = a b: da = g b^T, db = a^T g
+pub(super) fn matmul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    let (va, vb) = (cx.value(a), cx.value(b));
+    if let Some((d, mode)) = cx.slot(a) {
+        gemm(g.view(), vb.t(), d.view_mut(), mode);
+    }
+    if let Some((d, mode)) = cx.slot(b) {
+        gemm(va.t(), g.view(), d.view_mut(), mode);
+    }
+}
+
 // y = a w^T: da = g w, dw = g^T a
-#[cfg(test)]
 pub(super) fn matmul_nt_backward(a: Var, w: Var, g: &Array2<f32>, cx: &mut GradCx) {
     let (va, vw) = (cx.value(a), cx.value(w));
     if let Some((d, mode)) = cx.slot(a) {
@@ -79,7 +86,6 @@ pub(super) fn matmul_nt_backward(a: Var, w: Var, g: &Array2<f32>, cx: &mut GradC
 }
 
 /// dst (=|+=) the column sums of g, dst: [1, n] (the bias gradient of `add_bias`).
-#[cfg(test)]
 fn column_sums_into(g: ArrayView2<f32>, dst: &mut Array2<f32>, mode: Mode) {
     let dst = dst.as_slice_mut().expect("tape arrays are contiguous");
     if mode == Mode::Overwrite {
@@ -98,7 +104,6 @@ fn column_sums_into(g: ArrayView2<f32>, dst: &mut Array2<f32>, mode: Mode) {
 }
 
 // y = x + 1 b: dx = g, db = column sums of g
-#[cfg(test)]
 pub(super) fn add_bias_backward(x: Var, bias: Var, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         put!(mode, d, g; |g| g);
@@ -156,6 +161,27 @@ pub(super) fn linear_backward(
 mod tests {
     use super::super::grad_check::{grad_check, Inputs};
     use super::*;
+
+    #[test]
+    fn matmul_matches_finite_differences() {
+        grad_check(|t, v| t.matmul(v[0], v[1]), &[(4, 3), (3, 5)], Inputs::Any);
+    }
+
+    #[test]
+    fn matmul_fan_out_matches_finite_differences() {
+        // x x with x square: both factors are the same node.
+        grad_check(|t, v| t.matmul(v[0], v[0]), &[(3, 3)], Inputs::Any);
+    }
+
+    #[test]
+    fn matmul_multiplies_rows_by_columns() {
+        // [1 2; 3 4] [5; 6] = [17; 39]
+        let mut t = Tape::new();
+        let a = t.constant(ndarray::arr2(&[[1.0f32, 2.0], [3.0, 4.0]]).view());
+        let b = t.constant(ndarray::arr2(&[[5.0f32], [6.0]]).view());
+        let y = t.matmul(a, b);
+        assert_eq!(t.value(y), ndarray::arr2(&[[17.0f32], [39.0]]));
+    }
 
     #[test]
     fn matmul_nt_matches_finite_differences() {

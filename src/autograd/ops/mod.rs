@@ -1,12 +1,27 @@
 //! The differentiable operations. Each file defines its ops' forward (as `Tape` methods) next to
 //! their backward; this module only names them and dispatches the reverse pass.
+//!
+//! Every op is public on [`Tape`](super::Tape), with the shapes it takes in its doc comment:
+//!
+//! | file | ops |
+//! | --- | --- |
+//! | `elementwise.rs` | `add`, `sub`, `mul`, `scale`, `sigmoid`, `tanh`, `leaky_relu`, `square`, `exp`, `log` |
+//! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `linear` (fused) |
+//! | `softmax.rs` | `softmax`, `log_softmax`, `logsumexp` (row-wise) |
+//! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows` |
+//! | `reduce.rs` | `sum`, `mean`, `masked_mean` |
+//! | `lstm.rs` | `lstm`, `lstm_packed` (fused, over packed sequences) |
+//! | `gru.rs` | `gru`, `gru_packed` (fused, over packed sequences) |
 
 mod elementwise;
+mod gru;
 mod lstm;
 mod matmul;
 mod reduce;
 mod shape;
+mod softmax;
 
+pub use gru::GruVars;
 pub use lstm::LstmVars;
 
 use ndarray::Array2;
@@ -19,12 +34,14 @@ use super::tape::{GradCx, Var};
 pub(crate) enum Op {
     /// Parameter, constant, or an op's cache: nothing to propagate.
     Leaf,
-    #[cfg(test)]
+    MatMul {
+        a: Var,
+        b: Var,
+    },
     MatMulNt {
         a: Var,
         b: Var,
     },
-    #[cfg(test)]
     AddBias {
         x: Var,
         bias: Var,
@@ -35,7 +52,6 @@ pub(crate) enum Op {
         b: Var,
         act: Activation,
     },
-    #[cfg(test)]
     Add {
         a: Var,
         b: Var,
@@ -44,16 +60,17 @@ pub(crate) enum Op {
         a: Var,
         b: Var,
     },
-    #[cfg(test)]
     Mul {
         a: Var,
         b: Var,
     },
-    #[cfg(test)]
+    Scale {
+        x: Var,
+        c: f32,
+    },
     Sigmoid {
         x: Var,
     },
-    #[cfg(test)]
     Tanh {
         x: Var,
     },
@@ -64,11 +81,27 @@ pub(crate) enum Op {
     Square {
         x: Var,
     },
-    #[cfg(test)]
+    Exp {
+        x: Var,
+    },
+    Log {
+        x: Var,
+    },
+    Softmax {
+        x: Var,
+    },
+    LogSoftmax {
+        x: Var,
+    },
+    LogSumExp {
+        x: Var,
+    },
     ConcatRows {
         parts: Vec<Var>,
     },
-    #[cfg(test)]
+    ConcatCols {
+        parts: Vec<Var>,
+    },
     SliceCols {
         x: Var,
         start: usize,
@@ -81,10 +114,18 @@ pub(crate) enum Op {
         x: Var,
         index: Vec<usize>,
     },
+    Sum {
+        x: Var,
+    },
     Mean {
         x: Var,
     },
+    MaskedMean {
+        x: Var,
+        mask: Var,
+    },
     Lstm(Box<lstm::LstmNode>),
+    Gru(Box<gru::GruNode>),
 }
 
 impl Op {
@@ -93,30 +134,33 @@ impl Op {
     pub(crate) fn backward(&self, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
         match self {
             Op::Leaf => {}
-            #[cfg(test)]
+            Op::MatMul { a, b } => matmul::matmul_backward(*a, *b, g, cx),
             Op::MatMulNt { a, b } => matmul::matmul_nt_backward(*a, *b, g, cx),
-            #[cfg(test)]
             Op::AddBias { x, bias } => matmul::add_bias_backward(*x, *bias, g, cx),
             Op::Linear { x, w, b, act } => matmul::linear_backward(*x, *w, *b, *act, y, g, cx),
-            #[cfg(test)]
             Op::Add { a, b } => elementwise::add_backward(*a, *b, g, cx),
             Op::Sub { a, b } => elementwise::sub_backward(*a, *b, g, cx),
-            #[cfg(test)]
             Op::Mul { a, b } => elementwise::mul_backward(*a, *b, g, cx),
-            #[cfg(test)]
+            Op::Scale { x, c } => elementwise::scale_backward(*x, *c, g, cx),
             Op::Sigmoid { x } => elementwise::sigmoid_backward(*x, y, g, cx),
-            #[cfg(test)]
             Op::Tanh { x } => elementwise::tanh_backward(*x, y, g, cx),
             Op::LeakyRelu { x, slope } => elementwise::leaky_relu_backward(*x, *slope, g, cx),
             Op::Square { x } => elementwise::square_backward(*x, g, cx),
-            #[cfg(test)]
+            Op::Exp { x } => elementwise::exp_backward(*x, y, g, cx),
+            Op::Log { x } => elementwise::log_backward(*x, g, cx),
+            Op::Softmax { x } => softmax::softmax_backward(*x, y, g, cx),
+            Op::LogSoftmax { x } => softmax::log_softmax_backward(*x, y, g, cx),
+            Op::LogSumExp { x } => softmax::logsumexp_backward(*x, y, g, cx),
             Op::ConcatRows { parts } => shape::concat_rows_backward(parts, g, cx),
-            #[cfg(test)]
+            Op::ConcatCols { parts } => shape::concat_cols_backward(parts, g, cx),
             Op::SliceCols { x, start } => shape::slice_cols_backward(*x, *start, g, cx),
             Op::GatherCols { x, index } => shape::gather_cols_backward(*x, index, g, cx),
             Op::GatherRows { x, index } => shape::gather_rows_backward(*x, index, g, cx),
+            Op::Sum { x } => reduce::sum_backward(*x, g, cx),
             Op::Mean { x } => reduce::mean_backward(*x, g, cx),
+            Op::MaskedMean { x, mask } => reduce::masked_mean_backward(*x, *mask, g, cx),
             Op::Lstm(node) => node.backward(g, cx),
+            Op::Gru(node) => node.backward(g, cx),
         }
     }
 }

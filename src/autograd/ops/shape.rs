@@ -1,11 +1,8 @@
-//! Ops that move values without arithmetic: concatenation and slicing along features, row
-//! concatenation, and gathers (Q of the chosen action, row selection).
+//! Ops that move values without arithmetic: concatenation along rows and along features,
+//! slicing features, and gathers (Q of the chosen action, row selection).
 
-#[cfg(test)]
-use ndarray::s;
-use ndarray::{Array2, Axis};
+use ndarray::{s, Array2, Axis};
 
-#[cfg(test)]
 use super::put;
 use super::Op;
 use crate::autograd::kernels::gemm::Mode;
@@ -13,10 +10,6 @@ use crate::autograd::tape::{GradCx, Tape, Var};
 
 impl Tape {
     /// y = [a; b; ...] stacked along rows. Panics if the column counts differ or `parts` is empty.
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn concat_rows(&mut self, parts: &[Var]) -> Var {
         assert!(!parts.is_empty(), "concat_rows: no parts");
         let cols = self.shape(parts[0]).1;
@@ -42,11 +35,34 @@ impl Tape {
         )
     }
 
+    /// y = [a, b, ...] side by side: parts [m, n_i] give y [m, sum n_i] (e.g. an observation
+    /// beside a one-hot of the last action). Panics if the row counts differ or `parts` is empty.
+    pub fn concat_cols(&mut self, parts: &[Var]) -> Var {
+        assert!(!parts.is_empty(), "concat_cols: no parts");
+        let rows = self.shape(parts[0]).0;
+        let mut cols = 0;
+        for &p in parts {
+            let (r, c) = self.shape(p);
+            assert_eq!(r, rows, "concat_cols: row counts differ");
+            cols += c;
+        }
+        let mut y = self.pool().array(rows, cols);
+        let mut at = 0;
+        for &p in parts {
+            let c = self.shape(p).1;
+            y.slice_mut(s![.., at..at + c]).assign(&self.value(p));
+            at += c;
+        }
+        self.push_op(
+            y,
+            Op::ConcatCols {
+                parts: parts.to_vec(),
+            },
+            parts,
+        )
+    }
+
     /// y = x[:, start..end]. Panics if the range is out of bounds.
-    ///
-    /// Test-only: an elementary op of the unfused compositions that check the fused ops (the
-    /// LSTM, the linear layer), as a fused op keeps its unfused composition as its test oracle.
-    #[cfg(test)]
     pub fn slice_cols(&mut self, x: Var, start: usize, end: usize) -> Var {
         let (rows, cols) = self.shape(x);
         assert!(
@@ -102,7 +118,6 @@ impl Tape {
 }
 
 // Each part receives its block of rows of g.
-#[cfg(test)]
 pub(super) fn concat_rows_backward(parts: &[Var], g: &Array2<f32>, cx: &mut GradCx) {
     let mut at = 0;
     for &p in parts {
@@ -114,8 +129,19 @@ pub(super) fn concat_rows_backward(parts: &[Var], g: &Array2<f32>, cx: &mut Grad
     }
 }
 
+// Each part receives its block of columns of g.
+pub(super) fn concat_cols_backward(parts: &[Var], g: &Array2<f32>, cx: &mut GradCx) {
+    let mut at = 0;
+    for &p in parts {
+        let c = cx.value(p).ncols();
+        if let Some((d, mode)) = cx.slot(p) {
+            put!(mode, d, g.slice(s![.., at..at + c]); |g| g);
+        }
+        at += c;
+    }
+}
+
 // dx[:, start..end] += g, zero elsewhere.
-#[cfg(test)]
 pub(super) fn slice_cols_backward(x: Var, start: usize, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         if mode == Mode::Overwrite {
@@ -161,6 +187,28 @@ mod tests {
             |t, v| t.concat_rows(&[v[0], v[1], v[0]]),
             &[(2, 3), (1, 3)],
             Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn concat_cols_matches_finite_differences() {
+        // v[0] appears twice: its gradient is the sum of its two column blocks.
+        grad_check(
+            |t, v| t.concat_cols(&[v[0], v[1], v[0]]),
+            &[(3, 2), (3, 1)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn concat_cols_places_parts_side_by_side() {
+        let mut t = crate::autograd::Tape::new();
+        let a = t.constant(ndarray::arr2(&[[1.0f32], [2.0]]).view());
+        let b = t.constant(ndarray::arr2(&[[3.0f32, 4.0], [5.0, 6.0]]).view());
+        let y = t.concat_cols(&[a, b]);
+        assert_eq!(
+            t.value(y),
+            ndarray::arr2(&[[1.0f32, 3.0, 4.0], [2.0, 5.0, 6.0]])
         );
     }
 
