@@ -73,9 +73,49 @@ pub enum FirstRecordObs {
 ///
 /// This is the public trait a new domain implements to be trained by every method
 /// ([`crate::train`]): the step contract below plus what the learner and the plots need to know
-/// about the domain (the first record's observation rule, whether greedy evaluation is
-/// deterministic, the optimal return if known, display names of observations and actions).
-/// Nothing else in the crate matches on a domain's name to learn these.
+/// about the domain. Nothing else in the crate matches on a domain's name to learn these.
+///
+/// # The contract
+///
+/// - **Time.** An episode is a sequence of primitive steps. [`Self::reset`] starts one (t = 0,
+///   every agent free, [`Self::mac_done`] all true, [`Self::executed`] unspecified);
+///   [`Self::step`] advances it by exactly one primitive step and [`Self::t`] counts them.
+/// - **Macro-actions.** Agent i is *free* when its previous macro-action finished (after reset,
+///   every agent is). At each step the caller passes one action per agent; the entry of a free
+///   agent starts that macro-action (an out-of-range one is [`EnvError::ActionOutOfRange`] and
+///   the step changes nothing), the entry of a busy agent is ignored and may hold any value. A
+///   macro-action may last one step or many; its duration is the domain's business.
+/// - **After a step**, [`Self::executed`]`[i]` is the macro-action agent i ran during it (the
+///   one it started now, or the one it keeps running), and [`Self::mac_done`]`[i]` says whether
+///   that macro-action *ended at this step*: agent i is then free at the next step
+///   ([`Self::is_free`]). Learners build their macro-level transitions from exactly these flags:
+///   a macro-action starts at the step after a `mac_done` of its agent and ends at the next one.
+/// - **Observations are held.** [`Self::obs`]`(i)` is agent i's macro-observation: it must
+///   change only at steps where `mac_done[i]` is true (and at reset), because agent i perceives
+///   only when its macro-action ends; in between it keeps the observation it last received.
+///   What a decentralized policy sees is exactly this slice, so nothing else of the state may
+///   leak into it. Sizes are fixed ([`Self::obs_sizes`]).
+/// - **Reward** ([`StepOutcome::reward`]) is one shared team reward per primitive step; the
+///   learners sum it over a macro-action themselves.
+/// - **Episode end.** [`StepOutcome::done`] is true on the step the episode ends: a terminal
+///   state, or the horizon ([`Self::horizon`] primitive steps, which the domain enforces; the
+///   ICRA learners treat the horizon cut as terminal, quirk Q7). At `done`, every agent's
+///   macro-action counts as ended for its final transition only if `mac_done` says so; an
+///   unfinished one is dropped by the learners (spec Q6). After `done`, [`Self::step`] is
+///   [`EnvError::EpisodeOver`] until [`Self::reset`].
+/// - **Randomness** comes only from the `rng` passed in, so a run is reproducible from its seed
+///   and a checkpoint can hold the stream. A domain that draws nothing should say so through
+///   [`Self::deterministic`].
+/// - **Stepping should not allocate**: observations live in buffers the domain owns.
+///
+/// The optional methods: [`Self::first_record_obs`] says what the first record of an episode
+/// holds as its "before" observation ([`FirstRecordObs::Reset`], the observation reset handed
+/// out, for any domain whose first step does not rewrite that list in place);
+/// [`Self::deterministic`] (default true) lets evaluation run one greedy episode instead of
+/// `eval_num_epi`, so it must be false if any step draws from the rng;
+/// [`Self::optimal_return`] is the best return under a per-step discount where it is known (the
+/// plots' optimal line); [`Self::describe`] titles figures. A domain implementing this trait
+/// correctly needs nothing else from `src/` to train with every method.
 pub trait MacroEnv {
     /// Number of agents (Box Pushing 2, Warehouse 3).
     fn n_agents(&self) -> usize;
