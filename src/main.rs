@@ -6,6 +6,7 @@ use macdec::algos::method::Method;
 use macdec::bench::nets;
 use macdec::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use macdec::experiment::policy_files::NetRole;
+use macdec::experiment::results_tree;
 use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
 use macdec::experiment::seeds::parse_seeds;
 use macdec::experiment::slurm::{job_script, SlurmOptions};
@@ -603,7 +604,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     let labels: Vec<String> = experiment
         .runs()?
         .iter()
-        .map(|r| format!("{}/seed-{}", r.curve_name(), r.seed))
+        .map(|r| results_tree::run_label(&r.curve_name(), r.seed))
         .collect();
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     let config = absolute(config);
@@ -798,7 +799,7 @@ fn bench_envs() -> Result<()> {
 /// with what it is (a custom domain's by name: the binary cannot simulate it).
 fn refuse_policy_dir_as_run(dir: &Path) -> Result<()> {
     use macdec::deploy::manifest::{Manifest, MANIFEST_FILE};
-    let run_policy = dir.join(macdec::experiment::policy_files::POLICY_DIR);
+    let run_policy = dir.join(results_tree::POLICY_DIR);
     if !dir.join(MANIFEST_FILE).is_file() || run_policy.exists() {
         return Ok(());
     }
@@ -837,10 +838,7 @@ fn policy_factory(
 fn export(run: &Path, out: &Path) -> Result<()> {
     let manifest = macdec::deploy::export::export_run(run, out)
         .with_context(|| format!("exporting {} to {}", run.display(), out.display()))?;
-    if !run
-        .join(macdec::experiment::runner::FINISHED_MARKER)
-        .exists()
-    {
+    if !results_tree::is_finished(run) {
         eprintln!(
             "warning: {} has not finished training: exported its nets after {} episodes",
             run.display(),

@@ -245,7 +245,8 @@ checkpoint_freq = 40
 fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluation() {
     use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
     use macdec::envs::MacroEnv;
-    use macdec::experiment::train_run::{load_checkpoint, CHECKPOINT};
+    use macdec::experiment::results_tree::CHECKPOINT;
+    use macdec::experiment::train_run::load_checkpoint;
 
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("tiny.toml");

@@ -4,7 +4,8 @@
 //! version adds or carries keys this version does not know.
 
 use macdec::experiment::policy_files::{read_policy_files, NetRole, POLICY_DIR, POLICY_FILE};
-use macdec::experiment::train_run::{load_checkpoint, CHECKPOINT};
+use macdec::experiment::results_tree::CHECKPOINT;
+use macdec::experiment::train_run::load_checkpoint;
 use std::path::Path;
 use std::process::Command;
 

@@ -10,8 +10,9 @@
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics::{self, MetricsError};
 use crate::experiment::provenance::Provenance;
-use crate::experiment::runner::{Progress, FINISHED_MARKER};
-use crate::experiment::train_run::{train_run, RunError, RunManifest, CONFIG};
+use crate::experiment::results_tree::{self, CONFIG};
+use crate::experiment::runner::Progress;
+use crate::experiment::train_run::{train_run, RunError, RunManifest};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use std::path::{Path, PathBuf};
@@ -97,7 +98,7 @@ pub fn finished_runs(results: &Path) -> Result<Vec<PathBuf>, AuditError> {
     for exp in subdirs(results).map_err(read_err(results))? {
         for curve in subdirs(&exp).map_err(read_err(&exp))? {
             for run in subdirs(&curve).map_err(read_err(&curve))? {
-                if run.join(FINISHED_MARKER).is_file() && run.join(CONFIG).is_file() {
+                if results_tree::is_finished(&run) && run.join(CONFIG).is_file() {
                     runs.push(run);
                 }
             }
@@ -145,7 +146,7 @@ pub fn read_manifest(dir: &Path) -> Result<RunManifest, AuditError> {
 /// Retrain the run in `dir` inside `scratch` (which must not hold another run) and compare.
 pub fn audit_run(dir: &Path, scratch: &Path) -> Result<RunAudit, AuditError> {
     let committed_path = metrics::locate(dir)
-        .filter(|_| dir.join(FINISHED_MARKER).is_file())
+        .filter(|_| results_tree::is_finished(dir))
         .ok_or_else(|| AuditError::NotARun {
             dir: dir.to_path_buf(),
         })?;

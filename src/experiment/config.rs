@@ -12,6 +12,7 @@ use crate::envs::flags::{check_spec, EnvName, DEFAULT_GRID_DIM};
 use crate::envs::EnvSpec;
 use crate::experiment::limits;
 use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
+use crate::experiment::results_tree;
 use crate::experiment::run_settings::RunSettings;
 use crate::experiment::seeds::{check_seed_list, parse_seeds, SeedsError};
 use serde::Deserialize;
@@ -106,10 +107,12 @@ pub struct RunSpec {
 impl RunSpec {
     /// The run's directory below the results root: `<experiment>/<method>[@<variant>]/seed-<k>`.
     pub fn dir(&self, results_root: &Path) -> PathBuf {
-        results_root
-            .join(&self.experiment)
-            .join(self.curve_name())
-            .join(format!("seed-{}", self.seed))
+        results_tree::run_dir(
+            results_root,
+            &self.experiment,
+            &self.curve_name(),
+            self.seed,
+        )
     }
 
     /// The name of the curve this run belongs to: the method, plus the sweep point if any.
@@ -138,7 +141,7 @@ pub struct Experiment {
 
 /// The file in `<results>/<experiment>/` naming the curves that live in another experiment's
 /// directory (`our2 = "fig5_wtd"`), written by `macdec train` and read by `macdec plot`.
-pub const SHARED_CURVES_FILE: &str = "shared_curves.toml";
+pub use crate::experiment::results_tree::SHARED_CURVES as SHARED_CURVES_FILE;
 
 /// The command-line overrides of `macdec train`.
 #[derive(Debug, Clone, Default)]

@@ -12,6 +12,7 @@ pub mod paper;
 pub mod policy_files;
 pub mod provenance;
 pub mod report;
+pub mod results_tree;
 pub mod rollout;
 pub mod run_settings;
 pub mod runner;

@@ -31,7 +31,7 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 /// The policy directory inside a run directory.
-pub const POLICY_DIR: &str = "policy";
+pub use crate::experiment::results_tree::POLICY_DIR;
 /// The description file inside [`POLICY_DIR`].
 pub const POLICY_FILE: &str = "policy.json";
 /// The `format` tag of [`POLICY_FILE`].

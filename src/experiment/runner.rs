@@ -7,14 +7,12 @@
 //! run, naming the keys that differ.
 
 use crate::experiment::config::RunSpec;
+use crate::experiment::results_tree;
 use crate::experiment::train_run::{existing_run, Existing};
 use crate::experiment::work_queue::run_in_order;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-
-/// The marker a run writes when its last metrics row is on disk.
-pub const FINISHED_MARKER: &str = "finished";
 
 /// How to run a batch of runs.
 #[derive(Debug, Clone)]
@@ -84,10 +82,9 @@ impl Progress {
 /// `experiment/curve/seed-k`, as progress lines name a run.
 fn run_name(spec: &RunSpec) -> String {
     format!(
-        "{}/{}/seed-{}",
+        "{}/{}",
         spec.experiment,
-        spec.curve_name(),
-        spec.seed
+        results_tree::run_label(&spec.curve_name(), spec.seed)
     )
 }
 
@@ -162,7 +159,7 @@ where
             ProgressStyle::with_template("{prefix:32} {bar:20} {pos}/{len} {msg}")
                 .expect("valid template"),
         );
-        bar.set_prefix(format!("{}/seed-{}", spec.curve_name(), spec.seed));
+        bar.set_prefix(results_tree::run_label(&spec.curve_name(), spec.seed));
         let progress = Progress {
             bar: bar.clone(),
             total: total.clone(),
@@ -300,16 +297,17 @@ mod tests {
 
     /// What a finished run leaves: its config.toml and the marker.
     fn finish(spec: &RunSpec, dir: &Path) {
-        use crate::experiment::train_run::{RunManifest, CONFIG};
+        use crate::experiment::results_tree::{CONFIG, FINISHED};
+        use crate::experiment::train_run::RunManifest;
         std::fs::create_dir_all(dir).unwrap();
         let text = toml::to_string(&RunManifest::for_spec(spec)).unwrap();
         std::fs::write(dir.join(CONFIG), text).unwrap();
-        std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();
+        std::fs::write(dir.join(FINISHED), "").unwrap();
     }
 
     #[test]
     fn a_finished_run_of_another_config_is_refused_naming_the_keys_but_provenance_is_ignored() {
-        use crate::experiment::train_run::CONFIG;
+        use crate::experiment::results_tree::CONFIG;
         let dir = tempfile::tempdir().unwrap();
         let opts = RunnerOptions {
             out: dir.path().to_path_buf(),

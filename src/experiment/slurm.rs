@@ -127,7 +127,7 @@ pub fn job_script(
         no_control("run label", label)?;
         let (curve, seed) = label.split_once('/').unwrap_or((label, ""));
         check_curve_name(curve)?;
-        if !seed.starts_with("seed-") || !seed[5..].chars().all(|c| c.is_ascii_digit()) {
+        if crate::experiment::results_tree::parse_seed_dir(seed).is_none() {
             return Err(SlurmError::BadValue {
                 what: "run label",
                 value: label.clone(),

@@ -20,16 +20,12 @@ use crate::experiment::policy_files::{
     write_policy_files, NetRole, PolicyFilesError, RunPolicyInfo,
 };
 use crate::experiment::provenance::Provenance;
+use crate::experiment::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
 use crate::experiment::run_settings::RunSettings;
-use crate::experiment::runner::{Progress, RunEnd, FINISHED_MARKER};
+use crate::experiment::runner::{Progress, RunEnd};
 use crate::experiment::seeds::{stream, Role};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-
-/// The checkpoint file of a run.
-pub const CHECKPOINT: &str = "checkpoint.bin";
-/// The resolved config of a run.
-pub const CONFIG: &str = "config.toml";
 
 /// What a run directory's `config.toml` holds: who ran and with which hyperparameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -121,7 +117,7 @@ pub enum Existing {
 /// without a config is an error naming the problem and pointing at `--force`.
 pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
     let config_path = dir.join(CONFIG);
-    let finished = dir.join(FINISHED_MARKER).exists();
+    let finished = results_tree::is_finished(dir);
     if !config_path.exists() {
         if finished {
             return Err(RunError::UnreadableRun {
@@ -149,9 +145,6 @@ pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
         Existing::Unfinished
     })
 }
-
-/// The file a training process holds an exclusive lock on while it trains a run.
-pub const LOCK: &str = ".lock";
 
 /// Take the run's lock, creating its directory: two processes training one run (a campaign
 /// started twice, a Slurm task beside a local run) would interleave their checkpoints and
@@ -392,7 +385,7 @@ pub fn train_run(
     save_metrics(dir, &trainer)?;
     save_checkpoint(&checkpoint, &identity, &mut trainer)?;
     save_policy_files(dir, spec, &trainer)?;
-    let marker = dir.join(FINISHED_MARKER);
+    let marker = dir.join(FINISHED);
     write_atomic(&marker, b"").map_err(|e| io(&marker, e))?;
     Ok(RunEnd::Trained)
 }

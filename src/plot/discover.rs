@@ -11,13 +11,13 @@ use super::setting::EnvSetting;
 use crate::algos::method::Method;
 use crate::experiment::metrics::{self, MetricsError};
 use crate::experiment::provenance::Provenance;
-use crate::experiment::runner::FINISHED_MARKER;
+use crate::experiment::results_tree;
 use std::path::{Path, PathBuf};
 
 pub use crate::experiment::config::SHARED_CURVES_FILE;
 pub use crate::experiment::metrics::METRICS_FILE;
 /// The file each run writes its resolved config to.
-pub const CONFIG_FILE: &str = "config.toml";
+pub use crate::experiment::results_tree::CONFIG as CONFIG_FILE;
 
 /// One run's learning curve and what a figure needs to know about it.
 #[derive(Debug, Clone, PartialEq)]
@@ -215,9 +215,7 @@ enum RunProblem {
 
 fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
     let name = file_name(dir);
-    let seed = name
-        .strip_prefix("seed-")
-        .and_then(|s| s.parse::<u64>().ok())
+    let seed = results_tree::parse_seed_dir(&name)
         .ok_or_else(|| RunProblem::Skip("not a seed-<k> directory".into()))?;
     let Some(metrics_path) = metrics::locate(dir) else {
         return Err(RunProblem::Skip(format!("no {METRICS_FILE}")));
@@ -275,7 +273,7 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
         seed,
         dir: dir.to_path_buf(),
         points: rows.iter().map(|r| (r.episode, r.eval_return)).collect(),
-        finished: dir.join(FINISHED_MARKER).exists(),
+        finished: results_tree::is_finished(dir),
         wall_seconds: rows.last().map_or(0.0, |r| r.wall_seconds),
         setting,
         provenance,
@@ -328,7 +326,7 @@ pub(crate) mod tests {
         let dir = root
             .join(experiment)
             .join(curve)
-            .join(format!("seed-{seed}"));
+            .join(results_tree::seed_dir_name(seed));
         std::fs::create_dir_all(&dir).unwrap();
         let rows: Vec<MetricsRow> = points
             .iter()
@@ -346,7 +344,7 @@ pub(crate) mod tests {
         let config = RunSettings::paper(env, Method::Our1);
         std::fs::write(dir.join(CONFIG_FILE), toml::to_string(&config).unwrap()).unwrap();
         if finished {
-            std::fs::write(dir.join(FINISHED_MARKER), "").unwrap();
+            std::fs::write(dir.join(results_tree::FINISHED), "").unwrap();
         }
         dir
     }

@@ -1,0 +1,85 @@
+//! The results tree, named once: `<root>/<experiment>/<curve>/seed-<k>/` and the files of a run
+//! directory. Training writes this layout, and plotting, auditing, exporting, rendering and Slurm
+//! read it; each of them asks here for a path or a name instead of spelling it.
+
+use std::path::{Path, PathBuf};
+
+/// A run's resolved config (its identity, domain, hyperparameters and provenance).
+pub const CONFIG: &str = "config.toml";
+/// A run's learning curve, see [`crate::experiment::metrics`].
+pub use crate::experiment::metrics::{METRICS_FILE, METRICS_FILE_GZ};
+/// The whole training loop, for resuming only (never committed).
+pub const CHECKPOINT: &str = "checkpoint.bin";
+/// The run's nets as policy files, see [`crate::experiment::policy_files`].
+pub const POLICY_DIR: &str = "policy";
+/// Written last, once a run has trained all its episodes.
+pub const FINISHED: &str = "finished";
+/// The file a training process holds an exclusive lock on while it trains a run.
+pub const LOCK: &str = ".lock";
+/// An experiment directory's record of curves that live under another experiment.
+pub const SHARED_CURVES: &str = "shared_curves.toml";
+
+/// The directory name of seed `seed`: `seed-<k>`.
+pub fn seed_dir_name(seed: u64) -> String {
+    format!("seed-{seed}")
+}
+
+/// The seed a directory named `seed-<k>` holds (`k` decimal digits only); `None` otherwise.
+pub fn parse_seed_dir(name: &str) -> Option<u64> {
+    let digits = name.strip_prefix("seed-")?;
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    digits.parse().ok()
+}
+
+/// A run's label inside its experiment, as Slurm tasks and listings name it: `<curve>/seed-<k>`.
+pub fn run_label(curve: &str, seed: u64) -> String {
+    format!("{curve}/{}", seed_dir_name(seed))
+}
+
+/// A run's directory below the results root: `<root>/<experiment>/<curve>/seed-<k>`.
+pub fn run_dir(root: &Path, experiment: &str, curve: &str, seed: u64) -> PathBuf {
+    root.join(experiment).join(run_label(curve, seed))
+}
+
+/// Whether the run in `dir` has finished training (its marker exists).
+pub fn is_finished(dir: &Path) -> bool {
+    dir.join(FINISHED).is_file()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_directories_are_experiment_curve_and_seed() {
+        let d = run_dir(Path::new("out"), "fig5_wtd", "our2@l_rate=0.001", 7);
+        assert_eq!(d, Path::new("out/fig5_wtd/our2@l_rate=0.001/seed-7"));
+        assert_eq!(run_label("our1", 12), "our1/seed-12");
+    }
+
+    #[test]
+    fn only_seed_and_decimal_digits_name_a_seed_directory() {
+        assert_eq!(parse_seed_dir("seed-0"), Some(0));
+        assert_eq!(parse_seed_dir("seed-39"), Some(39));
+        for bad in [
+            "seed-", "seed-+1", "seed-1a", "seed--1", "seeds-1", "tmp", "seed-1 ",
+        ] {
+            assert_eq!(parse_seed_dir(bad), None, "{bad}");
+        }
+        // More digits than a u64 holds is not a seed either.
+        assert_eq!(parse_seed_dir("seed-99999999999999999999999"), None);
+    }
+
+    #[test]
+    fn a_run_is_finished_only_with_its_marker_file() {
+        let t = tempfile::tempdir().unwrap();
+        assert!(!is_finished(t.path()));
+        std::fs::create_dir(t.path().join(FINISHED)).unwrap();
+        assert!(!is_finished(t.path()), "a directory is not the marker");
+        std::fs::remove_dir(t.path().join(FINISHED)).unwrap();
+        std::fs::write(t.path().join(FINISHED), "").unwrap();
+        assert!(is_finished(t.path()));
+    }
+}
