@@ -56,6 +56,10 @@ enum Command {
         /// Where the figures and <experiment>_summary.csv files go.
         #[arg(long, default_value = "plots")]
         out: PathBuf,
+        /// The metrics.csv column to plot: eval_return, or any other (env_steps, updates, a
+        /// method family's own such as loss or epsilon); files become <experiment>_<metric>.*.
+        #[arg(long, default_value = "eval_return")]
+        metric: String,
     },
     /// Animate a trained run's greedy policy as a GIF.
     Render {
@@ -438,7 +442,11 @@ fn run() -> Result<()> {
             );
             Ok(())
         }
-        Command::Plot { results, out } => plot(&results, &out),
+        Command::Plot {
+            results,
+            out,
+            metric,
+        } => plot(&results, &out, &metric),
         Command::Demo { steps, seed } => demo_run(steps, seed),
         Command::Bench {
             what,
@@ -738,8 +746,8 @@ fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
     Ok(())
 }
 
-fn plot(results: &Path, out: &Path) -> Result<()> {
-    let report = macdec::plot::plot_results(results, out)
+fn plot(results: &Path, out: &Path, metric: &str) -> Result<()> {
+    let report = macdec::plot::plot_results_metric(results, out, metric)
         .with_context(|| format!("plotting {} into {}", results.display(), out.display()))?;
     for note in &report.notes {
         eprintln!("{note}");

@@ -24,7 +24,8 @@ pub use crate::experiment::results_tree::CONFIG as CONFIG_FILE;
 pub struct RunData {
     pub seed: u64,
     pub dir: PathBuf,
-    /// `(episode, eval_return)` per evaluation, episodes strictly increasing.
+    /// `(episode, value)` per evaluation of the plotted column (`eval_return` unless another
+    /// was asked for; rows with an empty cell are left out), episodes strictly increasing.
     pub points: Vec<(u64, f64)>,
     /// Whether the run wrote its `finished` marker.
     pub finished: bool,
@@ -75,9 +76,18 @@ pub struct Discovery {
     pub notes: Vec<String>,
 }
 
-/// Scan `results` for runs. Fails only when the root cannot be read, when it holds no run at
-/// all, or when every metrics file found is malformed.
+/// Scan `results` for runs' `eval_return` curves (see [`discover_metric`]).
 pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
+    discover_metric(results, EVAL_RETURN)
+}
+
+/// The column plotted by default: the evaluated policy's return.
+pub const EVAL_RETURN: &str = "eval_return";
+
+/// Scan `results` for runs, reading the `metric` column of each `metrics.csv` (any leading or
+/// family column). Fails only when the root cannot be read, when it holds no run at all, or when
+/// every metrics file found is malformed. A run without the column is skipped with a note.
+pub fn discover_metric(results: &Path, metric: &str) -> Result<Discovery, PlotError> {
     let exp_dirs = sorted_subdirs(results).map_err(|source| PlotError::ReadResults {
         path: results.to_path_buf(),
         source,
@@ -93,7 +103,7 @@ pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
             let method = method_name.parse::<Method>().ok();
             let mut runs = Vec::new();
             for run_dir in subdirs_or_note(&curve_dir, &mut notes) {
-                match read_run(&run_dir) {
+                match read_run(&run_dir, metric) {
                     Ok(run) => runs.push(run),
                     Err(RunProblem::Skip(why)) => {
                         notes.push(format!("skipping {}: {why}", run_dir.display()))
@@ -213,7 +223,7 @@ enum RunProblem {
     Malformed(PathBuf, String),
 }
 
-fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
+fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
     let name = file_name(dir);
     let seed = results_tree::parse_seed_dir(&name)
         .ok_or_else(|| RunProblem::Skip("not a seed-<k> directory".into()))?;
@@ -221,15 +231,14 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
         return Err(RunProblem::Skip(format!("no {METRICS_FILE}")));
     };
     let bad = |why: String| RunProblem::Malformed(metrics_path.clone(), why);
-    let rows = metrics::read(&metrics_path)
-        .map_err(|e| {
-            bad(match e {
-                MetricsError::Csv { source, .. } => source.to_string(),
-                MetricsError::Io { source, .. } => source.to_string(),
-                MetricsError::Layout { message, .. } => message,
-            })
-        })?
-        .rows;
+    let table = metrics::read(&metrics_path).map_err(|e| {
+        bad(match e {
+            MetricsError::Csv { source, .. } => source.to_string(),
+            MetricsError::Io { source, .. } => source.to_string(),
+            MetricsError::Layout { message, .. } => message,
+        })
+    })?;
+    let rows = &table.rows;
     if rows.is_empty() {
         // A header alone is a run before its first evaluation, unless it is not our header.
         let header = metrics::read_text(&metrics_path).unwrap_or_default();
@@ -255,11 +264,22 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
             )));
         }
     }
-    if let Some(row) = rows.iter().find(|r| !r.eval_return.is_finite()) {
-        return Err(bad(format!(
-            "episode {}: eval_return is {}",
-            row.episode, row.eval_return
+    let Some(values) = table.column(metric) else {
+        return Err(RunProblem::Skip(format!(
+            "no `{metric}` column (it has {})",
+            table.family_columns.join(", ")
         )));
+    };
+    let points: Vec<(u64, f64)> = rows
+        .iter()
+        .zip(values)
+        .filter_map(|(r, v)| v.map(|v| (r.episode, v)))
+        .collect();
+    if let Some((episode, value)) = points.iter().find(|(_, v)| !v.is_finite()) {
+        return Err(bad(format!("episode {episode}: {metric} is {value}")));
+    }
+    if points.is_empty() {
+        return Err(RunProblem::Skip(format!("no `{metric}` values yet")));
     }
     let config_text = std::fs::read_to_string(dir.join(CONFIG_FILE)).ok();
     let setting = config_text
@@ -272,7 +292,7 @@ fn read_run(dir: &Path) -> Result<RunData, RunProblem> {
     Ok(RunData {
         seed,
         dir: dir.to_path_buf(),
-        points: rows.iter().map(|r| (r.episode, r.eval_return)).collect(),
+        points,
         finished: results_tree::is_finished(dir),
         wall_seconds: rows.last().map_or(0.0, |r| r.wall_seconds),
         setting,

@@ -2,7 +2,7 @@
 //! point), its legend with the seed count, the optimal-return line, the partial-results mark, and
 //! the summary rows. Decides everything about the figure except pixels (`render` draws it).
 
-use super::discover::{CurveData, ExperimentData};
+use super::discover::{CurveData, ExperimentData, EVAL_RETURN};
 use super::stats::{
     aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training,
     run_mean_over_training, smooth, CurvePoint, SMOOTH_HALF_WINDOW,
@@ -34,6 +34,8 @@ pub struct Figure {
     pub partial: Option<String>,
     /// What the curves and bands are.
     pub caption: String,
+    /// The y axis: `discounted return`, or the plotted metrics column's name.
+    pub y_label: String,
 }
 
 /// A figure plus its summary rows and notes (e.g. why no optimal line is drawn).
@@ -57,10 +59,17 @@ const PALETTE: [Rgb; 9] = [
     (188, 189, 34),
 ];
 
-/// Build the figure and summary of one experiment.
+/// Build the figure and summary of one experiment's `eval_return` curves.
 pub fn build(exp: &ExperimentData) -> Built {
+    build_metric(exp, EVAL_RETURN)
+}
+
+/// Build the figure and summary of one experiment whose runs were read for the `metric` column
+/// ([`crate::plot::discover::discover_metric`]). Only `eval_return` has an optimal line.
+pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
     let mut notes = Vec::new();
     let (optimal, setting_text) = common_setting(exp, &mut notes);
+    let optimal = optimal.filter(|_| metric == EVAL_RETURN);
     // A method keeps its colour across figures unless a sweep puts it on the figure twice.
     let one_per_method = exp.curves.iter().all(|c| c.method.is_some())
         && exp.curves.windows(2).all(|w| w[0].method != w[1].method);
@@ -93,8 +102,13 @@ pub fn build(exp: &ExperimentData) -> Built {
         Some(s) => format!("{}: {s}", exp.name),
         None => exp.name.clone(),
     };
+    let quantity = if metric == EVAL_RETURN {
+        "the greedy discounted return".to_string()
+    } else {
+        format!("`{metric}`")
+    };
     let mut caption = format!(
-        "Mean over seeds of the greedy discounted return; band: standard error (ddof 1); \
+        "Mean over seeds of {quantity}; band: standard error (ddof 1); \
          both smoothed by a centred moving average over {} evaluation points.",
         2 * SMOOTH_HALF_WINDOW + 1
     );
@@ -109,6 +123,11 @@ pub fn build(exp: &ExperimentData) -> Built {
             optimal,
             partial,
             caption,
+            y_label: if metric == EVAL_RETURN {
+                "discounted return".into()
+            } else {
+                metric.to_string()
+            },
         },
         summary,
         notes,

@@ -58,7 +58,18 @@ impl PlotReport {
 /// `<experiment>_summary.csv`. Works on partial results (unfinished runs, fewer seeds) and says so
 /// in the figure.
 pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError> {
-    let found = discover::discover(results)?;
+    plot_results_metric(results, out, discover::EVAL_RETURN)
+}
+
+/// [`plot_results`] for any `metrics.csv` column (`eval_return`, `updates`, a family's own such
+/// as `loss` or `epsilon`). Files other than `eval_return`'s are named `<experiment>_<metric>.*`
+/// so they sit beside the return figures; only `eval_return` has an optimal line.
+pub fn plot_results_metric(
+    results: &Path,
+    out: &Path,
+    metric: &str,
+) -> Result<PlotReport, PlotError> {
+    let found = discover::discover_metric(results, metric)?;
     let mut notes = found.notes;
     std::fs::create_dir_all(out).map_err(|source| PlotError::Write {
         path: out.to_path_buf(),
@@ -66,11 +77,16 @@ pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError>
     })?;
     let mut plots = Vec::new();
     for exp in &found.experiments {
-        let built = figure::build(exp);
+        let built = figure::build_metric(exp, metric);
         notes.extend(built.notes);
-        let png = out.join(format!("{}.png", exp.name));
-        let svg = out.join(format!("{}.svg", exp.name));
-        let summary_csv = out.join(format!("{}_summary.csv", exp.name));
+        let stem = if metric == discover::EVAL_RETURN {
+            exp.name.clone()
+        } else {
+            format!("{}_{metric}", exp.name)
+        };
+        let png = out.join(format!("{stem}.png"));
+        let svg = out.join(format!("{stem}.svg"));
+        let summary_csv = out.join(format!("{stem}_summary.csv"));
         render::render_png(&built.figure, &png)?;
         let svg_text = render::render_svg(&built.figure, &svg)?;
         crate::experiment::atomic::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
@@ -81,7 +97,7 @@ pub fn plot_results(results: &Path, out: &Path) -> Result<PlotReport, PlotError>
         })?;
         summary::write_csv(&summary_csv, &built.summary)?;
         let tests = summary::pairwise_tests(&built.summary);
-        let tests_csv = out.join(format!("{}_welch.csv", exp.name));
+        let tests_csv = out.join(format!("{stem}_welch.csv"));
         summary::write_csv(&tests_csv, &tests)?;
         plots.push(ExperimentPlot {
             experiment: exp.name.clone(),
@@ -181,5 +197,42 @@ mod tests {
         let md = report.markdown();
         assert!(md.contains("| Our-1 | 3 (3) | 1500 |"), "{md}");
         assert!(report.notes.is_empty(), "{:?}", report.notes);
+    }
+
+    #[test]
+    fn any_metrics_column_plots_beside_the_returns_and_a_missing_one_is_named() {
+        let t = tempfile::tempdir().unwrap();
+        let res = t.path().join("results");
+        let bp10 = EnvSpec::paper_box_pushing(10);
+        for seed in 0..2 {
+            write_run(&res, "e", "our1", seed, &curve(seed, 90.0, 41), bp10, true);
+        }
+        let out = t.path().join("plots");
+        // write_run records updates = episode / 2; the final value is the mean over the last
+        // 10% of evaluations (episodes 360..=400, updates 180..=200).
+        let report = plot_results_metric(&res, &out, "updates").unwrap();
+        let p = &report.plots[0];
+        assert_eq!(p.svg, out.join("e_updates.svg"));
+        assert_eq!(p.summary_csv, out.join("e_updates_summary.csv"));
+        let svg = std::fs::read_to_string(&p.svg).unwrap();
+        assert!(svg.contains(">\nupdates\n<"), "the y axis names the column");
+        assert!(!svg.contains("discounted return"));
+        let s = &p.summary[0];
+        assert_eq!(s.optimal, None, "only eval_return has an optimal line");
+        assert_eq!(s.final_mean, 190.0);
+        // A family column is read by name too (write_run's epsilon is 1 throughout).
+        let eps = plot_results_metric(&res, &out, "epsilon").unwrap();
+        assert_eq!(eps.plots[0].summary[0].final_mean, 1.0);
+        // The return figure is unchanged by the others and keeps its own names.
+        let ret = plot_results(&res, &out).unwrap();
+        assert_eq!(ret.plots[0].svg, out.join("e.svg"));
+        assert!(ret.plots[0].summary[0].optimal.is_some());
+        // No run has a `q_loss` column, and `loss` has no values yet: no runs, notes say why.
+        for missing in ["q_loss", "loss"] {
+            let d = discover::discover_metric(&res, missing);
+            assert!(matches!(d, Err(PlotError::NoRuns { .. })), "{missing}");
+        }
+        let err = plot_results_metric(&res, &out, "q_loss").unwrap_err();
+        assert!(err.to_string().contains("no runs found"), "{err}");
     }
 }

@@ -201,7 +201,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     chart
         .configure_mesh()
         .x_desc("training episodes")
-        .y_desc("discounted return")
+        .y_desc(fig.y_label.as_str())
         .axis_desc_style((FAMILY, AXIS_DESC_PX))
         .label_style((FAMILY, TICK_PX))
         .x_labels(8)
@@ -343,6 +343,7 @@ mod tests {
             optimal: Some(80.0),
             partial: None,
             caption: String::new(),
+            y_label: "discounted return".into(),
         };
         let (x, y) = ranges(&fig);
         assert_eq!(x, 0.0..100.0);
@@ -369,6 +370,7 @@ mod tests {
             optimal: Some(80.0),
             partial: None,
             caption: String::new(),
+            y_label: "discounted return".into(),
         }
     }
 
