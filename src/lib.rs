@@ -16,6 +16,7 @@ pub mod curve_stats;
 pub mod deploy;
 pub mod envs;
 pub mod experiment;
+pub mod files;
 pub mod nn;
 pub mod plot;
 pub mod render;

@@ -383,7 +383,7 @@ impl Experiment {
             return Ok(());
         }
         let text = toml::to_string(&self.shared_curves).map_err(std::io::Error::other)?;
-        crate::experiment::atomic::write_atomic(
+        crate::files::atomic::write_atomic(
             &out.join(&self.name).join(SHARED_CURVES_FILE),
             text.as_bytes(),
         )

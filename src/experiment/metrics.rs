@@ -131,7 +131,7 @@ pub fn write(
     let p = || path.display().to_string();
     let bytes =
         to_csv(family_columns, rows).map_err(|source| MetricsError::Csv { path: p(), source })?;
-    super::atomic::write_atomic(path, &bytes)
+    crate::files::atomic::write_atomic(path, &bytes)
         .map_err(|source| MetricsError::Io { path: p(), source })
 }
 

@@ -1,8 +1,6 @@
 //! Experiments: configs, seeds, the parallel runner, metrics and checkpoints.
 
-pub mod atomic;
 pub mod audit;
-pub mod bounded_read;
 pub mod checkpoint;
 pub mod config;
 pub mod limits;

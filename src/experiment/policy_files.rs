@@ -22,8 +22,8 @@
 //! ```
 
 use crate::envs::EnvSpec;
-use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
-use crate::experiment::bounded_read::read_regular_file;
+use crate::files::atomic::{remove_stale_temp_files, write_atomic};
+use crate::files::bounded_read::read_regular_file;
 use crate::nn::safetensors_io::{from_safetensors_bytes, to_safetensors_bytes, WeightsError};
 use crate::nn::{QNet, QNetConfig};
 use serde::{Deserialize, Serialize};

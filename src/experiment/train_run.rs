@@ -12,7 +12,6 @@
 use crate::algos::any_loop::AnyLoop;
 use crate::algos::method::Method;
 use crate::algos::training_loop::{Advance, RunRngs, TrainError};
-use crate::experiment::atomic::{remove_stale_temp_files, write_atomic};
 use crate::experiment::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics::{self, METRICS_FILE};
@@ -24,6 +23,7 @@ use crate::experiment::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
 use crate::experiment::run_settings::RunSettings;
 use crate::experiment::runner::{Progress, RunEnd};
 use crate::experiment::seeds::{stream, Role};
+use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

@@ -89,7 +89,7 @@ pub fn plot_results_metric(
         let summary_csv = out.join(format!("{stem}_summary.csv"));
         render::render_png(&built.figure, &png)?;
         let svg_text = render::render_svg(&built.figure, &svg)?;
-        crate::experiment::atomic::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
+        crate::files::atomic::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
             PlotError::Write {
                 path: svg.clone(),
                 source,

@@ -107,7 +107,7 @@ pub fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<(), PlotError>
     let bytes = w
         .into_inner()
         .map_err(|e| write_err(std::io::Error::other(e.to_string())))?;
-    crate::experiment::atomic::write_atomic(path, &bytes).map_err(write_err)
+    crate::files::atomic::write_atomic(path, &bytes).map_err(write_err)
 }
 
 /// A Markdown table of one experiment's curves, headed by its title, then the matrix of

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::palette::{gif_palette, TRANSPARENT};
 use super::{Frame, RenderError};
-use crate::experiment::atomic::write_atomic;
+use crate::files::atomic::write_atomic;
 
 /// How long the last frame of an episode ([`Frame::hold`]) stays up, unless the frame delay is
 /// longer.

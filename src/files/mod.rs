@@ -1,0 +1,6 @@
+//! The ground floor: generic file I/O that every layer may use (atomic writes, bounded reads).
+//! It names nothing of the crate above it, so a lower layer (deploy, render, plot) writing a
+//! file never depends on the experiment layer.
+
+pub mod atomic;
+pub mod bounded_read;
