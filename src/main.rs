@@ -432,9 +432,8 @@ fn run() -> Result<()> {
             net,
         } => {
             refuse_policy_dir_as_run(&run)?;
-            let returns =
-                macdec::experiment::rollout::render_run(&run, net, episodes, &out, frame_ms)
-                    .with_context(|| format!("rendering {}", run.display()))?;
+            let returns = macdec::render::rollout::render_run(&run, net, episodes, &out, frame_ms)
+                .with_context(|| format!("rendering {}", run.display()))?;
             eprintln!(
                 "wrote {} ({} episode(s), team returns {returns:?})",
                 out.display(),

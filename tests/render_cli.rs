@@ -63,9 +63,9 @@ fn a_run_of_a_domain_render_cannot_draw_is_refused_naming_the_domain() {
     assert!(!gif.exists());
 }
 
-/// The renderer (`src/render`) is reached only through `experiment/rollout.rs` (`macdec
-/// render`): training, evaluation, plots, export and deployment never name it, so a domain
-/// without a picture loses only `render`.
+/// The renderer (`src/render`, with its run rollouts in `render/rollout.rs`) is reached only by
+/// `main.rs`'s `macdec render`: training, evaluation, plots, export and deployment never name
+/// it, so a domain without a picture loses only `render`.
 #[test]
 fn only_the_render_command_reaches_the_renderer() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -87,5 +87,5 @@ fn only_the_render_command_reaches_the_renderer() {
         }
     }
     users.sort();
-    assert_eq!(users, ["experiment/rollout.rs"]);
+    assert_eq!(users, ["main.rs"]);
 }

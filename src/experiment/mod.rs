@@ -1,20 +1,15 @@
-//! Experiments: configs, seeds, the parallel runner, metrics and checkpoints.
+//! Experiments, in three folders by job: [`definition`] (what to run: configs, paper settings,
+//! seeds, limits), [`run`] (running it: the runner, one run on disk, checkpoints, metrics, policy
+//! files, the results tree) and [`cluster`] (Slurm and audits over a results tree). The modules
+//! are re-exported here, so `macdec::experiment::train_run` and the like keep their paths.
 
-pub mod audit;
-pub mod checkpoint;
-pub mod config;
-pub mod limits;
-pub mod metrics;
-pub mod names;
-pub mod paper;
-pub mod policy_files;
-pub mod provenance;
-pub mod report;
-pub mod results_tree;
-pub mod rollout;
-pub mod run_settings;
-pub mod runner;
-pub mod seeds;
-pub mod slurm;
-pub mod train_run;
-pub mod work_queue;
+pub mod cluster;
+pub mod definition;
+pub mod run;
+
+pub use cluster::{audit, slurm};
+pub use definition::{config, limits, names, paper, run_settings, seeds};
+pub use run::{
+    checkpoint, metrics, policy_files, provenance, report, results_tree, runner, train_run,
+    work_queue,
+};

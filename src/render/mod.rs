@@ -32,6 +32,7 @@ mod gif_out;
 mod hud;
 pub mod palette;
 mod record;
+pub mod rollout;
 mod warehouse;
 
 pub use canvas::Canvas;

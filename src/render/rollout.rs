@@ -1,4 +1,5 @@
-//! Animated rollouts of a trained run's greedy policy (`macdec render`).
+//! Animated rollouts of a trained run's greedy policy (`macdec render`): reads the run's policy
+//! files and draws its episodes.
 
 use crate::algos::value::acting::ActScratch;
 use crate::algos::value::evaluate::GreedyActor;

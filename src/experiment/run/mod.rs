@@ -1,0 +1,13 @@
+//! Running it and what a run writes: the parallel runner ([`runner`], [`work_queue`]), one run on
+//! disk with resume ([`train_run`]), its files ([`results_tree`] names them; [`checkpoint`],
+//! [`metrics`], [`policy_files`], [`provenance`]) and the terminal summary ([`report`]).
+
+pub mod checkpoint;
+pub mod metrics;
+pub mod policy_files;
+pub mod provenance;
+pub mod report;
+pub mod results_tree;
+pub mod runner;
+pub mod train_run;
+pub mod work_queue;
