@@ -13,24 +13,19 @@
 //! any policy directory's greedy episodes in-process, exactly as deployment does. A policy may be
 //! of a domain defined outside this binary ([`policy_env`]): robots serve it, the commands that
 //! simulate a domain refuse it by name.
+//!
+//! Three folders by job: [`policy`] (the policy directory: format, export, import, the Q-net
+//! acting from it), [`serve`] (the robot side: protocol, stdio and TCP servers) and [`drive`]
+//! (the domain side: episodes against robot links, processes, remote robots, local evaluation).
+//! Their modules are re-exported here, so `macdec::deploy::<module>` paths stay.
 
-pub mod architecture;
-pub mod deadline;
-pub mod driver;
-pub mod export;
-pub mod import;
-pub mod line_reader;
-pub mod link;
-pub mod local_eval;
-pub mod manifest;
-pub mod mock;
-pub mod policy_env;
-pub mod processes;
-pub mod protocol;
-pub mod qnet_policy;
-pub mod remote;
-pub mod robot;
-pub mod server;
+pub mod drive;
+pub mod policy;
+pub mod serve;
+
+pub use drive::{driver, link, local_eval, processes, remote};
+pub use policy::{architecture, export, import, manifest, mock, policy_env, qnet_policy};
+pub use serve::{deadline, line_reader, protocol, robot, server};
 
 pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};
 pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
