@@ -7,6 +7,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use ndarray::ArrayViewD;
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 
 use super::gru::GRU_TENSOR_NAMES;
@@ -56,12 +57,17 @@ pub enum WeightsError {
 
 /// The file's bytes for `params` (PyTorch's `{"format": "pt"}` metadata included).
 pub fn to_safetensors_bytes(params: &QNetParams) -> Vec<u8> {
-    let data: Vec<(&str, Vec<usize>, Vec<u8>)> = params
-        .named()
-        .into_iter()
+    named_to_safetensors_bytes(&params.named())
+}
+
+/// Named f32 tensors as safetensors bytes, with PyTorch's `{"format": "pt"}` metadata: the one
+/// writer behind every net's file.
+fn named_to_safetensors_bytes(named: &[(&'static str, ArrayViewD<'_, f32>)]) -> Vec<u8> {
+    let data: Vec<(&str, Vec<usize>, Vec<u8>)> = named
+        .iter()
         .map(|(name, a)| {
             let bytes = a.iter().flat_map(|v| v.to_le_bytes()).collect();
-            (name, a.shape().to_vec(), bytes)
+            (*name, a.shape().to_vec(), bytes)
         })
         .collect();
     let views = data.iter().map(|(name, shape, bytes)| {
@@ -168,21 +174,7 @@ pub fn config_of_safetensors(bytes: &[u8], origin: &Path) -> Result<QNetConfig, 
 /// The file's bytes for a GRU's parameters, under `nn.GRU`'s state_dict names
 /// ([`GRU_TENSOR_NAMES`]), with PyTorch's `{"format": "pt"}` metadata.
 pub fn gru_to_safetensors_bytes(params: &GruParams) -> Vec<u8> {
-    let data: Vec<(&str, Vec<usize>, Vec<u8>)> = params
-        .named()
-        .into_iter()
-        .map(|(name, a)| {
-            let bytes = a.iter().flat_map(|v| v.to_le_bytes()).collect();
-            (name, a.shape().to_vec(), bytes)
-        })
-        .collect();
-    let views = data.iter().map(|(name, shape, bytes)| {
-        let view = TensorView::new(Dtype::F32, shape.clone(), bytes)
-            .expect("shape and byte length agree by construction");
-        (*name, view)
-    });
-    let meta = Some(HashMap::from([("format".to_string(), "pt".to_string())]));
-    safetensors::serialize(views, &meta).expect("serializing in-memory f32 tensors cannot fail")
+    named_to_safetensors_bytes(&params.named())
 }
 
 /// Parse a bare `nn.GRU` state_dict (one layer, with biases) from a file's bytes, taking the
