@@ -9,13 +9,10 @@
 //! h' = (1 - z) * n + z * h
 //! ```
 
-use ndarray::{ArrayViewD, Axis};
-use rand_chacha::ChaCha8Rng;
+use ndarray::ArrayViewD;
 use serde::{Deserialize, Serialize};
 
-use super::init::{uniform1, uniform2};
-use super::linear::copy_grad;
-use super::params::{flat, flat_mut, GruParams};
+use super::params::{flat, GruParams};
 use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::kernels::gru::forward_cells;
 use crate::autograd::{GruVars, SeqPacking, Tape, Var};
@@ -26,18 +23,6 @@ pub const GRU_TENSOR_NAMES: [&str; 4] =
     ["weight_ih_l0", "weight_hh_l0", "bias_ih_l0", "bias_hh_l0"];
 
 impl GruParams {
-    /// PyTorch's default: every weight and both biases U(-1/sqrt(H), 1/sqrt(H)), drawn in the
-    /// order weight_ih, weight_hh, bias_ih, bias_hh (the module's parameter order).
-    pub fn pytorch_default(input: usize, hidden: usize, rng: &mut ChaCha8Rng) -> Self {
-        let k = 1.0 / (hidden as f32).sqrt();
-        GruParams {
-            weight_ih: uniform2(3 * hidden, input, k, rng),
-            weight_hh: uniform2(3 * hidden, hidden, k, rng),
-            bias_ih: uniform1(3 * hidden, k, rng),
-            bias_hh: uniform1(3 * hidden, k, rng),
-        }
-    }
-
     /// Every tensor with its `nn.GRU` state_dict name, in [`GRU_TENSOR_NAMES`] order.
     pub fn named(&self) -> [(&'static str, ArrayViewD<'_, f32>); 4] {
         let n = GRU_TENSOR_NAMES;
@@ -51,11 +36,12 @@ impl GruParams {
 
     /// Put the parameters on a tape as trainable leaves (biases as [1, 3H] rows).
     pub fn bind(&self, tape: &mut Tape) -> GruVars {
+        let [w_ih, w_hh, b_ih, b_hh] = self.leaves(tape);
         GruVars {
-            w_ih: tape.param(self.weight_ih.view()),
-            w_hh: tape.param(self.weight_hh.view()),
-            b_ih: tape.param(self.bias_ih.view().insert_axis(Axis(0))),
-            b_hh: tape.param(self.bias_hh.view().insert_axis(Axis(0))),
+            w_ih,
+            w_hh,
+            b_ih,
+            b_hh,
         }
     }
 
@@ -156,10 +142,7 @@ impl GruVars {
 
     /// Copy the GRU's gradients from the tape into `into` (zero where none reached it).
     pub fn grads_into(&self, tape: &Tape, into: &mut GruParams) {
-        copy_grad(tape, self.w_ih, flat_mut(&mut into.weight_ih));
-        copy_grad(tape, self.w_hh, flat_mut(&mut into.weight_hh));
-        copy_grad(tape, self.b_ih, flat_mut(&mut into.bias_ih));
-        copy_grad(tape, self.b_hh, flat_mut(&mut into.bias_hh));
+        into.copy_grads(tape, [self.w_ih, self.w_hh, self.b_ih, self.b_hh]);
     }
 }
 
@@ -169,6 +152,7 @@ mod tests {
 
     use ndarray::{Array1, Array2};
     use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
     use serde_json::Value;
 
     use super::*;

@@ -1,37 +1,22 @@
 //! The LSTM layer: PyTorch's default initialization, binding to a tape, and the one-step update
 //! with a carried (h, c) used when acting.
 
-use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::init::{uniform1, uniform2};
-use super::linear::copy_grad;
-use super::params::{flat, flat_mut, LstmParams};
+use super::params::{flat, LstmParams};
 use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace, tanh_into};
 use crate::autograd::kernels::dense::lstm_gates_row;
 use crate::autograd::{LstmVars, Tape};
 
 impl LstmParams {
-    /// PyTorch's default: every weight and both biases U(-1/sqrt(H), 1/sqrt(H)), drawn in the
-    /// order weight_ih, weight_hh, bias_ih, bias_hh (spec 2.2).
-    pub fn pytorch_default(input: usize, hidden: usize, rng: &mut ChaCha8Rng) -> Self {
-        let k = 1.0 / (hidden as f32).sqrt();
-        LstmParams {
-            weight_ih: uniform2(4 * hidden, input, k, rng),
-            weight_hh: uniform2(4 * hidden, hidden, k, rng),
-            bias_ih: uniform1(4 * hidden, k, rng),
-            bias_hh: uniform1(4 * hidden, k, rng),
-        }
-    }
-
     /// Put the parameters on a tape as trainable leaves.
     pub fn bind(&self, tape: &mut Tape) -> LstmVars {
-        use ndarray::Axis;
+        let [w_ih, w_hh, b_ih, b_hh] = self.leaves(tape);
         LstmVars {
-            w_ih: tape.param(self.weight_ih.view()),
-            w_hh: tape.param(self.weight_hh.view()),
-            b_ih: tape.param(self.bias_ih.view().insert_axis(Axis(0))),
-            b_hh: tape.param(self.bias_hh.view().insert_axis(Axis(0))),
+            w_ih,
+            w_hh,
+            b_ih,
+            b_hh,
         }
     }
 
@@ -112,10 +97,7 @@ impl LstmState {
 impl LstmVars {
     /// Copy the LSTM's gradients from the tape into `into` (zero where none reached it).
     pub fn grads_into(&self, tape: &Tape, into: &mut LstmParams) {
-        copy_grad(tape, self.w_ih, flat_mut(&mut into.weight_ih));
-        copy_grad(tape, self.w_hh, flat_mut(&mut into.weight_hh));
-        copy_grad(tape, self.b_ih, flat_mut(&mut into.bias_ih));
-        copy_grad(tape, self.b_hh, flat_mut(&mut into.bias_hh));
+        into.copy_grads(tape, [self.w_ih, self.w_hh, self.b_ih, self.b_hh]);
     }
 }
 
@@ -124,6 +106,7 @@ mod tests {
     use super::*;
     use crate::autograd::SeqPacking;
     use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
 
     #[test]
     fn stepping_matches_the_sequence_op() {

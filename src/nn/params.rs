@@ -1,8 +1,13 @@
 //! Parameter containers: named tensors with PyTorch's state_dict names, and the [`Params`] view
 //! Adam and the checkpoint code work through.
 
-use ndarray::{Array1, Array2};
+use ndarray::{Array1, Array2, Axis};
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+
+use super::init::{uniform1, uniform2};
+use super::linear::copy_grad;
+use crate::autograd::{Tape, Var};
 
 /// A set of parameter tensors seen as flat slices in a fixed order (Adam steps over them; a
 /// gradient set of the same type lines up entry by entry).
@@ -30,51 +35,47 @@ impl LinearParams {
     }
 }
 
-/// A one-layer LSTM's parameters (PyTorch `nn.LSTM`, gate order i, f, g, o):
-/// weight_ih [4H, in], weight_hh [4H, H], bias_ih [4H], bias_hh [4H].
+/// A one-layer recurrent layer's parameters in PyTorch's layout, with `GATES` gate blocks
+/// stacked along the first axis: weight_ih [GATES·H, in], weight_hh [GATES·H, H], bias_ih and
+/// bias_hh [GATES·H]. [`LstmParams`] and [`GruParams`] are its two instances; what differs
+/// between them (the cell, the tape op, the state_dict names) lives in `nn/lstm.rs` and
+/// `nn/gru.rs`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LstmParams {
+pub struct RecurrentParams<const GATES: usize> {
     pub weight_ih: Array2<f32>,
     pub weight_hh: Array2<f32>,
     pub bias_ih: Array1<f32>,
     pub bias_hh: Array1<f32>,
 }
 
-impl LstmParams {
-    /// All-zero parameters for `input` features and hidden size `hidden`.
-    pub fn zeros(input: usize, hidden: usize) -> Self {
-        LstmParams {
-            weight_ih: Array2::zeros((4 * hidden, input)),
-            weight_hh: Array2::zeros((4 * hidden, hidden)),
-            bias_ih: Array1::zeros(4 * hidden),
-            bias_hh: Array1::zeros(4 * hidden),
-        }
-    }
-
-    /// Hidden size H.
-    pub fn hidden(&self) -> usize {
-        self.weight_hh.ncols()
-    }
-}
+/// A one-layer LSTM's parameters (PyTorch `nn.LSTM`, gate order i, f, g, o):
+/// weight_ih [4H, in], weight_hh [4H, H], bias_ih [4H], bias_hh [4H].
+pub type LstmParams = RecurrentParams<4>;
 
 /// A one-layer GRU's parameters (PyTorch `nn.GRU`, gate order r, z, n):
 /// weight_ih [3H, in], weight_hh [3H, H], bias_ih [3H], bias_hh [3H].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GruParams {
-    pub weight_ih: Array2<f32>,
-    pub weight_hh: Array2<f32>,
-    pub bias_ih: Array1<f32>,
-    pub bias_hh: Array1<f32>,
-}
+pub type GruParams = RecurrentParams<3>;
 
-impl GruParams {
+impl<const GATES: usize> RecurrentParams<GATES> {
     /// All-zero parameters for `input` features and hidden size `hidden` (a gradient buffer).
     pub fn zeros(input: usize, hidden: usize) -> Self {
-        GruParams {
-            weight_ih: Array2::zeros((3 * hidden, input)),
-            weight_hh: Array2::zeros((3 * hidden, hidden)),
-            bias_ih: Array1::zeros(3 * hidden),
-            bias_hh: Array1::zeros(3 * hidden),
+        RecurrentParams {
+            weight_ih: Array2::zeros((GATES * hidden, input)),
+            weight_hh: Array2::zeros((GATES * hidden, hidden)),
+            bias_ih: Array1::zeros(GATES * hidden),
+            bias_hh: Array1::zeros(GATES * hidden),
+        }
+    }
+
+    /// PyTorch's default: every weight and both biases U(-1/sqrt(H), 1/sqrt(H)), drawn in the
+    /// order weight_ih, weight_hh, bias_ih, bias_hh (the module's parameter order; spec 2.2).
+    pub fn pytorch_default(input: usize, hidden: usize, rng: &mut ChaCha8Rng) -> Self {
+        let k = 1.0 / (hidden as f32).sqrt();
+        RecurrentParams {
+            weight_ih: uniform2(GATES * hidden, input, k, rng),
+            weight_hh: uniform2(GATES * hidden, hidden, k, rng),
+            bias_ih: uniform1(GATES * hidden, k, rng),
+            bias_hh: uniform1(GATES * hidden, k, rng),
         }
     }
 
@@ -87,9 +88,29 @@ impl GruParams {
     pub fn input(&self) -> usize {
         self.weight_ih.ncols()
     }
+
+    /// The four tensors on a tape as trainable leaves, biases as [1, GATES·H] rows:
+    /// `[w_ih, w_hh, b_ih, b_hh]`.
+    pub(crate) fn leaves(&self, tape: &mut Tape) -> [Var; 4] {
+        [
+            tape.param(self.weight_ih.view()),
+            tape.param(self.weight_hh.view()),
+            tape.param(self.bias_ih.view().insert_axis(Axis(0))),
+            tape.param(self.bias_hh.view().insert_axis(Axis(0))),
+        ]
+    }
+
+    /// Copy the gradients of the leaves `[w_ih, w_hh, b_ih, b_hh]` from the tape into `self`
+    /// (zero where none reached them).
+    pub(crate) fn copy_grads(&mut self, tape: &Tape, [w_ih, w_hh, b_ih, b_hh]: [Var; 4]) {
+        copy_grad(tape, w_ih, flat_mut(&mut self.weight_ih));
+        copy_grad(tape, w_hh, flat_mut(&mut self.weight_hh));
+        copy_grad(tape, b_ih, flat_mut(&mut self.bias_ih));
+        copy_grad(tape, b_hh, flat_mut(&mut self.bias_hh));
+    }
 }
 
-impl Params for GruParams {
+impl<const GATES: usize> Params for RecurrentParams<GATES> {
     fn slices(&self) -> Vec<&[f32]> {
         vec![
             flat(&self.weight_ih),
