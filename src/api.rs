@@ -3,9 +3,9 @@
 //! the command line, result directories or checkpoints. [`TrainedPolicy::export`] writes the
 //! decentralized nets as a policy directory `macdec robot` serves, whatever the domain.
 //!
-//! The command line's `macdec train` drives the same training loop ([`AnyLoop`]) with the same per-seed random
-//! streams, so a run through [`train`] on Box Pushing or Warehouse gives exactly the numbers of
-//! `macdec train` with that config, method and seed.
+//! The command line's `macdec train` drives the same training loop ([`AnyLoop`]) with the same
+//! per-seed random streams, so a run through [`train`] on Box Pushing or Warehouse gives exactly
+//! the numbers of `macdec train` with that config, method and seed.
 
 use crate::algos::any_loop::AnyLoop;
 use crate::algos::hyper::RunConfig;
@@ -43,8 +43,8 @@ pub enum LibraryTrainError {
 /// environment the method needs (evaluation, training, Our-2's second training env); each call
 /// must build the same domain. What the learner needs to know about the domain comes from its
 /// [`MacroEnv`] implementation, horizon included; the config names no domain and is validated
-/// like a config file's (every key named on error). `on_episode` is called after every training episode with
-/// the trainer, e.g. for progress output. [`train_policy`] also gives back the trained nets.
+/// like a config file's (every key named on error). `on_episode` is called after every training
+/// episode with the loop, e.g. for progress output. [`train_policy`] also gives back the nets.
 pub fn train<E: MacroEnv>(
     make_env: impl Fn() -> Result<E, EnvError>,
     config: &RunConfig,
@@ -90,6 +90,7 @@ pub fn train_policy<E: MacroEnv>(
     while trainer.advance()? != Advance::Finished {
         on_episode(&trainer);
     }
+    let nets = trainer.saved_nets();
     Ok(TrainedPolicy {
         method,
         seed,
@@ -97,8 +98,8 @@ pub fn train_policy<E: MacroEnv>(
         config: config.clone(),
         evals: trainer.evals().to_vec(),
         metric_columns: trainer.metric_columns(),
-        dec: trainer.saved_nets().dec.into_iter().cloned().collect(),
-        cen: trainer.saved_nets().cen.cloned(),
+        dec: nets.dec.into_iter().cloned().collect(),
+        cen: nets.cen.cloned(),
     })
 }
 
@@ -162,11 +163,9 @@ mod tests {
     fn library_training_gives_the_numbers_of_the_command_lines_trainer() {
         for method in [Method::Our1, Method::DecHddrqn] {
             let c = short(method);
-            let spec = SPEC;
-            let evals = train(|| spec.build(), &c, method, 5, |_| {}).unwrap();
-            let env = SPEC;
+            let evals = train(|| SPEC.build(), &c, method, 5, |_| {}).unwrap();
             let mut t: AnyLoop<AnyEnv> =
-                AnyLoop::new(&c, method, 5, run_rngs(5), || env.build()).unwrap();
+                AnyLoop::new(&c, method, 5, run_rngs(5), || SPEC.build()).unwrap();
             while t.advance().unwrap() != Advance::Finished {}
             assert_eq!(evals.len(), 4);
             for (a, b) in evals.iter().zip(t.evals()) {

@@ -240,18 +240,8 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
     })?;
     let rows = &table.rows;
     if rows.is_empty() {
-        // A header alone is a run before its first evaluation, unless it is not our header.
-        let header = metrics::read_text(&metrics_path).unwrap_or_default();
-        let header = String::from_utf8_lossy(&header);
-        let columns: Vec<&str> = header.lines().next().unwrap_or("").split(',').collect();
-        if !["episode", "eval_return"]
-            .iter()
-            .all(|c| columns.contains(c))
-        {
-            return Err(bad(
-                "the header lacks the `episode` and `eval_return` columns".into(),
-            ));
-        }
+        // A header alone is a run before its first evaluation (`metrics::read` has already
+        // refused a header that is not a metrics file's).
         return Err(RunProblem::Skip("no evaluation rows yet".into()));
     }
     for (i, pair) in rows.windows(2).enumerate() {

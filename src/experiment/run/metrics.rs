@@ -47,18 +47,16 @@ impl MetricsTable {
     /// Every row's value of column `name` (a leading, family or `wall_seconds` column); `None`
     /// when the file has no such column. Empty cells are `None`.
     pub fn column(&self, name: &str) -> Option<Vec<Option<f64>>> {
-        let leading = |r: &MetricsRow| -> Option<f64> {
-            Some(match name {
-                "episode" => r.episode as f64,
-                "env_steps" => r.env_steps as f64,
-                "updates" => r.updates as f64,
-                "eval_return" => r.eval_return,
-                WALL_SECONDS => r.wall_seconds,
-                _ => return None,
-            })
+        let common: Option<fn(&MetricsRow) -> f64> = match name {
+            "episode" => Some(|r| r.episode as f64),
+            "env_steps" => Some(|r| r.env_steps as f64),
+            "updates" => Some(|r| r.updates as f64),
+            "eval_return" => Some(|r| r.eval_return),
+            WALL_SECONDS => Some(|r| r.wall_seconds),
+            _ => None,
         };
-        if LEADING_COLUMNS.contains(&name) || name == WALL_SECONDS {
-            return Some(self.rows.iter().map(leading).collect());
+        if let Some(value) = common {
+            return Some(self.rows.iter().map(|r| Some(value(r))).collect());
         }
         let at = self.family_columns.iter().position(|c| c == name)?;
         Some(self.rows.iter().map(|r| r.family[at]).collect())
@@ -80,13 +78,12 @@ pub enum MetricsError {
 }
 
 /// One CSV cell, written exactly as the csv crate writes the field's type (integers as
-/// integers, floats by `ryu`, a missing value as an empty cell).
+/// integers, floats by `ryu`, `None` as an empty cell).
 #[derive(Serialize)]
 #[serde(untagged)]
 enum Cell {
     Count(u64),
-    Value(f64),
-    Missing(Option<f64>),
+    Value(Option<f64>),
 }
 
 /// The rows as CSV text, header first. Every row must have one family value per
@@ -110,13 +107,10 @@ pub fn to_csv(family_columns: &[&str], rows: &[MetricsRow]) -> Result<Vec<u8>, c
             Cell::Count(r.episode),
             Cell::Count(r.env_steps),
             Cell::Count(r.updates),
-            Cell::Value(r.eval_return),
+            Cell::Value(Some(r.eval_return)),
         ];
-        cells.extend(r.family.iter().map(|v| match v {
-            Some(v) => Cell::Value(*v),
-            None => Cell::Missing(None),
-        }));
-        cells.push(Cell::Value(r.wall_seconds));
+        cells.extend(r.family.iter().map(|&v| Cell::Value(v)));
+        cells.push(Cell::Value(Some(r.wall_seconds)));
         w.serialize(cells)?;
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
