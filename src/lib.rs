@@ -12,6 +12,7 @@ pub mod algos;
 pub mod api;
 pub mod autograd;
 pub mod bench;
+pub mod cli;
 pub mod curve_stats;
 pub mod deploy;
 pub mod envs;
