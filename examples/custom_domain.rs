@@ -20,7 +20,7 @@
 //! `domain` and `render` refuse it: Rendezvous is not built into the binary.
 
 use macdec::experiment::metrics;
-use macdec::{paper_defaults, EnvError, EnvRng, EnvSpec, MacroEnv, Method, PolicyEnv, StepOutcome};
+use macdec::{paper_defaults, EnvError, EnvRng, MacroEnv, Method, PolicyEnv, StepOutcome};
 
 /// Corridor cells.
 const CELLS: usize = 9;
@@ -220,7 +220,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // Start from the paper's Warehouse settings (whole-episode replay) and scale them down.
         // The config's `env` stays Warehouse's: `macdec::train` trains on Rendezvous instead and
         // takes the horizon from it.
-        let mut config = paper_defaults(EnvSpec::paper_warehouse(), method);
+        let mut config = paper_defaults(&macdec::envs::warehouse::paper_spec(), method);
         config.discount = DISCOUNT;
         config.total_epi = 3000;
         config.eps_l_d_steps = 1500;

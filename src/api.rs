@@ -121,7 +121,7 @@ impl TrainedPolicy {
         // manifest's `env` alone.
         let config = match &domain {
             PolicyEnv::BuiltIn(spec) => serde_json::to_value(RunSettings {
-                env: *spec,
+                env: spec.clone(),
                 config: self.config.clone(),
             }),
             PolicyEnv::Custom(_) => serde_json::to_value(&self.config),
@@ -147,13 +147,12 @@ mod tests {
     use crate::experiment::paper::paper_defaults;
 
     /// The library trains on BP 10x10 here.
-    const SPEC: EnvSpec = EnvSpec::BoxPushing {
-        grid: 10,
-        horizon: 100,
-    };
+    fn spec() -> EnvSpec {
+        crate::envs::box_pushing::spec(10, 100)
+    }
 
     fn short(method: Method) -> RunConfig {
-        let mut c = paper_defaults(SPEC, method);
+        let mut c = paper_defaults(&spec(), method);
         c.total_epi = 12;
         c.eval_freq = 4;
         c
@@ -163,9 +162,9 @@ mod tests {
     fn library_training_gives_the_numbers_of_the_command_lines_trainer() {
         for method in [Method::Our1, Method::DecHddrqn] {
             let c = short(method);
-            let evals = train(|| SPEC.build(), &c, method, 5, |_| {}).unwrap();
+            let evals = train(|| spec().build(), &c, method, 5, |_| {}).unwrap();
             let mut t: AnyLoop<AnyEnv> =
-                AnyLoop::new(&c, method, 5, run_rngs(5), || SPEC.build()).unwrap();
+                AnyLoop::new(&c, method, 5, run_rngs(5), || spec().build()).unwrap();
             while t.advance().unwrap() != Advance::Finished {}
             assert_eq!(evals.len(), 4);
             for (a, b) in evals.iter().zip(t.evals()) {
@@ -186,7 +185,7 @@ mod tests {
         use crate::deploy::manifest::load_agent;
         use crate::deploy::qnet_policy::load_net;
         let c = short(Method::Our1);
-        let spec = SPEC;
+        let spec = spec();
         let trained = train_policy(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
         let evals = train(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
         let no_wall = |e: &[EvalPoint]| -> Vec<EvalPoint> {
@@ -202,7 +201,7 @@ mod tests {
         let env = spec.build().unwrap();
         let dir = tempfile::tempdir().unwrap();
         for (sub, domain) in [
-            ("built-in", PolicyEnv::from(spec)),
+            ("built-in", PolicyEnv::from(spec.clone())),
             ("custom", PolicyEnv::custom("my-pushing", &env)),
         ] {
             let out = dir.path().join(sub);
@@ -235,7 +234,7 @@ mod tests {
     fn a_bad_config_key_is_named_before_training() {
         let mut c = short(Method::Our1);
         c.batch_size = 0;
-        let spec = SPEC;
+        let spec = spec();
         let err = train(|| spec.build(), &c, Method::Our1, 0, |_| {}).unwrap_err();
         assert!(err.to_string().contains("batch_size"), "{err}");
     }
@@ -243,11 +242,8 @@ mod tests {
     #[test]
     fn a_failing_env_factory_is_reported() {
         let c = short(Method::Our1);
-        let bad = crate::envs::EnvSpec::BoxPushing {
-            grid: 3,
-            horizon: 100,
-        };
-        let err = train(|| bad.build(), &c, Method::Our1, 0, |_| {}).unwrap_err();
+        let bad = || crate::envs::box_pushing::BoxPushing::new(3, 100);
+        let err = train(bad, &c, Method::Our1, 0, |_| {}).unwrap_err();
         assert!(err.to_string().contains("grid"), "{err}");
     }
 }

@@ -15,6 +15,7 @@ pub mod bench;
 pub mod cli;
 pub mod curve_stats;
 pub mod deploy;
+pub mod draw;
 pub mod envs;
 pub mod experiment;
 pub mod files;

@@ -10,7 +10,7 @@ use macdec::deploy::link::JsonLink;
 use macdec::deploy::manifest::Manifest;
 use macdec::deploy::protocol::Reply;
 use macdec::deploy::{greedy_action, PolicyEnv};
-use macdec::{paper_defaults, EnvError, EnvRng, EnvSpec, MacroEnv, Method, StepOutcome};
+use macdec::{paper_defaults, EnvError, EnvRng, MacroEnv, Method, StepOutcome};
 use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;
 use std::path::Path;
@@ -127,7 +127,7 @@ impl MacroEnv for Beacon {
 
 /// A few episodes of Our-1 on [`Beacon`] through the library, exported to `dir`.
 fn train_and_export(dir: &Path) -> (macdec::TrainedPolicy, Manifest) {
-    let mut config = paper_defaults(EnvSpec::paper_warehouse(), Method::Our1);
+    let mut config = paper_defaults(&macdec::envs::warehouse::paper_spec(), Method::Our1);
     config.total_epi = 12;
     config.eps_l_d_steps = 6;
     config.h_stable_at = 6;

@@ -16,10 +16,9 @@ mod common;
 
 use common::{ok, traces, BIN};
 
-const BP10: EnvSpec = EnvSpec::BoxPushing {
-    grid: 10,
-    horizon: 100,
-};
+fn bp10() -> EnvSpec {
+    macdec::envs::box_pushing::spec(10, 100)
+}
 
 fn observe(obs: &[f32], done: bool) -> String {
     Request::Observe {
@@ -32,7 +31,7 @@ fn observe(obs: &[f32], done: bool) -> String {
 #[test]
 fn stdio_robot_keeps_its_hidden_state_and_survives_bad_lines() {
     let dir = tempfile::tempdir().unwrap();
-    let manifest = write_mock_policy(dir.path(), BP10).unwrap();
+    let manifest = write_mock_policy(dir.path(), bp10()).unwrap();
     let (a, b) = ([1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.0, 0.0]);
     let input = [
         r#"{"type":"info"}"#.to_string(),
@@ -100,7 +99,7 @@ fn stdio_robot_keeps_its_hidden_state_and_survives_bad_lines() {
 #[test]
 fn robot_refuses_a_corrupt_export_with_the_file_named() {
     let dir = tempfile::tempdir().unwrap();
-    write_mock_policy(dir.path(), BP10).unwrap();
+    write_mock_policy(dir.path(), bp10()).unwrap();
     let path = dir.path().join("agent-1.safetensors");
     let mut bytes = std::fs::read(&path).unwrap();
     let last = bytes.len() - 1;
@@ -142,7 +141,7 @@ fn robot_refuses_a_corrupt_export_with_the_file_named() {
 #[test]
 fn tcp_robot_announces_its_port_and_serves_connections() {
     let dir = tempfile::tempdir().unwrap();
-    write_mock_policy(dir.path(), BP10).unwrap();
+    write_mock_policy(dir.path(), bp10()).unwrap();
     let mut child = Command::new(BIN)
         .args([
             "robot",
@@ -186,11 +185,8 @@ fn tcp_robot_announces_its_port_and_serves_connections() {
 #[test]
 fn deployed_robot_processes_equal_in_process_greedy_execution() {
     let dir = tempfile::tempdir().unwrap();
-    let env = EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.2,
-    };
-    let manifest = write_mock_policy(dir.path(), env).unwrap();
+    let env = macdec::envs::warehouse::spec(150, 0.2);
+    let manifest = write_mock_policy(dir.path(), env.clone()).unwrap();
     let out = Command::new(BIN)
         .args([
             "deploy",
@@ -336,7 +332,7 @@ fn deploy_prints_each_episode_as_it_ends() {
     // A million episodes would take hours: the first line must still arrive within seconds, so
     // results are streamed, not kept until the end.
     let dir = tempfile::tempdir().unwrap();
-    write_mock_policy(dir.path(), BP10).unwrap();
+    write_mock_policy(dir.path(), bp10()).unwrap();
     let mut child = Command::new(BIN)
         .args(["deploy", "--mock", "--episodes", "1000000", "--policy"])
         .arg(dir.path())

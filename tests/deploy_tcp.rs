@@ -34,7 +34,7 @@ fn rng(seed: u64) -> EnvRng {
 /// `algos::value::evaluate::greedy_episode` with `select_dec`): free agents, in index order, query
 /// their own policy on their own observation and take the first maximal Q.
 fn reference_episode(env_spec: EnvSpec, seed_rng: &mut EnvRng) -> (f64, Vec<Vec<usize>>, Vec<f64>) {
-    let manifest = mock_manifest(env_spec);
+    let manifest = mock_manifest(env_spec.clone());
     let mut policies = mock_policies(&manifest);
     let mut env = env_spec.build().unwrap();
     env.reset(seed_rng);
@@ -67,7 +67,7 @@ fn tcp_robots(
     Vec<RobotServer>,
     Vec<JsonLink<std::io::BufReader<std::net::TcpStream>, std::net::TcpStream>>,
 ) {
-    let manifest = mock_manifest(env_spec);
+    let manifest = mock_manifest(env_spec.clone());
     let servers: Vec<RobotServer> = (0..manifest.agents.len())
         .map(|i| mock_robot_server(&manifest, i, i as u64))
         .collect();
@@ -82,8 +82,8 @@ fn tcp_robots(
 }
 
 fn check_equals_reference(env_spec: EnvSpec, seed: u64, episodes: usize) -> Vec<EpisodeTrace> {
-    let manifest = mock_manifest(env_spec);
-    let (_servers, mut links) = tcp_robots(env_spec);
+    let manifest = mock_manifest(env_spec.clone());
+    let (_servers, mut links) = tcp_robots(env_spec.clone());
     let mut env = env_spec.build().unwrap();
     let over_tcp = run_episodes(
         &mut env,
@@ -108,7 +108,7 @@ fn check_equals_reference(env_spec: EnvSpec, seed: u64, episodes: usize) -> Vec<
     assert_eq!(over_tcp, in_process);
     let mut reference_rng = rng(seed);
     for trace in &over_tcp {
-        let (ret, executed, rewards) = reference_episode(env_spec, &mut reference_rng);
+        let (ret, executed, rewards) = reference_episode(env_spec.clone(), &mut reference_rng);
         assert_eq!(trace.discounted_return, ret);
         let got: Vec<Vec<usize>> = trace
             .trajectory
@@ -144,26 +144,16 @@ fn check_equals_reference(env_spec: EnvSpec, seed: u64, episodes: usize) -> Vec<
 
 #[test]
 fn box_pushing_over_tcp_equals_in_process_greedy_execution() {
-    let traces = check_equals_reference(
-        EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        },
-        0,
-        2,
-    );
+    let traces = check_equals_reference(macdec::envs::box_pushing::spec(10, 100), 0, 2);
     assert_eq!(traces.len(), 2);
     assert!(traces[0].trajectory.last().unwrap().done);
 }
 
 #[test]
 fn noisy_warehouse_over_tcp_equals_in_process_greedy_execution_with_the_same_seed() {
-    let spec = EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.3,
-    };
-    let a = check_equals_reference(spec, 11, 3);
-    let b = check_equals_reference(spec, 12, 1);
+    let spec = macdec::envs::warehouse::spec(150, 0.3);
+    let a = check_equals_reference(spec.clone(), 11, 3);
+    let b = check_equals_reference(spec.clone(), 12, 1);
     // The seed matters (movement noise), so equality above is per seed, not by accident.
     assert_ne!(a[0].trajectory, b[0].trajectory);
 }
@@ -175,18 +165,12 @@ fn noisy_warehouse_over_tcp_equals_in_process_greedy_execution_with_the_same_see
 fn deploy_speed() {
     use std::time::Instant;
     for spec in [
-        EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        },
-        EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.0,
-        },
+        macdec::envs::box_pushing::spec(10, 100),
+        macdec::envs::warehouse::spec(150, 0.0),
     ] {
-        let manifest = mock_manifest(spec);
+        let manifest = mock_manifest(spec.clone());
         let mut env = spec.build().unwrap();
-        let (_servers, mut links) = tcp_robots(spec);
+        let (_servers, mut links) = tcp_robots(spec.clone());
         let episodes = 200;
         let start = Instant::now();
         let traces = run_episodes(&mut env, &mut links, 0.98, episodes, &mut rng(0)).unwrap();
@@ -215,10 +199,7 @@ fn deploy_speed() {
 /// TCP, give exactly what `algos::value::evaluate::greedy_episode` gives in-process.
 #[test]
 fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
-    let env_spec = EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.2,
-    };
+    let env_spec = macdec::envs::warehouse::spec(150, 0.2);
     let mut env = env_spec.build().unwrap();
     // Large pseudo-random weights, so the greedy actions change along an episode.
     let arch = Architecture::ddrqn(16, 8);
@@ -285,10 +266,7 @@ fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
 
 #[test]
 fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
-    let spec = EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.3,
-    };
+    let spec = macdec::envs::warehouse::spec(150, 0.3);
     let mut env = spec.build().unwrap();
     let dir = tempfile::tempdir().unwrap();
     write_synthetic_policy(dir.path(), spec, 1.0, 0);
@@ -343,10 +321,7 @@ fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
 }
 
 fn spec() -> EnvSpec {
-    EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.3,
-    }
+    macdec::envs::warehouse::spec(150, 0.3)
 }
 
 #[test]

@@ -6,7 +6,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use macdec::envs::bench::random_macro_steps;
-use macdec::envs::{EnvRng, EnvSpec};
+use macdec::envs::EnvRng;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -52,22 +52,10 @@ fn allocations_during(f: impl FnOnce()) -> u64 {
 #[test]
 fn stepping_and_resetting_allocate_nothing() {
     let specs = [
-        EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        },
-        EnvSpec::BoxPushing {
-            grid: 30,
-            horizon: 200,
-        },
-        EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.0,
-        },
-        EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.1,
-        },
+        macdec::envs::box_pushing::spec(10, 100),
+        macdec::envs::box_pushing::spec(30, 200),
+        macdec::envs::warehouse::spec(150, 0.0),
+        macdec::envs::warehouse::spec(150, 0.1),
     ];
     for spec in specs {
         let mut env = spec.build().unwrap();

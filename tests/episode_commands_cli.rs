@@ -10,10 +10,9 @@ use macdec::envs::EnvSpec;
 use std::process::Output;
 
 /// Noisy Warehouse: the seed changes the episodes, so a wrong seed shows.
-const NOISY_WAREHOUSE: EnvSpec = EnvSpec::Warehouse {
-    horizon: 150,
-    tb_m_noisy: 0.3,
-};
+fn noisy_warehouse() -> EnvSpec {
+    macdec::envs::warehouse::spec(150, 0.3)
+}
 
 /// The seed the policy's run claims; the default of `--seed`.
 const RUN_SEED: u64 = 7;
@@ -31,7 +30,7 @@ fn mean(traces: &[EpisodeTrace], f: impl Fn(&EpisodeTrace) -> f64) -> f64 {
 #[test]
 fn eval_deploy_and_domain_print_the_same_episodes_and_their_own_summaries() {
     let dir = tempfile::tempdir().unwrap();
-    let manifest = write_synthetic_policy(dir.path(), NOISY_WAREHOUSE, 0.95, RUN_SEED);
+    let manifest = write_synthetic_policy(dir.path(), noisy_warehouse(), 0.95, RUN_SEED);
     let p = dir.path().to_str().unwrap();
     let robots: Vec<_> = (0..manifest.agents.len())
         .map(|i| robot_process(dir.path(), i, false))

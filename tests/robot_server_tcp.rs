@@ -12,7 +12,6 @@ use macdec::deploy::server::{
     spawn_server, Limits, PolicyFactory, RobotServer, DEFAULT_IDLE_TIMEOUT_SECS,
 };
 use macdec::deploy::AgentPolicy;
-use macdec::envs::EnvSpec;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::io::Write;
@@ -26,10 +25,7 @@ const OBS: usize = 5;
 const ACTIONS: usize = 8;
 
 fn start_with(limits: Limits, factory: PolicyFactory) -> RobotServer {
-    let manifest = mock_manifest(EnvSpec::BoxPushing {
-        grid: 10,
-        horizon: 100,
-    });
+    let manifest = mock_manifest(macdec::envs::box_pushing::spec(10, 100));
     let spec = Arc::new(RobotSpec::new(&manifest, 0).unwrap());
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     spawn_server(listener, factory, spec, limits).unwrap()

@@ -13,7 +13,6 @@ mod common;
 use common::{agents_arg, write_agents, BIN};
 use macdec::deploy::architecture::Architecture;
 use macdec::deploy::import::Naming;
-use macdec::envs::EnvSpec;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -30,10 +29,7 @@ fn run(args: &[&str]) -> Output {
 
 /// An imported noisy Warehouse policy with large pseudo-random weights (actions vary).
 fn warehouse_policy(dir: &Path) -> PathBuf {
-    let env = EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.3,
-    };
+    let env = macdec::envs::warehouse::spec(150, 0.3);
     let files = agents_arg(&write_agents(
         dir,
         env,

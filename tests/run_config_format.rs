@@ -19,17 +19,11 @@ fn fixtures() -> [(PathBuf, EnvSpec); 2] {
     [
         (
             dir.join("fig4a_bp10_our1_seed-0.toml"),
-            EnvSpec::BoxPushing {
-                grid: 10,
-                horizon: 100,
-            },
+            macdec::envs::box_pushing::spec(10, 100),
         ),
         (
             dir.join("fig5_wtd_cen-ddrqn_seed-5.toml"),
-            EnvSpec::Warehouse {
-                horizon: 150,
-                tb_m_noisy: 0.0,
-            },
+            macdec::envs::warehouse::spec(150, 0.0),
         ),
     ]
 }

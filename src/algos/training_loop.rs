@@ -336,7 +336,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 mod tests {
     use super::*;
     use crate::algos::learner::LanePlan;
-    use crate::envs::{EnvSpec, StepOutcome};
+    use crate::envs::StepOutcome;
     use crate::experiment::paper::paper_defaults;
     use crate::experiment::train_run::run_rngs;
 
@@ -447,11 +447,8 @@ mod tests {
     fn the_loop_trains_syncs_and_evaluates_on_the_learners_schedule() {
         // Box Pushing 8x8 with horizon 10 and every agent always on action 0: each episode runs
         // to the horizon, so episode k ends at main-loop step 10k - 1.
-        let spec = EnvSpec::BoxPushing {
-            grid: 8,
-            horizon: 10,
-        };
-        let mut config = paper_defaults(spec, Method::Our2);
+        let spec = crate::envs::box_pushing::spec(8, 10);
+        let mut config = paper_defaults(&spec, Method::Our2);
         config.total_epi = 4;
         config.eval_freq = 2;
         config.checkpoint_freq = 3;

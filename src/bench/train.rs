@@ -40,12 +40,12 @@ pub fn suite() -> Vec<(EnvSpec, Method)> {
     let mut v: Vec<(EnvSpec, Method)> = Method::ALL
         .into_iter()
         .filter(|&m| !m.requires_episode_buffer())
-        .map(|m| (EnvSpec::paper_box_pushing(10), m))
+        .map(|m| (crate::envs::box_pushing::paper_spec(10), m))
         .collect();
     v.extend(
         Method::ALL
             .into_iter()
-            .map(|m| (EnvSpec::paper_warehouse(), m)),
+            .map(|m| (crate::envs::warehouse::paper_spec(), m)),
     );
     v
 }
@@ -56,7 +56,7 @@ pub fn bench_train(
     method: Method,
     episodes: usize,
 ) -> Result<TrainBench, TrainError> {
-    let mut config = paper_defaults(env, method);
+    let mut config = paper_defaults(&env, method);
     config.total_epi = episodes;
     let start = Instant::now();
     let mut trainer = AnyLoop::new(&config, method, 0, run_rngs(0), || env.build())?;

@@ -2,8 +2,6 @@
 //! [`main`]; a user's own binary gets the same command line for its own domains with
 //! [`main_with`].
 
-use anyhow::{bail, Context, Result};
-use clap::{Parser, Subcommand, ValueEnum};
 use crate::algos::method::Method;
 use crate::bench::nets;
 use crate::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
@@ -14,6 +12,8 @@ use crate::experiment::seeds::parse_seeds;
 use crate::experiment::slurm::{job_script, SlurmOptions};
 use crate::experiment::train_run::train_run;
 use crate::nn::demo;
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -719,7 +719,6 @@ fn demo_run(steps: usize, seed: u64) -> Result<()> {
 fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
     use crate::algos::method::Method;
     use crate::bench::train;
-    use crate::envs::EnvSpec;
     let mut rows = Vec::new();
     for (env, method) in train::suite() {
         if only.is_some_and(|o| o != train::name(&env, method)) {
@@ -732,10 +731,26 @@ fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
     print!("{}", train::format_table(&rows));
     if only.is_none() {
         // Two runs on two threads should take no longer than one alone (no shared state).
-        let one = train::bench_train(EnvSpec::paper_box_pushing(10), Method::Our1, episodes)?;
+        let one = train::bench_train(
+            crate::envs::box_pushing::paper_spec(10),
+            Method::Our1,
+            episodes,
+        )?;
         let (a, b) = rayon::join(
-            || train::bench_train(EnvSpec::paper_box_pushing(10), Method::Our1, episodes),
-            || train::bench_train(EnvSpec::paper_box_pushing(10), Method::Our1, episodes),
+            || {
+                train::bench_train(
+                    crate::envs::box_pushing::paper_spec(10),
+                    Method::Our1,
+                    episodes,
+                )
+            },
+            || {
+                train::bench_train(
+                    crate::envs::box_pushing::paper_spec(10),
+                    Method::Our1,
+                    episodes,
+                )
+            },
         );
         let (a, b) = (a?, b?);
         println!(
@@ -1014,22 +1029,27 @@ fn deploy(args: DeployArgs) -> Result<()> {
 
 fn import(args: ImportArgs) -> Result<()> {
     use crate::deploy::import::{import_policy, ImportRequest};
+    use crate::envs::domain::{key_table, HORIZON_KEY};
     use crate::envs::EnvSpec;
+    let horizon = (HORIZON_KEY, toml::Value::from(args.horizon as i64));
     let env = match (args.env, args.grid) {
-        (ImportEnv::BoxPushing, Some(grid)) => EnvSpec::BoxPushing {
-            grid,
-            horizon: args.horizon,
-        },
+        (ImportEnv::BoxPushing, Some(grid)) => EnvSpec::new(
+            "box-pushing",
+            &key_table([("grid_dim", (grid as i64).into()), horizon]),
+        ),
         (ImportEnv::BoxPushing, None) => bail!("--env box-pushing needs --grid N"),
-        (ImportEnv::Warehouse, None) => EnvSpec::Warehouse {
-            horizon: args.horizon,
-            tb_m_noisy: args.tb_m_noisy,
-        },
+        (ImportEnv::Warehouse, None) => EnvSpec::new(
+            "warehouse",
+            &key_table([horizon, ("tb_m_noisy", args.tb_m_noisy.into())]),
+        ),
         (ImportEnv::Warehouse, Some(_)) => bail!("--grid is for box-pushing; warehouse has none"),
-    };
+    }?;
     let request = ImportRequest {
+        discount: args
+            .discount
+            .or_else(|| env.paper_discount())
+            .unwrap_or(1.0),
         env,
-        discount: args.discount.unwrap_or_else(|| env.paper_discount()),
         agents: args.agents,
     };
     let manifest = import_policy(&request, &args.out)

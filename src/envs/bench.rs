@@ -75,24 +75,15 @@ pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
     vec![
         (
             "box-pushing 10x10 (horizon 100)",
-            EnvSpec::BoxPushing {
-                grid: 10,
-                horizon: 100,
-            },
+            crate::envs::box_pushing::spec(10, 100),
         ),
         (
             "box-pushing 30x30 (horizon 200)",
-            EnvSpec::BoxPushing {
-                grid: 30,
-                horizon: 200,
-            },
+            crate::envs::box_pushing::spec(30, 200),
         ),
         (
             "warehouse (horizon 150)",
-            EnvSpec::Warehouse {
-                horizon: 150,
-                tb_m_noisy: 0.0,
-            },
+            crate::envs::warehouse::spec(150, 0.0),
         ),
     ]
 }
@@ -105,10 +96,7 @@ mod tests {
     fn random_stepping_counts_steps_and_restarts_episodes() {
         // Stay-only episodes of BP last the horizon; random ones at most the horizon, so 1000
         // steps with horizon 10 need at least 100 episodes.
-        let spec = EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 10,
-        };
+        let spec = crate::envs::box_pushing::spec(10, 10);
         let r = bench_env("bp", spec, 1000).unwrap();
         assert_eq!(r.steps, 1000);
         assert!(r.episodes >= 100, "{r:?}");

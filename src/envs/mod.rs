@@ -12,12 +12,17 @@ use rand_chacha::ChaCha8Rng;
 
 pub mod bench;
 pub mod box_pushing;
-pub mod flags;
+pub mod built_in;
+pub mod custom_env;
+pub mod domain;
+pub mod registry;
 pub mod replay;
 pub mod spec;
 pub mod warehouse;
 
-pub use spec::{AnyEnv, EnvSpec};
+pub use built_in::AnyEnv;
+pub use domain::Domain;
+pub use spec::EnvSpec;
 
 /// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the
 /// caller, so a checkpoint can save it and a run derives it from its seed (spec `algorithms.md` 8).
@@ -38,6 +43,8 @@ pub enum EnvError {
     EpisodeOver,
     #[error("invalid environment parameter `{name}`: {reason}")]
     InvalidParameter { name: &'static str, reason: String },
+    #[error("invalid domain key `{key}`: {reason}")]
+    InvalidKey { key: String, reason: String },
 }
 
 /// What one primitive step returns besides the observations (read them with [`MacroEnv::obs`]).
@@ -114,8 +121,10 @@ pub enum FirstRecordObs {
 /// [`Self::deterministic`] (default true) lets evaluation run one greedy episode instead of
 /// `eval_num_epi`, so it must be false if any step draws from the rng;
 /// [`Self::optimal_return`] is the best return under a per-step discount where it is known (the
-/// plots' optimal line); [`Self::describe`] titles figures. A domain implementing this trait
-/// correctly needs nothing else from `src/` to train with every method.
+/// plots' optimal line); [`Self::describe`] titles figures; [`Self::draw`] is the picture
+/// `macdec render` animates. A domain implementing this trait correctly needs nothing else from
+/// `src/` to train with every method; to get the whole command line (configs, runs, plots,
+/// export, ...) it also implements [`domain::Domain`].
 pub trait MacroEnv {
     /// Number of agents (Box Pushing 2, Warehouse 3).
     fn n_agents(&self) -> usize;
@@ -172,6 +181,11 @@ pub trait MacroEnv {
     /// A short description for figure titles, e.g. "Box Pushing 10x10, horizon 100".
     fn describe(&self) -> String {
         format!("{} agents, horizon {}", self.n_agents(), self.horizon())
+    }
+    /// A picture of the current state for `macdec render` (which adds the status bar below
+    /// it), drawn with [`crate::draw`]; `None` (the default) when the domain draws none.
+    fn draw(&self) -> Option<crate::draw::Picture> {
+        None
     }
 
     /// Total joint observation size (sum of the agents' sizes), the centralized nets' input.

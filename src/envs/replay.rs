@@ -291,13 +291,13 @@ mod tests {
         let e = error_of(r#"{"env": "box-pushing", "grid": 10, "horizon": 100}"#);
         assert!(e.contains("missing field `steps`"), "{e}");
         let e = error_of(r#"{"env": "sokoban", "horizon": 100, "steps": []}"#);
-        assert!(e.contains("unknown variant `sokoban`"), "{e}");
+        assert!(e.contains("unknown domain `sokoban`"), "{e}");
         let e = error_of(r#"{"env": "box-pushing", "horizon": 100, "steps": []}"#);
         assert!(e.contains("missing field `grid`"), "{e}");
         let e = error_of(r#"{"env": "box-pushing", "grid": 7, "horizon": 100, "steps": []}"#);
-        assert!(e.contains("cannot build") && e.contains("grid"), "{e}");
+        assert!(e.contains("grid_dim") && e.contains("got 7"), "{e}");
         let e = error_of(r#"{"env": "warehouse", "horizon": 0, "steps": []}"#);
-        assert!(e.contains("cannot build") && e.contains("horizon"), "{e}");
+        assert!(e.contains("env_terminate_step"), "{e}");
         let e = error_of(&bp10("[[1, 2], [3]]"));
         assert_eq!(e, "step 2: expected 2 actions (one per agent), got 1");
         let e = error_of(&bp10("[[1, 8]]"));

@@ -1,235 +1,221 @@
-//! Choosing a domain by value: [`EnvSpec`] says which environment and with which parameters (as it
-//! appears in configs and replay files), and [`AnyEnv`] holds any built domain behind one
-//! [`MacroEnv`] implementation, dispatched by `match` (no trait objects, `Clone`).
+//! Choosing a domain by value: [`EnvSpec`] is a domain and its config keys, complete and checked,
+//! as configs record it; [`EnvSpec::build`] gives the environment as an [`AnyEnv`].
+//!
+//! In policy and replay files a spec is one JSON object, the domain's tag and its fields
+//! ([`Domain::to_tagged`](super::domain::Domain::to_tagged)): `{"env": "box-pushing", "grid":
+//! 10, "horizon": 100}`, `{"env": "warehouse", "horizon": 150, "tb_m_noisy": 0.0}`, or a user's
+//! domain's `{"env": "rendezvous", "env_terminate_step": 20}`.
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::box_pushing::BoxPushing;
-use super::warehouse::{Warehouse, WarehouseParams};
-use super::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
+use super::domain::{key_usize, DomainEntry, KeyError, HORIZON_KEY};
+use super::{registry, AnyEnv, EnvError};
 
-/// Which domain, with its parameters. Serialized with the tag `env`:
-/// `{"env": "box-pushing", "grid": 10, "horizon": 100}` or `{"env": "warehouse", "horizon": 150}`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "env", deny_unknown_fields)]
-pub enum EnvSpec {
-    /// Box Pushing on a `grid` x `grid` grid (spec `box_pushing.md`; paper: 10/100 and 30/200).
-    #[serde(rename = "box-pushing")]
-    BoxPushing { grid: usize, horizon: usize },
-    /// Warehouse Tool Delivery (spec `warehouse.md`; paper: horizon 150, no movement noise).
-    #[serde(rename = "warehouse")]
-    Warehouse {
-        horizon: usize,
-        /// Std of the Turtlebots' movement noise (`TB_move_noisy`; paper 0).
-        #[serde(default)]
-        tb_m_noisy: f64,
+/// A domain and the values of all its config keys (checked by the domain).
+#[derive(Clone)]
+pub struct EnvSpec {
+    domain: &'static dyn DomainEntry,
+    keys: toml::Table,
+}
+
+/// Why a spec could not be made: no such domain, or a bad key.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpecError {
+    #[error("unknown domain `{name}`: this binary has {known}")]
+    UnknownDomain { name: String, known: String },
+    #[error("{domain}: {source}")]
+    Key {
+        domain: &'static str,
+        #[source]
+        source: KeyError,
     },
 }
 
-impl EnvSpec {
-    /// The `env` tag of this spec.
-    pub fn name(&self) -> &'static str {
+impl SpecError {
+    /// The config key to blame: `env_name` for an unknown domain, else the bad key.
+    pub fn key(&self) -> &str {
         match self {
-            EnvSpec::BoxPushing { .. } => "box-pushing",
-            EnvSpec::Warehouse { .. } => "warehouse",
+            SpecError::UnknownDomain { .. } => "env_name",
+            SpecError::Key { source, .. } => &source.key,
         }
     }
+}
 
-    /// Box Pushing at the paper's horizon for its grid: 100 steps below 30 x 30 (Figure 4a's 10 x
-    /// 10), 200 from 30 x 30 on (Figure 4b) (spec `algorithms.md` 10.1, 10.2).
-    pub fn paper_box_pushing(grid: usize) -> EnvSpec {
-        EnvSpec::BoxPushing {
-            grid,
-            horizon: if grid >= 30 { 200 } else { 100 },
-        }
+impl EnvSpec {
+    /// The domain named `name` (its `env_name`, an alias or its tag) with the keys `given`
+    /// (the rest at the domain's defaults).
+    pub fn new(name: &str, given: &toml::Table) -> Result<EnvSpec, SpecError> {
+        let domain = registry::find(name).ok_or_else(|| SpecError::UnknownDomain {
+            name: name.to_string(),
+            known: registry::names_and_tags(),
+        })?;
+        Self::of(domain, given)
     }
 
-    /// Warehouse Tool Delivery as in Figure 5: horizon 150, no movement noise (spec 10.3).
-    pub fn paper_warehouse() -> EnvSpec {
-        let p = WarehouseParams::default();
-        EnvSpec::Warehouse {
-            horizon: p.terminate_step,
-            tb_m_noisy: p.tb_move_noisy,
+    /// `domain` with the keys `given` (the rest at the domain's defaults).
+    pub fn of(domain: &'static dyn DomainEntry, given: &toml::Table) -> Result<EnvSpec, SpecError> {
+        let keys = domain.keys(given).map_err(|source| SpecError::Key {
+            domain: domain.name(),
+            source,
+        })?;
+        if let Err(source) = key_usize(&keys, HORIZON_KEY) {
+            return Err(SpecError::Key {
+                domain: domain.name(),
+                source,
+            });
         }
+        Ok(EnvSpec { domain, keys })
+    }
+
+    /// The named domain at its default keys (see [`Self::new`]); panics on an unknown name, so
+    /// only for names known to be built in.
+    pub fn built_in(name: &str) -> EnvSpec {
+        Self::new(name, &toml::Table::new()).expect("a built-in domain at its defaults")
+    }
+
+    /// The domain.
+    pub fn domain(&self) -> &'static dyn DomainEntry {
+        self.domain
+    }
+
+    /// Every key of the domain with its value, in the order `config.toml` records them.
+    pub fn keys(&self) -> &toml::Table {
+        &self.keys
+    }
+
+    /// The domain's `env_name` (`BP_MA`, `OSD_S_4`, a user's domain's name).
+    pub fn env_name(&self) -> &'static str {
+        self.domain.name()
+    }
+
+    /// The domain's tag in policy and replay files (`box-pushing`, `warehouse`), the name
+    /// messages use.
+    pub fn name(&self) -> &'static str {
+        self.domain.tag()
     }
 
     /// The horizon in primitive steps (the `env_terminate_step` key).
     pub fn horizon(&self) -> usize {
-        match *self {
-            EnvSpec::BoxPushing { horizon, .. } | EnvSpec::Warehouse { horizon, .. } => horizon,
-        }
+        key_usize(&self.keys, HORIZON_KEY).expect("checked when the spec was made")
     }
 
-    /// A short label for tables, benchmarks and file names: `bp<grid>` (e.g. `bp10`) or `wtd`.
+    /// A short label for tables, benchmarks and file names: `bp10`, `wtd`, ...
     pub fn short_name(&self) -> String {
-        match self {
-            EnvSpec::BoxPushing { grid, .. } => format!("bp{grid}"),
-            EnvSpec::Warehouse { .. } => "wtd".into(),
+        self.domain.short_name(&self.keys)
+    }
+
+    /// The hyperparameters a paper used on this setting ([`super::domain::Domain::paper_settings`]).
+    pub fn paper_settings(&self) -> toml::Table {
+        self.domain.paper_settings(&self.keys)
+    }
+
+    /// The discount per primitive step the paper trains and evaluates this setting under (Box
+    /// Pushing 0.98, Warehouse 1.0; spec 10), the one its known optimum is stated for; `None`
+    /// for a domain no paper trained on.
+    pub fn paper_discount(&self) -> Option<f64> {
+        match self.paper_settings().get("discount")? {
+            toml::Value::Float(d) => Some(*d),
+            toml::Value::Integer(d) => Some(*d as f64),
+            _ => None,
         }
     }
 
-    /// The discount per primitive step the paper trains and evaluates this domain under (Box
-    /// Pushing 0.98, Warehouse 1.0; spec 10), the discount its known optimum is stated for.
-    pub fn paper_discount(&self) -> f64 {
-        match self {
-            EnvSpec::BoxPushing { .. } => 0.98,
-            EnvSpec::Warehouse { .. } => 1.0,
-        }
+    /// The same domain with `key` set to `value` (checked by the domain).
+    pub fn with(&self, key: &str, value: impl Into<toml::Value>) -> Result<EnvSpec, SpecError> {
+        let mut keys = self.keys.clone();
+        keys.insert(key.to_string(), value.into());
+        Self::of(self.domain, &keys)
     }
 
-    /// Check the parameters as [`Self::build`] would, without building: configs are validated
-    /// before any run starts. Errors name the bad parameter (`grid`, `horizon`, ...).
-    pub fn validate(&self) -> Result<(), EnvError> {
-        match *self {
-            EnvSpec::BoxPushing { grid, horizon } => BoxPushing::check_params(grid, horizon),
-            EnvSpec::Warehouse {
-                horizon,
-                tb_m_noisy,
-            } => warehouse_params(horizon, tb_m_noisy).validate(),
-        }
-    }
-
-    /// Build the environment, in its reset state. Errors name the bad parameter.
+    /// Build the environment, in its reset state. Errors name the bad key.
     pub fn build(&self) -> Result<AnyEnv, EnvError> {
-        match *self {
-            EnvSpec::BoxPushing { grid, horizon } => {
-                Ok(AnyEnv::BoxPushing(BoxPushing::new(grid, horizon)?))
-            }
-            EnvSpec::Warehouse {
-                horizon,
-                tb_m_noisy,
-            } => Ok(AnyEnv::Warehouse(Warehouse::new(warehouse_params(
-                horizon, tb_m_noisy,
-            ))?)),
-        }
+        self.domain
+            .build_any(&self.keys)
+            .map_err(|e| EnvError::InvalidKey {
+                key: e.key,
+                reason: e.message,
+            })
     }
 }
 
-/// Warehouse's full parameter set: a spec's horizon and noise, the paper's values for the rest.
-fn warehouse_params(horizon: usize, tb_m_noisy: f64) -> WarehouseParams {
-    WarehouseParams {
-        terminate_step: horizon,
-        tb_move_noisy: tb_m_noisy,
-        ..WarehouseParams::default()
+impl PartialEq for EnvSpec {
+    fn eq(&self, other: &Self) -> bool {
+        self.domain.name() == other.domain.name() && self.keys == other.keys
     }
 }
 
-/// Any built domain. Each method is one `match`, so the trainer pays no dynamic dispatch.
-///
-/// The variants differ in size (Warehouse is larger); a run holds one `AnyEnv`, so boxing would
-/// only add a pointer chase to every step of the hot loop.
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
-pub enum AnyEnv {
-    BoxPushing(BoxPushing),
-    Warehouse(Warehouse),
+impl std::fmt::Debug for EnvSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "EnvSpec({} {})", self.domain.name(), self.keys)
+    }
 }
 
-/// Forward a method call to the variant's environment.
-macro_rules! dispatch {
-    ($self:expr, $env:ident => $call:expr) => {
-        match $self {
-            AnyEnv::BoxPushing($env) => $call,
-            AnyEnv::Warehouse($env) => $call,
-        }
-    };
+impl Serialize for EnvSpec {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut object = serde_json::Map::new();
+        object.insert("env".into(), self.domain.tag().into());
+        object.extend(self.domain.to_tagged(&self.keys));
+        object.serialize(s)
+    }
 }
 
-impl MacroEnv for AnyEnv {
-    fn n_agents(&self) -> usize {
-        dispatch!(self, e => e.n_agents())
-    }
-    fn obs_sizes(&self) -> &[usize] {
-        dispatch!(self, e => e.obs_sizes())
-    }
-    fn n_actions(&self) -> &[usize] {
-        dispatch!(self, e => e.n_actions())
-    }
-    fn action_names(&self, agent: usize) -> &'static [&'static str] {
-        dispatch!(self, e => e.action_names(agent))
-    }
-    fn obs_names(&self, agent: usize) -> Vec<String> {
-        dispatch!(self, e => e.obs_names(agent))
-    }
-    fn horizon(&self) -> usize {
-        dispatch!(self, e => e.horizon())
-    }
-    fn reset(&mut self, rng: &mut EnvRng) {
-        dispatch!(self, e => e.reset(rng))
-    }
-    #[inline]
-    fn step(&mut self, actions: &[usize], rng: &mut EnvRng) -> Result<StepOutcome, EnvError> {
-        dispatch!(self, e => e.step(actions, rng))
-    }
-    #[inline]
-    fn obs(&self, agent: usize) -> &[f32] {
-        dispatch!(self, e => e.obs(agent))
-    }
-    fn executed(&self) -> &[usize] {
-        dispatch!(self, e => e.executed())
-    }
-    #[inline]
-    fn mac_done(&self) -> &[bool] {
-        dispatch!(self, e => e.mac_done())
-    }
-    #[inline]
-    fn is_free(&self, agent: usize) -> bool {
-        dispatch!(self, e => e.is_free(agent))
-    }
-    fn t(&self) -> usize {
-        dispatch!(self, e => e.t())
-    }
-    fn render_ascii(&self) -> String {
-        dispatch!(self, e => e.render_ascii())
-    }
-    fn first_record_obs(&self) -> FirstRecordObs {
-        dispatch!(self, e => e.first_record_obs())
-    }
-    fn deterministic(&self) -> bool {
-        dispatch!(self, e => e.deterministic())
-    }
-    fn optimal_return(&self, discount: f64) -> Option<f64> {
-        dispatch!(self, e => e.optimal_return(discount))
-    }
-    fn describe(&self) -> String {
-        dispatch!(self, e => e.describe())
+impl<'de> Deserialize<'de> for EnvSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut object = serde_json::Map::<String, serde_json::Value>::deserialize(d)?;
+        let tag = match object.remove("env") {
+            Some(serde_json::Value::String(tag)) => tag,
+            Some(other) => return Err(D::Error::custom(format!("`env` is not a name: {other}"))),
+            None => return Err(D::Error::missing_field("env")),
+        };
+        let domain = registry::find(&tag).ok_or_else(|| {
+            D::Error::custom(format!(
+                "unknown domain `{tag}`: this binary has {}",
+                registry::names_and_tags()
+            ))
+        })?;
+        let keys = domain
+            .keys_of_tagged(&object)
+            .map_err(|e| D::Error::custom(format!("{tag}: {e}")))?;
+        EnvSpec::of(domain, &keys).map_err(D::Error::custom)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::envs::box_pushing::BoxPushing;
+    use crate::envs::box_pushing::{paper_spec as paper_bp_spec, spec as bp_spec};
+    use crate::envs::warehouse::spec as wtd_spec;
+    use crate::envs::{EnvRng, MacroEnv};
 
     #[test]
     fn box_pushing_spec_parses_from_its_tagged_form() {
         let spec: EnvSpec =
             serde_json::from_str(r#"{"env": "box-pushing", "grid": 30, "horizon": 200}"#).unwrap();
-        assert_eq!(
-            spec,
-            EnvSpec::BoxPushing {
-                grid: 30,
-                horizon: 200
-            }
-        );
+        assert_eq!(spec, bp_spec(30, 200));
+        assert_eq!(spec, paper_bp_spec(30));
         let env = spec.build().unwrap();
         assert_eq!(env.horizon(), 200);
         assert_eq!(env.n_joint_actions(), 64);
+        assert_eq!(
+            serde_json::to_string(&spec).unwrap(),
+            r#"{"env":"box-pushing","grid":30,"horizon":200}"#
+        );
     }
 
     #[test]
     fn warehouse_spec_parses_with_paper_noise_by_default() {
         let spec: EnvSpec =
             serde_json::from_str(r#"{"env": "warehouse", "horizon": 150}"#).unwrap();
-        assert_eq!(
-            spec,
-            EnvSpec::Warehouse {
-                horizon: 150,
-                tb_m_noisy: 0.0
-            }
-        );
+        assert_eq!(spec, wtd_spec(150, 0.0));
         let env = spec.build().unwrap();
         assert_eq!(env.obs_sizes(), &[13, 13, 4]);
         assert_eq!(env.n_joint_actions(), 54);
+        assert_eq!(
+            serde_json::to_string(&spec).unwrap(),
+            r#"{"env":"warehouse","horizon":150,"tb_m_noisy":0.0}"#
+        );
     }
 
     #[test]
@@ -237,10 +223,7 @@ mod tests {
         let err = serde_json::from_str::<EnvSpec>(r#"{"env": "boxpushing", "horizon": 1}"#)
             .unwrap_err()
             .to_string();
-        assert!(
-            err.contains("boxpushing") && err.contains("box-pushing"),
-            "{err}"
-        );
+        assert!(err.contains("boxpushing") && err.contains("BP_MA"), "{err}");
         let err = serde_json::from_str::<EnvSpec>(r#"{"env": "box-pushing", "horizon": 1}"#)
             .unwrap_err()
             .to_string();
@@ -256,12 +239,7 @@ mod tests {
     #[test]
     fn any_env_steps_like_the_wrapped_env() {
         let mut rng = <EnvRng as rand::SeedableRng>::seed_from_u64(0);
-        let mut any = EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        }
-        .build()
-        .unwrap();
+        let mut any = bp_spec(10, 100).build().unwrap();
         let mut bp = BoxPushing::new(10, 100).unwrap();
         for _ in 0..7 {
             let a = any.step(&[2, 3], &mut rng).unwrap();

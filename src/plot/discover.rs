@@ -359,19 +359,26 @@ pub(crate) mod tests {
         dir
     }
 
-    const BP10: EnvSpec = EnvSpec::BoxPushing {
-        grid: 10,
-        horizon: 100,
-    };
+    fn bp10_spec() -> EnvSpec {
+        crate::envs::box_pushing::spec(10, 100)
+    }
 
     #[test]
     fn finds_experiments_curves_and_seeds_in_paper_order() {
         let t = tempfile::tempdir().unwrap();
         let pts = [(0, 1.0), (10, 2.0)];
-        write_run(t.path(), "fig4a", "our1", 10, &pts, BP10, true);
-        write_run(t.path(), "fig4a", "our1", 2, &pts[..1], BP10, false);
-        write_run(t.path(), "fig4a", "dec-hddrqn", 0, &pts, BP10, true);
-        write_run(t.path(), "fig4a", "our1@trace_len=10", 0, &pts, BP10, true);
+        write_run(t.path(), "fig4a", "our1", 10, &pts, bp10_spec(), true);
+        write_run(t.path(), "fig4a", "our1", 2, &pts[..1], bp10_spec(), false);
+        write_run(t.path(), "fig4a", "dec-hddrqn", 0, &pts, bp10_spec(), true);
+        write_run(
+            t.path(),
+            "fig4a",
+            "our1@trace_len=10",
+            0,
+            &pts,
+            bp10_spec(),
+            true,
+        );
         let d = discover(t.path()).unwrap();
         assert_eq!(d.experiments.len(), 1);
         let names: Vec<&str> = d.experiments[0]
@@ -389,7 +396,7 @@ pub(crate) mod tests {
         assert_eq!(our1.runs[0].points, vec![(0, 1.0)]);
         assert_eq!(our1.runs[1].wall_seconds, 5.0);
         assert_eq!(
-            our1.runs[1].setting.unwrap().optimal_return(),
+            our1.runs[1].setting.clone().unwrap().optimal_return(),
             Some(80.71093744250365)
         );
         assert!(d.notes.is_empty(), "{:?}", d.notes);
@@ -419,12 +426,12 @@ pub(crate) mod tests {
     #[test]
     fn shared_curves_are_read_from_the_experiment_they_belong_to() {
         let t = tempfile::tempdir().unwrap();
-        let bp = EnvSpec::paper_box_pushing(10);
-        write_run(t.path(), "fig5", "our2", 0, &[(0, 1.0)], bp, true);
-        write_run(t.path(), "fig5", "our2", 1, &[(0, 2.0)], bp, true);
-        write_run(t.path(), "fig6", "our1", 0, &[(0, 3.0)], bp, true);
+        let bp = crate::envs::box_pushing::paper_spec(10);
+        write_run(t.path(), "fig5", "our2", 0, &[(0, 1.0)], bp.clone(), true);
+        write_run(t.path(), "fig5", "our2", 1, &[(0, 2.0)], bp.clone(), true);
+        write_run(t.path(), "fig6", "our1", 0, &[(0, 3.0)], bp.clone(), true);
         // A stale own copy is replaced by the shared one, with a note.
-        write_run(t.path(), "fig6", "our2", 7, &[(0, 9.0)], bp, true);
+        write_run(t.path(), "fig6", "our2", 7, &[(0, 9.0)], bp.clone(), true);
         std::fs::write(
             t.path().join("fig6").join(SHARED_CURVES_FILE),
             "our2 = \"fig5\"\nour1-r = \"fig5\"\nbad = \"../x\"\n",
@@ -451,7 +458,7 @@ pub(crate) mod tests {
     #[test]
     fn junk_is_skipped_with_notes() {
         let t = tempfile::tempdir().unwrap();
-        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
         std::fs::create_dir_all(t.path().join("e/our1/seed-1")).unwrap(); // no metrics yet
         std::fs::create_dir_all(t.path().join("e/our1/tmp")).unwrap(); // not a seed dir
         std::fs::write(t.path().join("e/README.txt"), "stray file").unwrap();
@@ -467,8 +474,8 @@ pub(crate) mod tests {
     #[test]
     fn malformed_csv_is_a_warning_when_other_runs_exist() {
         let t = tempfile::tempdir().unwrap();
-        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
-        let bad = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], BP10, true);
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
+        let bad = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], bp10_spec(), true);
         std::fs::write(bad.join(METRICS_FILE), "episode,eval_return\nten,abc\n").unwrap();
         let d = discover(t.path()).unwrap();
         assert_eq!(d.experiments[0].curves[0].runs.len(), 1);
@@ -481,7 +488,7 @@ pub(crate) mod tests {
     #[test]
     fn malformed_csv_is_the_error_when_it_is_the_only_run() {
         let t = tempfile::tempdir().unwrap();
-        let bad = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        let bad = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
         std::fs::write(bad.join(METRICS_FILE), "episode,eval_return\nten,abc\n").unwrap();
         let err = discover(t.path()).unwrap_err();
         assert!(matches!(err, PlotError::Malformed { .. }));
@@ -491,9 +498,9 @@ pub(crate) mod tests {
     #[test]
     fn a_header_only_run_is_skipped_but_a_foreign_header_is_malformed() {
         let t = tempfile::tempdir().unwrap();
-        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
-        write_run(t.path(), "e", "our1", 1, &[], BP10, false);
-        let foreign = write_run(t.path(), "e", "our1", 2, &[(0, 1.0)], BP10, true);
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
+        write_run(t.path(), "e", "our1", 1, &[], bp10_spec(), false);
+        let foreign = write_run(t.path(), "e", "our1", 2, &[(0, 1.0)], bp10_spec(), true);
         std::fs::write(foreign.join(METRICS_FILE), "x,y\n").unwrap();
         let d = discover(t.path()).unwrap();
         assert_eq!(d.experiments[0].curves[0].runs.len(), 1);
@@ -511,7 +518,7 @@ pub(crate) mod tests {
             "our1",
             0,
             &[(10, 1.0), (10, 2.0)],
-            BP10,
+            bp10_spec(),
             true,
         );
         let err = discover(t.path()).unwrap_err();

@@ -248,7 +248,7 @@ fn summarize(
 /// Runs that disagree (e.g. a sweep over grid_dim) get no line and no description.
 fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>, Option<String>) {
     let runs = exp.curves.iter().flat_map(|c| &c.runs);
-    let settings: Vec<_> = runs.clone().filter_map(|r| r.setting).collect();
+    let settings: Vec<_> = runs.clone().filter_map(|r| r.setting.clone()).collect();
     let missing = runs.count() - settings.len();
     let Some(first) = settings.first() else {
         notes.push(format!(
@@ -284,18 +284,17 @@ mod tests {
     use crate::envs::EnvSpec;
     use crate::plot::discover::{discover, tests::write_run};
 
-    const BP10: EnvSpec = EnvSpec::BoxPushing {
-        grid: 10,
-        horizon: 100,
-    };
+    fn bp10_spec() -> EnvSpec {
+        crate::envs::box_pushing::spec(10, 100)
+    }
 
     #[test]
     fn partial_results_are_marked_and_counted_per_curve() {
         let t = tempfile::tempdir().unwrap();
         let full: Vec<(u64, f64)> = (0..5).map(|i| (i * 10, i as f64)).collect();
-        write_run(t.path(), "e", "our1", 0, &full, BP10, true);
-        write_run(t.path(), "e", "our1", 1, &full[..2], BP10, false);
-        write_run(t.path(), "e", "cen-ddrqn", 0, &full, BP10, true);
+        write_run(t.path(), "e", "our1", 0, &full, bp10_spec(), true);
+        write_run(t.path(), "e", "our1", 1, &full[..2], bp10_spec(), false);
+        write_run(t.path(), "e", "cen-ddrqn", 0, &full, bp10_spec(), true);
         let d = discover(t.path()).unwrap();
         let b = build(&d.experiments[0]);
         let f = &b.figure;
@@ -338,17 +337,17 @@ mod tests {
             ));
             std::fs::write(path, text).unwrap();
         };
-        let a = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
-        let b = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], BP10, true);
+        let a = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
+        let b = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], bp10_spec(), true);
         stamp(&a, &"a".repeat(40), "avx512");
         stamp(&b, &"a".repeat(40), "avx512");
         let built = build(&discover(t.path()).unwrap().experiments[0]);
         assert!(built.notes.is_empty(), "{:?}", built.notes);
         assert!(!built.figure.caption.contains("Note:"));
 
-        let b = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], BP10, true);
+        let b = write_run(t.path(), "e", "our1", 1, &[(0, 1.0)], bp10_spec(), true);
         stamp(&b, &"b".repeat(40), "avx2");
-        write_run(t.path(), "e", "our2", 0, &[(0, 1.0)], BP10, true);
+        write_run(t.path(), "e", "our2", 0, &[(0, 1.0)], bp10_spec(), true);
         let built = build(&discover(t.path()).unwrap().experiments[0]);
         let note = built.notes.join("\n");
         assert!(
@@ -366,14 +365,14 @@ mod tests {
     #[test]
     fn mixed_settings_have_no_optimal_line() {
         let t = tempfile::tempdir().unwrap();
-        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], BP10, true);
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
         write_run(
             t.path(),
             "e",
             "our2",
             0,
             &[(0, 1.0)],
-            EnvSpec::paper_warehouse(),
+            crate::envs::warehouse::paper_spec(),
             true,
         );
         let d = discover(t.path()).unwrap();
@@ -393,7 +392,7 @@ mod tests {
             "our1@trace_len=10",
             0,
             &[(0, 1.0)],
-            BP10,
+            bp10_spec(),
             true,
         );
         write_run(
@@ -402,7 +401,7 @@ mod tests {
             "our1@trace_len=20",
             0,
             &[(0, 1.0)],
-            BP10,
+            bp10_spec(),
             true,
         );
         let d = discover(t.path()).unwrap();

@@ -116,7 +116,7 @@ pub fn plot_results_metric(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::envs::EnvSpec;
+
     use discover::tests::write_run;
 
     /// A noisy rising learning curve, deterministic per seed.
@@ -134,12 +134,20 @@ mod tests {
     fn plots_synthetic_results_to_png_svg_and_summary() {
         let t = tempfile::tempdir().unwrap();
         let res = t.path().join("results");
-        let bp10 = EnvSpec::paper_box_pushing(10);
+        let bp10 = crate::envs::box_pushing::paper_spec(10);
         for seed in 0..3 {
             let pts = curve(seed, 95.0, 151);
-            write_run(&res, "fig4a_bp10", "our1", seed, &pts, bp10, true);
+            write_run(&res, "fig4a_bp10", "our1", seed, &pts, bp10.clone(), true);
             let pts = curve(seed + 10, 60.0, 151);
-            write_run(&res, "fig4a_bp10", "dec-hddrqn", seed, &pts, bp10, true);
+            write_run(
+                &res,
+                "fig4a_bp10",
+                "dec-hddrqn",
+                seed,
+                &pts,
+                bp10.clone(),
+                true,
+            );
         }
         // Cen-DDRQN: two seeds, one unfinished at episode 800.
         write_run(
@@ -148,7 +156,7 @@ mod tests {
             "cen-ddrqn",
             0,
             &curve(20, 85.0, 151),
-            bp10,
+            bp10.clone(),
             true,
         );
         write_run(
@@ -157,7 +165,7 @@ mod tests {
             "cen-ddrqn",
             1,
             &curve(21, 85.0, 81),
-            bp10,
+            bp10.clone(),
             false,
         );
         let out = t.path().join("plots");
@@ -203,9 +211,17 @@ mod tests {
     fn any_metrics_column_plots_beside_the_returns_and_a_missing_one_is_named() {
         let t = tempfile::tempdir().unwrap();
         let res = t.path().join("results");
-        let bp10 = EnvSpec::paper_box_pushing(10);
+        let bp10 = crate::envs::box_pushing::paper_spec(10);
         for seed in 0..2 {
-            write_run(&res, "e", "our1", seed, &curve(seed, 90.0, 41), bp10, true);
+            write_run(
+                &res,
+                "e",
+                "our1",
+                seed,
+                &curve(seed, 90.0, 41),
+                bp10.clone(),
+                true,
+            );
         }
         let out = t.path().join("plots");
         // write_run records updates = episode / 2; the final value is the mean over the last

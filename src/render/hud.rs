@@ -4,9 +4,8 @@
 //! Its layout depends only on the environment (agent labels and the longest action name of each
 //! agent), never on the state, so every frame of an episode has the same height.
 
-use super::canvas::Canvas;
-use super::font::{draw_text, ADVANCE, GLYPH_H};
-use super::palette::Colour;
+use crate::draw::font::{draw_text, ADVANCE, GLYPH_H};
+use crate::draw::{Canvas, Colour};
 use crate::envs::MacroEnv;
 
 /// Font scale: each font pixel is 2 x 2 image pixels (glyphs 6 x 10).

@@ -1,14 +1,15 @@
 //! Animated rollouts for the README (issue 6, `macdec render`): play an episode of either domain,
 //! draw every primitive step into a small indexed picture, and write the pictures as a GIF.
 //!
-//! No fonts or image libraries: [`canvas`] draws rectangles, discs and lines into palette indices
-//! ([`palette`]), a built-in 3 x 5 font writes the status bar, and the `gif` crate encodes.
-//! Each domain's picture lives in its own file (`box_pushing.rs`, `warehouse.rs`).
+//! No fonts or image libraries: [`crate::draw`] draws rectangles, discs and lines into palette
+//! indices, a built-in 3 x 5 font writes the status bar, and the `gif` crate encodes. Each
+//! domain draws its own picture in its folder ([`MacroEnv::draw`]); a domain that draws none
+//! cannot be rendered, and [`draw_frame`] says so.
 //!
 //! ```no_run
-//! # use macdec::envs::{EnvSpec, EnvRng, MacroEnv};
+//! # use macdec::envs::{EnvRng, MacroEnv};
 //! # use rand::SeedableRng;
-//! let mut env = EnvSpec::BoxPushing { grid: 10, horizon: 100 }.build()?;
+//! let mut env = macdec::envs::box_pushing::spec(10, 100).build()?;
 //! let mut rng = EnvRng::seed_from_u64(0);
 //! let frames = macdec::render::record_episode(&mut env, &mut rng, |env, actions| {
 //!     for i in 0..env.n_agents() {
@@ -23,21 +24,15 @@
 
 use std::path::PathBuf;
 
-use crate::envs::{AnyEnv, EnvError};
+use crate::envs::{EnvError, MacroEnv};
 
-mod box_pushing;
-pub mod canvas;
-mod font;
 mod gif_out;
 mod hud;
-pub mod palette;
 mod record;
 pub mod rollout;
-mod warehouse;
 
-pub use canvas::Canvas;
+pub use crate::draw::{canvas, palette, Canvas, Colour};
 pub use gif_out::{write_gif, HOLD_MS};
-pub use palette::Colour;
 pub use record::record_episode;
 
 /// One drawn primitive step of an episode.
@@ -56,6 +51,8 @@ pub struct Frame {
 /// Why recording or writing a rollout failed. File errors name the path.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    #[error("the domain `{domain}` draws no picture (its MacroEnv has no `draw`), so it cannot be rendered; `macdec replay --verbose` prints its text form")]
+    NoPicture { domain: String },
     #[error("step {t} of the recorded episode was refused: {source}")]
     Env {
         t: usize,
@@ -91,14 +88,26 @@ pub enum RenderError {
     },
 }
 
-/// The picture of `env`'s current state with `team_return` in the status bar. Sizes: Box
-/// Pushing 10 x 10 is 321 pixels wide (32 per cell), 30 x 30 is 361 (12 per cell); Warehouse is
-/// 420 (60 per metre); the status bar adds a few dozen rows.
-pub fn draw_frame(env: &AnyEnv, team_return: f64) -> Canvas {
-    match env {
-        AnyEnv::BoxPushing(e) => box_pushing::draw(e, team_return),
-        AnyEnv::Warehouse(e) => warehouse::draw(e, team_return),
-    }
+/// The domain's picture of `env`'s current state ([`MacroEnv::draw`]) with the status bar
+/// below it, `team_return` in it; `None` for a domain that draws none. Sizes: Box Pushing
+/// 10 x 10 is 321 pixels wide (32 per cell), 30 x 30 is 361 (12 per cell); Warehouse is 420 (60
+/// per metre); the status bar adds a few dozen rows.
+pub fn draw_frame(env: &impl MacroEnv, team_return: f64) -> Option<Canvas> {
+    let picture = env.draw()?;
+    let (w, h) = (picture.world.width(), picture.world.height());
+    // A picture must label every agent; a domain that labels too few gets numbered labels.
+    const NUMBERED: [&str; 16] = [
+        "A0", "A1", "A2", "A3", "A4", "A5", "A6", "A7", "A8", "A9", "A10", "A11", "A12", "A13",
+        "A14", "A15",
+    ];
+    let labels = match picture.agent_labels {
+        l if l.len() >= env.n_agents() => l,
+        _ => NUMBERED.get(..env.n_agents())?,
+    };
+    let mut canvas = Canvas::new(w, h + hud::hud_height(env, labels, w), Colour::Background);
+    canvas.paste(&picture.world, 0, 0);
+    hud::draw_hud(&mut canvas, h, env, labels, team_return);
+    Some(canvas)
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Play one episode and keep a picture of every primitive step.
 
 use super::{draw_frame, Frame, RenderError};
-use crate::envs::{AnyEnv, EnvRng, MacroEnv};
+use crate::envs::{EnvRng, MacroEnv};
 
 /// Reset `env`, then let `choose` fill the actions and step until the episode ends, drawing a
 /// frame after the reset and after every step (so an episode of T steps gives T + 1 frames; the
@@ -11,17 +11,18 @@ use crate::envs::{AnyEnv, EnvRng, MacroEnv};
 /// agent ([`MacroEnv::is_free`]); entries of busy agents are ignored by the environment (spec
 /// `algorithms.md` 1.1) and keep whatever was there. `actions` starts as zeros. At most
 /// `env.horizon()` steps are taken, so a loop that never sees `done` still stops. A step the
-/// environment refuses (an out-of-range action) is returned as [`RenderError::Env`].
-pub fn record_episode(
-    env: &mut AnyEnv,
+/// environment refuses (an out-of-range action) is returned as [`RenderError::Env`]; a domain
+/// that draws no picture, as [`RenderError::NoPicture`] before any step.
+pub fn record_episode<E: MacroEnv>(
+    env: &mut E,
     rng: &mut EnvRng,
-    mut choose: impl FnMut(&AnyEnv, &mut [usize]),
+    mut choose: impl FnMut(&E, &mut [usize]),
 ) -> Result<Vec<Frame>, RenderError> {
     env.reset(rng);
     let mut actions = vec![0usize; env.n_agents()];
     let mut team_return = 0.0;
     let mut frames = Vec::with_capacity(env.horizon() + 1);
-    frames.push(Frame::capture(env, team_return));
+    frames.push(Frame::capture(env, team_return)?);
     for _ in 0..env.horizon() {
         choose(env, &mut actions);
         let out = env.step(&actions, rng).map_err(|source| RenderError::Env {
@@ -29,7 +30,7 @@ pub fn record_episode(
             source,
         })?;
         team_return += out.reward;
-        frames.push(Frame::capture(env, team_return));
+        frames.push(Frame::capture(env, team_return)?);
         if out.done {
             break;
         }
@@ -41,13 +42,16 @@ pub fn record_episode(
 }
 
 impl Frame {
-    /// Draw `env` now. Not held.
-    pub fn capture(env: &AnyEnv, team_return: f64) -> Self {
-        Self {
-            image: draw_frame(env, team_return),
+    /// Draw `env` now. Not held. [`RenderError::NoPicture`] if its domain draws none.
+    pub fn capture(env: &impl MacroEnv, team_return: f64) -> Result<Self, RenderError> {
+        let image = draw_frame(env, team_return).ok_or_else(|| RenderError::NoPicture {
+            domain: env.describe(),
+        })?;
+        Ok(Self {
+            image,
             t: env.t(),
             team_return,
             hold: false,
-        }
+        })
     }
 }

@@ -7,8 +7,10 @@ use rand::{Rng, SeedableRng};
 
 use super::*;
 use crate::envs::box_pushing::actions::PUSH;
+use crate::envs::box_pushing::draw as box_pushing;
 use crate::envs::box_pushing::geometry::Cell;
-use crate::envs::{EnvRng, EnvSpec, MacroEnv};
+use crate::envs::warehouse::draw as warehouse;
+use crate::envs::{AnyEnv, EnvRng, MacroEnv};
 
 /// A decoded GIF: logical size, every frame composited onto the previous one, and delays (cs).
 struct Decoded {
@@ -65,21 +67,11 @@ fn bp_optimal(env: &AnyEnv, actions: &mut [usize]) {
 }
 
 fn bp10() -> AnyEnv {
-    EnvSpec::BoxPushing {
-        grid: 10,
-        horizon: 100,
-    }
-    .build()
-    .unwrap()
+    crate::envs::box_pushing::spec(10, 100).build().unwrap()
 }
 
 fn wtd() -> AnyEnv {
-    EnvSpec::Warehouse {
-        horizon: 150,
-        tb_m_noisy: 0.0,
-    }
-    .build()
-    .unwrap()
+    crate::envs::warehouse::spec(150, 0.0).build().unwrap()
 }
 
 /// Warehouse scenario S2 (spec section 14): each free agent takes its queue's next action, then
@@ -166,12 +158,7 @@ fn bp10_last_frame_shows_the_big_box_in_the_goal_row_with_both_robots_below() {
 
 #[test]
 fn bp30_frames_are_361_pixels_wide() {
-    let mut env = EnvSpec::BoxPushing {
-        grid: 30,
-        horizon: 200,
-    }
-    .build()
-    .unwrap();
+    let mut env = crate::envs::box_pushing::spec(30, 200).build().unwrap();
     let mut rng = EnvRng::seed_from_u64(0);
     let frames = record_episode(&mut env, &mut rng, bp_optimal).unwrap();
     assert_eq!(frames.len(), 42, "T* = 41 on 30x30 (spec 11)");
@@ -241,8 +228,8 @@ fn writing_no_frames_or_mixed_sizes_names_the_file() {
     let path = Path::new("/nonexistent/x.gif");
     let err = write_gif(&[], path, 100).unwrap_err();
     assert!(err.to_string().contains("/nonexistent/x.gif"), "{err}");
-    let a = Frame::capture(&bp10(), 0.0);
-    let b = Frame::capture(&wtd(), 0.0);
+    let a = Frame::capture(&bp10(), 0.0).unwrap();
+    let b = Frame::capture(&wtd(), 0.0).unwrap();
     let err = write_gif(&[a.clone(), b], path, 100).unwrap_err();
     assert!(
         matches!(err, RenderError::SizeMismatch { index: 1, .. }),
@@ -293,12 +280,7 @@ fn preview() {
     png(&frames[0].image, "bp10_t0.png");
     png(&frames[8].image, "bp10_t8.png");
     write_gif(&frames, &out.join("bp10_optimal.gif"), 250).unwrap();
-    let mut env = EnvSpec::BoxPushing {
-        grid: 30,
-        horizon: 200,
-    }
-    .build()
-    .unwrap();
+    let mut env = crate::envs::box_pushing::spec(30, 200).build().unwrap();
     let frames = record_episode(&mut env, &mut rng, bp_optimal).unwrap();
     png(&frames[30].image, "bp30_t30.png");
     write_gif(&frames, &out.join("bp30_optimal.gif"), 120).unwrap();
@@ -321,12 +303,7 @@ fn speed() {
         ("bp10 optimal", bp10()),
         (
             "bp30 optimal",
-            EnvSpec::BoxPushing {
-                grid: 30,
-                horizon: 200,
-            }
-            .build()
-            .unwrap(),
+            crate::envs::box_pushing::spec(30, 200).build().unwrap(),
         ),
         ("wtd random", wtd()),
     ];

@@ -172,7 +172,7 @@ mod tests {
     use super::*;
     use crate::deploy::link::{JsonLink, LocalLink};
     use crate::deploy::mock::{mock_manifest, MockPolicy};
-    use crate::envs::EnvSpec;
+
     use rand::SeedableRng;
 
     fn rng(seed: u64) -> EnvRng {
@@ -181,10 +181,7 @@ mod tests {
 
     #[test]
     fn wrong_robot_count_is_refused() {
-        let spec = EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        };
+        let spec = crate::envs::box_pushing::spec(10, 100);
         let mut env = spec.build().unwrap();
         let mut one = vec![LocalLink::new(MockPolicy::new(5, 8, 0))];
         let err = run_episode(&mut env, &mut one, 0.98, &mut rng(0), 0).unwrap_err();
@@ -223,11 +220,8 @@ mod tests {
 
     #[test]
     fn a_robot_hanging_up_or_misbehaving_mid_episode_is_named() {
-        let spec = EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        };
-        let manifest = mock_manifest(spec);
+        let spec = crate::envs::box_pushing::spec(10, 100);
+        let manifest = mock_manifest(spec.clone());
         let mut env = spec.build().unwrap();
         // Stay (7) lasts one step, so the good robot decides every step; GT_SB0 (0) takes several.
         let decision = r#"{"action":7,"name":"Stay","q":[0,0,0,0,0,0,0,1]}"#;
@@ -273,11 +267,8 @@ mod tests {
 
     #[test]
     fn a_robot_for_another_agent_or_policy_fails_the_handshake() {
-        let spec = EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        };
-        let manifest = mock_manifest(spec);
+        let spec = crate::envs::box_pushing::spec(10, 100);
+        let manifest = mock_manifest(spec.clone());
         let info = crate::deploy::protocol::Reply::Info {
             agent: 1,
             manifest: Box::new(manifest.clone()),

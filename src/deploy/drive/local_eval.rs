@@ -54,15 +54,12 @@ pub fn eval_policy(
 mod tests {
     use super::*;
     use crate::deploy::manifest::load_all;
-    use crate::envs::EnvSpec;
+
     use rand::SeedableRng;
 
     #[test]
     fn a_callback_error_stops_the_run() {
-        let spec = EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        };
+        let spec = crate::envs::box_pushing::spec(10, 100);
         let dir = tempfile::tempdir().unwrap();
         crate::deploy::mock::write_mock_policy(dir.path(), spec).unwrap();
         let (manifest, verified) = load_all(dir.path()).unwrap();

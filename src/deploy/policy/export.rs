@@ -128,7 +128,7 @@ pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
     write_export(
         out,
         previous,
-        run.env.into(),
+        run.env.clone().into(),
         &domain,
         run.discount,
         Architecture::ddrqn(mlp, hidden),

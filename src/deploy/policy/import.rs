@@ -384,7 +384,7 @@ pub fn import_policy(request: &ImportRequest, out: &Path) -> Result<Manifest, Im
     let weights: Vec<Vec<u8>> = checked.into_iter().map(|c| c.canonical).collect();
     Ok(Manifest::write_policy(
         out,
-        request.env,
+        request.env.clone(),
         request.discount,
         Architecture::ddrqn(m, h),
         run,
@@ -415,10 +415,9 @@ mod tests {
     use crate::deploy::manifest::load_all;
     use safetensors::tensor::TensorView;
 
-    const BP10: EnvSpec = EnvSpec::BoxPushing {
-        grid: 10,
-        horizon: 100,
-    };
+    fn bp10() -> EnvSpec {
+        crate::envs::box_pushing::spec(10, 100)
+    }
 
     fn value(name: &str, i: usize) -> f32 {
         ((i * 7 + name.len() * 13) % 17) as f32 * 0.1 - 0.8
@@ -632,8 +631,8 @@ mod tests {
         let a1 = write(dir.path(), "a1.safetensors", &a1_bytes);
         let out = dir.path().join("policy");
         let request = ImportRequest {
-            env: BP10,
-            discount: BP10.paper_discount(),
+            env: bp10(),
+            discount: 0.98,
             agents: vec![a0.clone(), a1.clone()],
         };
         let written = import_policy(&request, &out).unwrap();
@@ -678,11 +677,8 @@ mod tests {
 
     #[test]
     fn warehouse_agents_get_their_own_sizes_and_the_paper_discount() {
-        let spec = EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.0,
-        };
-        assert_eq!(spec.paper_discount(), 1.0);
+        let spec = crate::envs::warehouse::spec(150, 0.0);
+        assert_eq!(spec.paper_discount(), Some(1.0));
         let env = spec.build().unwrap();
         let dir = tempfile::tempdir().unwrap();
         let arch = Architecture::ddrqn(32, 64);

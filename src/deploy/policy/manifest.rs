@@ -566,10 +566,7 @@ mod tests {
     use crate::deploy::architecture::synthetic_weights;
 
     fn bp10() -> EnvSpec {
-        EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        }
+        crate::envs::box_pushing::spec(10, 100)
     }
 
     fn run_info() -> RunInfo {

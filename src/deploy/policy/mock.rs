@@ -116,14 +116,14 @@ fn mock_weights(env: EnvSpec) -> Result<Vec<Vec<u8>>, ManifestError> {
 /// `macdec robot --mock` and `macdec deploy --mock` load it, check it, and run [`MockPolicy`]
 /// instead of the weights.
 pub fn write_mock_policy(dir: &Path, env: EnvSpec) -> Result<Manifest, ManifestError> {
-    let weights = mock_weights(env)?;
+    let weights = mock_weights(env.clone())?;
     Manifest::write_policy(dir, env, 0.98, mock_architecture(), mock_run(), &weights)
 }
 
 /// The manifest [`write_mock_policy`] writes, without touching the disk. Panics if `env` has
 /// invalid parameters.
 pub fn mock_manifest(env: EnvSpec) -> Manifest {
-    let weights = mock_weights(env).expect("valid env spec for a mock manifest");
+    let weights = mock_weights(env.clone()).expect("valid env spec for a mock manifest");
     Manifest::build(env, 0.98, mock_architecture(), mock_run(), &weights)
         .expect("mock weights fit the mock architecture")
 }
@@ -172,15 +172,12 @@ mod tests {
     #[test]
     fn mock_policy_dir_loads_and_verifies() {
         let dir = tempfile::tempdir().unwrap();
-        let env = EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.0,
-        };
-        let written = write_mock_policy(dir.path(), env).unwrap();
+        let env = crate::envs::warehouse::spec(150, 0.0);
+        let written = write_mock_policy(dir.path(), env.clone()).unwrap();
         let (read, agents) = crate::deploy::manifest::load_all(dir.path()).unwrap();
         assert_eq!(read, written);
         assert_eq!(agents.len(), 3);
-        assert_eq!(mock_manifest(env), written);
+        assert_eq!(mock_manifest(env.clone()), written);
         let sizes: Vec<(usize, usize)> = mock_policies(&read)
             .iter()
             .map(|p| (p.obs_len(), p.n_actions()))

@@ -70,7 +70,7 @@ impl PolicyEnv {
     /// The built-in domain's spec, or [`NotBuiltIn`] naming the custom domain.
     pub fn built_in(&self) -> Result<EnvSpec, NotBuiltIn> {
         match self {
-            PolicyEnv::BuiltIn(spec) => Ok(*spec),
+            PolicyEnv::BuiltIn(spec) => Ok(spec.clone()),
             PolicyEnv::Custom(c) => Err(NotBuiltIn {
                 name: c.name.clone(),
             }),
@@ -172,7 +172,7 @@ impl<'de> Deserialize<'de> for PolicyEnv {
         serde_json::from_value(value)
             .map(PolicyEnv::BuiltIn)
             .map_err(|e| {
-                let hint = if e.to_string().contains("unknown variant") {
+                let hint = if e.to_string().contains("unknown domain") {
                     format!(" (or `{CUSTOM}` for a domain defined outside this binary)")
                 } else {
                     String::new()
@@ -189,13 +189,10 @@ mod tests {
     #[test]
     fn a_built_in_domain_serializes_exactly_as_its_spec() {
         for spec in [
-            EnvSpec::paper_box_pushing(10),
-            EnvSpec::Warehouse {
-                horizon: 150,
-                tb_m_noisy: 0.25,
-            },
+            crate::envs::box_pushing::paper_spec(10),
+            crate::envs::warehouse::spec(150, 0.25),
         ] {
-            let env = PolicyEnv::BuiltIn(spec);
+            let env = PolicyEnv::BuiltIn(spec.clone());
             assert_eq!(
                 serde_json::to_string_pretty(&env).unwrap(),
                 serde_json::to_string_pretty(&spec).unwrap()
@@ -205,7 +202,7 @@ mod tests {
         }
         let old: PolicyEnv =
             serde_json::from_str(r#"{"env": "warehouse", "horizon": 150}"#).unwrap();
-        assert_eq!(old, EnvSpec::paper_warehouse());
+        assert_eq!(old, crate::envs::warehouse::paper_spec());
     }
 
     #[test]
@@ -252,7 +249,7 @@ mod tests {
             err.contains("`rendezvous`") && err.contains("not built into this binary"),
             "{err}"
         );
-        assert!(PolicyEnv::BuiltIn(EnvSpec::paper_warehouse())
+        assert!(PolicyEnv::BuiltIn(crate::envs::warehouse::paper_spec())
             .build()
             .is_ok());
     }

@@ -77,7 +77,7 @@ mod tests {
     use super::*;
     use crate::deploy::architecture::Architecture;
     use crate::deploy::manifest::{load_agent, RunInfo};
-    use crate::envs::EnvSpec;
+
     use crate::nn::safetensors_io::to_safetensors_bytes;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -113,10 +113,7 @@ mod tests {
             episodes_trained: 0,
             config: serde_json::Value::Null,
         };
-        let env = EnvSpec::Warehouse {
-            horizon: 150,
-            tb_m_noisy: 0.0,
-        };
+        let env = crate::envs::warehouse::spec(150, 0.0);
         Manifest::write_policy(
             dir.path(),
             env,

@@ -217,13 +217,9 @@ mod tests {
     use super::*;
     use crate::deploy::line_reader::MAX_LINE_BYTES;
     use crate::deploy::mock::{mock_manifest, MockPolicy};
-    use crate::envs::EnvSpec;
 
     fn bp_spec(agent: usize) -> (Manifest, Arc<RobotSpec>) {
-        let manifest = mock_manifest(EnvSpec::BoxPushing {
-            grid: 10,
-            horizon: 100,
-        });
+        let manifest = mock_manifest(crate::envs::box_pushing::spec(10, 100));
         let spec = Arc::new(RobotSpec::new(&manifest, agent).unwrap());
         (manifest, spec)
     }

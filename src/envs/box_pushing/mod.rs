@@ -8,6 +8,8 @@
 //! [`actions`] (3), `step` (4), `navigate` (5.1), `push` (5.2), [`observe`] (6), `render`.
 
 pub mod actions;
+mod domain;
+pub mod draw;
 pub mod geometry;
 pub mod layout;
 mod navigate;
@@ -16,6 +18,8 @@ mod push;
 mod render;
 pub mod state;
 mod step;
+
+pub use domain::{paper_spec, spec, BoxPushingDomain, DEFAULT_GRID_DIM, MAX_GRID_DIM};
 
 #[cfg(test)]
 mod properties;
@@ -279,6 +283,10 @@ impl MacroEnv for BoxPushing {
             self.grid(),
             self.horizon
         )
+    }
+
+    fn draw(&self) -> Option<crate::draw::Picture> {
+        Some(draw::draw(self))
     }
 }
 

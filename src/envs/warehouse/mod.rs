@@ -9,6 +9,8 @@
 //! file. At the paper's settings nothing is random; with `tb_move_noisy > 0` travel steps draw
 //! normals from the caller's [`EnvRng`].
 
+mod domain;
+pub mod draw;
 mod fetch;
 mod human;
 mod observe;
@@ -25,6 +27,7 @@ mod scenarios;
 #[cfg(test)]
 mod testkit;
 
+pub use domain::{paper_spec, spec, WarehouseDomain};
 pub use fetch::{Fetch, FetchAction};
 pub use human::Human;
 pub use observe::{FETCH_OBS, TB_OBS};
@@ -252,6 +255,10 @@ impl MacroEnv for Warehouse {
             "Warehouse Tool Delivery, horizon {}",
             self.params.terminate_step
         )
+    }
+
+    fn draw(&self) -> Option<crate::draw::Picture> {
+        Some(draw::draw(self))
     }
 }
 

@@ -8,7 +8,6 @@
 
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::envs::flags::{check_spec, EnvName, DEFAULT_GRID_DIM};
 use crate::envs::EnvSpec;
 use crate::experiment::limits;
 use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
@@ -365,7 +364,7 @@ impl Experiment {
                         method,
                         variant: variant.clone(),
                         seed,
-                        env: config.env,
+                        env: config.env.clone(),
                         config: config.config.clone(),
                     });
                 }
@@ -456,7 +455,10 @@ fn expand_grid(
         });
     }
     let mut points = vec![(String::new(), toml::Table::new())];
-    for (key, value) in table {
+    // Keys in name order, so a variant's name does not depend on how the file orders them.
+    let mut keys: Vec<(&String, &toml::Value)> = table.iter().collect();
+    keys.sort_by_key(|(k, _)| *k);
+    for (key, value) in keys {
         let choices: Vec<toml::Value> = match value {
             toml::Value::Array(items) => items.clone(),
             other => vec![other.clone()],
@@ -500,34 +502,32 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
         key: key.to_string(),
         message,
     };
-    let env: EnvName = match point.get("env_name") {
-        Some(v) => v.clone().try_into().map_err(|_| {
-            bad(
-                "env_name",
-                format!("expected \"BP_MA\" or \"OSD_S_4\", got {v}"),
-            )
-        })?,
-        None => EnvName::BoxPushing,
+    // The domain first: `env_name` (Box Pushing when absent) takes the point's keys that are
+    // its own, so its defaults may follow them (Box Pushing's horizon follows its grid).
+    let env_name = match point.get("env_name") {
+        Some(toml::Value::String(name)) => name.as_str(),
+        Some(v) => return Err(bad("env_name", format!("expected a domain name, got {v}"))),
+        None => "BP_MA",
     };
-    let grid_dim = match point.get("grid_dim") {
-        Some(toml::Value::Integer(n)) if *n > 0 && *n as u64 <= limits::MAX_GRID_DIM as u64 => {
-            *n as usize
-        }
-        Some(toml::Value::Integer(n)) if *n > 0 => {
-            return Err(bad(
-                "grid_dim",
-                format!("must be at most {}, got {n}", limits::MAX_GRID_DIM),
-            ))
-        }
-        Some(v) => {
-            return Err(bad(
-                "grid_dim",
-                format!("expected a positive integer, got {v}"),
-            ))
-        }
-        None => DEFAULT_GRID_DIM,
-    };
-    let defaults = RunSettings::paper(env.paper_spec(grid_dim), method);
+    let domain = crate::envs::registry::find(env_name).ok_or_else(|| {
+        bad(
+            "env_name",
+            format!(
+                "unknown domain {env_name:?}: this binary has {}",
+                crate::envs::registry::names_and_tags()
+            ),
+        )
+    })?;
+    let domain_keys = domain
+        .keys(&toml::Table::new())
+        .map_err(|e| bad(&e.key, e.message))?;
+    let given: toml::Table = point
+        .iter()
+        .filter(|(k, _)| domain_keys.contains_key(*k))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    let env = EnvSpec::of(domain, &given).map_err(|e| bad(e.key(), e.to_string()))?;
+    let defaults = RunSettings::paper(env, method);
     let mut table = toml::Table::try_from(&defaults).expect("RunSettings serializes to a table");
     for (key, value) in point {
         if !table.contains_key(key) {
@@ -574,8 +574,6 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
             ));
         }
     }
-    // The domain checks its own parameters, named by the keys that set them.
-    check_spec(&config.env).map_err(|(key, message)| bad(key, message))?;
     validate(&config.config, method, config.env.horizon())
         .map_err(|(key, message)| bad(key, message))?;
     Ok(config)
@@ -792,9 +790,9 @@ mod tests {
     fn env_name_aliases_resolve_to_the_reference_names() {
         let e = parse("[params]\nenv_name = \"box-pushing\"\ngrid_dim = 30", &[]).unwrap();
         let run = &e.runs().unwrap()[0];
-        assert_eq!(run.env, crate::envs::EnvSpec::paper_box_pushing(30));
+        assert_eq!(run.env, crate::envs::box_pushing::paper_spec(30));
         let text = toml::to_string(&RunSettings {
-            env: run.env,
+            env: run.env.clone(),
             config: run.config.clone(),
         })
         .unwrap();

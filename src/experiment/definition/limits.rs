@@ -11,8 +11,8 @@ use crate::algos::hyper::RunConfig;
 pub const MAX_RUNS: usize = 100_000;
 /// Seeds in one `--seeds` value or `seeds` list.
 pub const MAX_SEEDS: usize = 10_000;
-/// Box Pushing grid side (paper: 10 and 30).
-pub const MAX_GRID_DIM: usize = 1_000;
+/// Box Pushing grid side (paper: 10 and 30); the domain checks it (`envs/box_pushing`).
+pub use crate::envs::box_pushing::MAX_GRID_DIM;
 /// Episode horizon in primitive steps, `env_terminate_step` (paper: 100 to 200).
 pub const MAX_HORIZON: usize = 100_000;
 /// Window length `trace_len` and minimum kept records `sub_trace_len` (paper: 15 and 45).
@@ -112,25 +112,29 @@ pub fn worker_threads(requested: usize, runs: usize) -> usize {
 mod tests {
     use super::*;
     use crate::algos::method::Method;
-    use crate::envs::EnvSpec;
+
     use crate::experiment::paper::paper_defaults;
 
     #[test]
     fn the_papers_settings_are_within_every_bound() {
         for grid in [10, 30] {
             for m in [Method::DecHddrqn, Method::CenDdrqn, Method::Our1] {
-                let env = EnvSpec::paper_box_pushing(grid);
-                check_sizes(&paper_defaults(env, m), env.horizon()).unwrap();
+                let env = crate::envs::box_pushing::paper_spec(grid);
+                check_sizes(&paper_defaults(&env, m), env.horizon()).unwrap();
             }
         }
         for m in [Method::DecHddrqn, Method::CenDdrqn, Method::Our2] {
-            check_sizes(&paper_defaults(EnvSpec::paper_warehouse(), m), 150).unwrap();
+            check_sizes(
+                &paper_defaults(&crate::envs::warehouse::paper_spec(), m),
+                150,
+            )
+            .unwrap();
         }
     }
 
     #[test]
     fn each_size_beyond_its_bound_names_its_key() {
-        let base = paper_defaults(EnvSpec::paper_box_pushing(10), Method::Our1);
+        let base = paper_defaults(&crate::envs::box_pushing::paper_spec(10), Method::Our1);
         type Edit = fn(&mut RunConfig, &mut usize);
         let cases: [(&str, Edit); 6] = [
             ("batch_size", |c, _| c.batch_size = MAX_BATCH_SIZE + 1),

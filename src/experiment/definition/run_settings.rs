@@ -1,21 +1,20 @@
 //! A run's domain and hyperparameters together, as its `config.toml` records them: the
 //! learner's [`RunConfig`] names no domain, so the run layer keeps the domain ([`EnvSpec`])
-//! beside it and writes both as one table, the domain first as the reference's four keys
-//! `env_name`, `grid_dim`, `env_terminate_step` and `tb_m_noisy` ([`EnvFlags`]). Every existing
-//! run directory keeps reading and writing byte for byte the same.
+//! beside it and writes both as one table: `env_name`, then the domain's own keys in its order
+//! (for the built-in domains the reference's `grid_dim`, `env_terminate_step`, `tb_m_noisy`),
+//! then every hyperparameter. Every existing run directory keeps reading and writing byte for
+//! byte the same.
 
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::envs::flags::{EnvFlags, EnvName};
 use crate::envs::EnvSpec;
 use crate::experiment::paper::paper_defaults;
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// The domain a run trains on and its hyperparameters: `config.toml`'s `[config]` table.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(from = "RunSettingsFile", into = "RunSettingsFile")]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RunSettings {
-    /// The domain and its parameters, horizon included (BP 10x10: 100, 30x30: 200; WTD: 150).
+    /// The domain and its keys, horizon included (BP 10x10: 100, 30x30: 200; WTD: 150).
     pub env: EnvSpec,
     pub config: RunConfig,
 }
@@ -23,141 +22,61 @@ pub struct RunSettings {
 impl RunSettings {
     /// The paper's settings for `method` on `env` (see [`paper_defaults`]).
     pub fn paper(env: EnvSpec, method: Method) -> Self {
-        RunSettings {
-            env,
-            config: paper_defaults(env, method),
+        let config = paper_defaults(&env, method);
+        RunSettings { env, config }
+    }
+
+    /// The table `config.toml` records: `env_name`, the domain's keys, the hyperparameters.
+    pub fn to_table(&self) -> toml::Table {
+        let mut table = toml::Table::new();
+        table.insert("env_name".into(), self.env.env_name().into());
+        table.extend(self.env.keys().clone());
+        table.extend(toml::Table::try_from(&self.config).expect("RunConfig serializes to a table"));
+        table
+    }
+
+    /// Read the table [`Self::to_table`] writes. The domain is found by `env_name` (an alias
+    /// too); it takes its own keys and checks them, the rest must be exactly the
+    /// hyperparameters (unknown keys are refused, so a typo in a hand-edited config fails
+    /// instead of being ignored).
+    pub fn from_table(mut table: toml::Table) -> Result<Self, String> {
+        let name = match table.remove("env_name") {
+            Some(toml::Value::String(name)) => name,
+            Some(other) => return Err(format!("`env_name` is not a name: {other}")),
+            None => return Err("missing field `env_name`".into()),
+        };
+        let domain = crate::envs::registry::find(&name).ok_or_else(|| {
+            format!(
+                "unknown `env_name` {name:?}: this binary has {}",
+                crate::envs::registry::names_and_tags()
+            )
+        })?;
+        let known = domain
+            .keys(&toml::Table::new())
+            .map_err(|e| e.to_string())?;
+        let mut given = toml::Table::new();
+        for key in known.keys() {
+            if let Some(value) = table.remove(key) {
+                given.insert(key.clone(), value);
+            }
         }
+        let env = EnvSpec::of(domain, &given).map_err(|e| e.to_string())?;
+        let config = RunConfig::deserialize(toml::Value::Table(table))
+            .map_err(|e| e.message().to_string())?;
+        Ok(RunSettings { env, config })
     }
 }
 
-/// `config.toml`'s `[config]` table as written since the first runs: the domain as its four
-/// reference keys, then every hyperparameter, in this order. Only [`RunSettings`]'s serde goes
-/// through it. Unknown keys are refused, so a typo in a hand-edited config fails instead of
-/// being ignored.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RunSettingsFile {
-    env_name: EnvName,
-    grid_dim: usize,
-    env_terminate_step: usize,
-    tb_m_noisy: f64,
-    total_epi: usize,
-    replay_buffer_size: usize,
-    sample_epi: bool,
-    dynamic_h: bool,
-    init_h: f64,
-    end_h: f64,
-    h_stable_at: usize,
-    eps_l_d: bool,
-    eps_l_d_steps: usize,
-    eps_end: f64,
-    h_explore: bool,
-    cen_explore: bool,
-    l_rate: f64,
-    discount: f64,
-    start_train: usize,
-    train_freq: usize,
-    target_update_freq: usize,
-    trace_len: usize,
-    sub_trace_len: usize,
-    batch_size: usize,
-    dec_mlp_layer_size: usize,
-    dec_rnn_h_size: usize,
-    cen_mlp_layer_size: usize,
-    cen_rnn_h_size: usize,
-    eval_freq: usize,
-    eval_num_epi: usize,
-    checkpoint_freq: usize,
-    early_return_skips_all: bool,
-}
-
-impl From<RunSettings> for RunSettingsFile {
-    fn from(RunSettings { env, config: c }: RunSettings) -> Self {
-        let EnvFlags {
-            env_name,
-            grid_dim,
-            env_terminate_step,
-            tb_m_noisy,
-        } = EnvFlags::of(&env);
-        RunSettingsFile {
-            env_name,
-            grid_dim,
-            env_terminate_step,
-            tb_m_noisy,
-            total_epi: c.total_epi,
-            replay_buffer_size: c.replay_buffer_size,
-            sample_epi: c.sample_epi,
-            dynamic_h: c.dynamic_h,
-            init_h: c.init_h,
-            end_h: c.end_h,
-            h_stable_at: c.h_stable_at,
-            eps_l_d: c.eps_l_d,
-            eps_l_d_steps: c.eps_l_d_steps,
-            eps_end: c.eps_end,
-            h_explore: c.h_explore,
-            cen_explore: c.cen_explore,
-            l_rate: c.l_rate,
-            discount: c.discount,
-            start_train: c.start_train,
-            train_freq: c.train_freq,
-            target_update_freq: c.target_update_freq,
-            trace_len: c.trace_len,
-            sub_trace_len: c.sub_trace_len,
-            batch_size: c.batch_size,
-            dec_mlp_layer_size: c.dec_mlp_layer_size,
-            dec_rnn_h_size: c.dec_rnn_h_size,
-            cen_mlp_layer_size: c.cen_mlp_layer_size,
-            cen_rnn_h_size: c.cen_rnn_h_size,
-            eval_freq: c.eval_freq,
-            eval_num_epi: c.eval_num_epi,
-            checkpoint_freq: c.checkpoint_freq,
-            early_return_skips_all: c.early_return_skips_all,
-        }
+impl Serialize for RunSettings {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.to_table().serialize(s)
     }
 }
 
-impl From<RunSettingsFile> for RunSettings {
-    fn from(f: RunSettingsFile) -> Self {
-        let flags = EnvFlags {
-            env_name: f.env_name,
-            grid_dim: f.grid_dim,
-            env_terminate_step: f.env_terminate_step,
-            tb_m_noisy: f.tb_m_noisy,
-        };
-        let config = RunConfig {
-            total_epi: f.total_epi,
-            replay_buffer_size: f.replay_buffer_size,
-            sample_epi: f.sample_epi,
-            dynamic_h: f.dynamic_h,
-            init_h: f.init_h,
-            end_h: f.end_h,
-            h_stable_at: f.h_stable_at,
-            eps_l_d: f.eps_l_d,
-            eps_l_d_steps: f.eps_l_d_steps,
-            eps_end: f.eps_end,
-            h_explore: f.h_explore,
-            cen_explore: f.cen_explore,
-            l_rate: f.l_rate,
-            discount: f.discount,
-            start_train: f.start_train,
-            train_freq: f.train_freq,
-            target_update_freq: f.target_update_freq,
-            trace_len: f.trace_len,
-            sub_trace_len: f.sub_trace_len,
-            batch_size: f.batch_size,
-            dec_mlp_layer_size: f.dec_mlp_layer_size,
-            dec_rnn_h_size: f.dec_rnn_h_size,
-            cen_mlp_layer_size: f.cen_mlp_layer_size,
-            cen_rnn_h_size: f.cen_rnn_h_size,
-            eval_freq: f.eval_freq,
-            eval_num_epi: f.eval_num_epi,
-            checkpoint_freq: f.checkpoint_freq,
-            early_return_skips_all: f.early_return_skips_all,
-        };
-        RunSettings {
-            env: flags.spec(),
-            config,
-        }
+impl<'de> Deserialize<'de> for RunSettings {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let table = toml::Table::deserialize(d)?;
+        RunSettings::from_table(table).map_err(serde::de::Error::custom)
     }
 }
 
@@ -172,7 +91,7 @@ mod tests {
 
     #[test]
     fn the_domain_is_written_as_the_four_reference_keys_first() {
-        let c = paper(EnvSpec::paper_warehouse(), Method::Our2);
+        let c = paper(crate::envs::warehouse::paper_spec(), Method::Our2);
         let text = toml::to_string(&c).unwrap();
         assert!(
             text.starts_with(
@@ -190,10 +109,15 @@ mod tests {
 
     #[test]
     fn unknown_keys_are_refused_and_unused_domain_keys_are_not_read() {
-        let c = paper(EnvSpec::paper_box_pushing(10), Method::Our1);
+        let c = paper(crate::envs::box_pushing::paper_spec(10), Method::Our1);
         let text = toml::to_string(&c).unwrap();
         let err = toml::from_str::<RunSettings>(&format!("{text}trace_lenn = 3\n")).unwrap_err();
         assert!(err.message().contains("trace_lenn"), "{err}");
+        let err = toml::from_str::<RunSettings>(&text.replace("BP_MA", "Pong")).unwrap_err();
+        assert!(
+            err.message().contains("Pong") && err.message().contains("OSD_S_4"),
+            "{err}"
+        );
         // A Box Pushing config's tb_m_noisy is not part of its domain.
         let noisy = text.replace("tb_m_noisy = 0.0", "tb_m_noisy = 0.3");
         assert_ne!(noisy, text);

@@ -196,14 +196,14 @@ pub fn decode(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::envs::EnvSpec;
+
     use crate::experiment::train_run::run_rngs;
 
     fn tiny() -> (CheckpointIdentity, AnyLoop) {
-        let mut c = RunSettings::paper(EnvSpec::paper_box_pushing(8), Method::Our1);
+        let mut c = RunSettings::paper(crate::envs::box_pushing::paper_spec(8), Method::Our1);
         c.config.batch_size = 4;
         c.config.replay_buffer_size = 50;
-        let env = c.env;
+        let env = c.env.clone();
         let t = AnyLoop::new(&c.config, Method::Our1, 3, run_rngs(3), || env.build()).unwrap();
         (CheckpointIdentity::new("e", Method::Our1, "", 3, &c), t)
     }

@@ -343,10 +343,7 @@ mod tests {
             variant: String::new(),
             seed: 7,
             episodes_trained: 40,
-            env: EnvSpec::BoxPushing {
-                grid: 4,
-                horizon: 20,
-            },
+            env: crate::envs::box_pushing::spec(8, 20),
             discount: 0.98,
             evaluated,
             config: serde_json::json!({"lr": 0.001}),

@@ -51,7 +51,7 @@ impl RunManifest {
             variant: spec.variant.clone(),
             seed: spec.seed,
             config: RunSettings {
-                env: spec.env,
+                env: spec.env.clone(),
                 config: spec.config.clone(),
             },
             provenance: Some(Provenance::current()),
@@ -305,11 +305,11 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<()
         variant: spec.variant.clone(),
         seed: trainer.seed(),
         episodes_trained: trainer.episodes(),
-        env: spec.env,
+        env: spec.env.clone(),
         discount: config.discount,
         evaluated,
         config: serde_json::to_value(RunSettings {
-            env: spec.env,
+            env: spec.env.clone(),
             config: config.clone(),
         })
         .map_err(|e| io(dir, e))?,
@@ -358,7 +358,7 @@ pub fn train_run(
     let mut trainer = if checkpoint.exists() {
         load_checkpoint_of(&checkpoint, Some(&identity))?
     } else {
-        let env = spec.env;
+        let env = spec.env.clone();
         AnyLoop::new(
             &spec.config,
             spec.method,

@@ -44,6 +44,16 @@ impl Canvas {
         Colour::from_index(self.pixels[y * self.width + x])
     }
 
+    /// Copy `other` onto this canvas with its top-left pixel at (x, y), clipped at the borders.
+    pub fn paste(&mut self, other: &Canvas, x: usize, y: usize) {
+        for row in 0..other.height.min(self.height.saturating_sub(y)) {
+            let n = other.width.min(self.width.saturating_sub(x));
+            let from = row * other.width;
+            let to = (y + row) * self.width + x;
+            self.pixels[to..to + n].copy_from_slice(&other.pixels[from..from + n]);
+        }
+    }
+
     /// Set one pixel; ignored outside the canvas.
     #[inline]
     pub fn set(&mut self, x: i64, y: i64, c: Colour) {

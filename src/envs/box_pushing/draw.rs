@@ -1,12 +1,10 @@
 //! One Box Pushing frame: the grid with the goal row (yellow, at the top as in the paper's figure),
 //! faint waypoints, the two small boxes, the 1 x 2 big box and both robots with a heading marker,
-//! then the status bar (spec `box_pushing.md` sections 1-2 for what is where).
+//! for the status bar below it (spec `box_pushing.md` sections 1-2 for what is where).
 
-use super::canvas::Canvas;
-use super::hud::{draw_hud, hud_height};
-use super::palette::Colour;
-use crate::envs::box_pushing::geometry::{Cell, Heading};
-use crate::envs::box_pushing::BoxPushing;
+use super::geometry::{Cell, Heading};
+use super::BoxPushing;
+use crate::draw::{Canvas, Colour, Picture};
 
 /// Status-bar labels of the two robots.
 pub const LABELS: [&str; 2] = ["R0", "R1"];
@@ -88,15 +86,11 @@ fn screen_dir(h: Heading) -> (f64, f64) {
     (f64::from(dc), -f64::from(dr))
 }
 
-/// The frame of `env`'s current state; `team_return` is the undiscounted reward so far.
-pub fn draw(env: &BoxPushing, team_return: f64) -> Canvas {
+/// The picture of `env`'s current state.
+pub fn draw(env: &BoxPushing) -> Picture {
     let g = GridPixels::new(env.grid());
     let side = g.side();
-    let mut canvas = Canvas::new(
-        side,
-        side + hud_height(env, &LABELS, side),
-        Colour::Background,
-    );
+    let mut canvas = Canvas::new(side, side, Colour::Background);
     let n = g.n;
     let layout = env.layout();
 
@@ -160,8 +154,10 @@ pub fn draw(env: &BoxPushing, team_return: f64) -> Canvas {
         );
     }
 
-    draw_hud(&mut canvas, side, env, &LABELS, team_return);
-    canvas
+    Picture {
+        world: canvas,
+        agent_labels: &LABELS,
+    }
 }
 
 #[cfg(test)]
@@ -182,7 +178,7 @@ mod tests {
     #[test]
     fn start_frame_puts_each_object_on_its_cell() {
         let env = BoxPushing::new(10, 100).unwrap();
-        let c = draw(&env, 0.0);
+        let c = draw(&env).world;
         let g = GridPixels::new(10);
         // Robot 0 at (1,1) faces east: its disc shows green left of the centre, robot 1 at (8,1)
         // faces west: blue right of its centre.
@@ -217,7 +213,7 @@ mod tests {
     fn robots_on_one_cell_are_both_visible() {
         let mut env = BoxPushing::new(10, 100).unwrap();
         env.place_robot(1, Cell::new(1, 1), Heading::North);
-        let c = draw(&env, 0.0);
+        let c = draw(&env).world;
         let (x, y) = GridPixels::new(10).centre(Cell::new(1, 1));
         assert_eq!(at(&c, (x - 10.0, y - 10.0)), Some(Colour::Agent0));
         assert_eq!(at(&c, (x + 10.0, y + 10.0)), Some(Colour::Agent1));

@@ -5,11 +5,9 @@
 //! (gray), the Turtlebots (green T0, blue T1) with the tools in their baskets, and the human with
 //! a bar of its work steps and the tool it needs next. Tools are coloured by index everywhere.
 
-use super::canvas::Canvas;
-use super::font::{draw_text, text_width, GLYPH_H};
-use super::hud::{draw_hud, hud_height};
-use super::palette::Colour;
-use crate::envs::warehouse::{FetchAction, Warehouse, FETCH_POS, WAYPOINTS};
+use super::{FetchAction, Warehouse, FETCH_POS, WAYPOINTS};
+use crate::draw::font::{draw_text, text_width, GLYPH_H};
+use crate::draw::{Canvas, Colour, Picture};
 
 /// Status-bar labels: Turtlebot 0, Turtlebot 1, Fetch.
 pub const LABELS: [&str; 3] = ["T0", "T1", "F"];
@@ -24,7 +22,7 @@ const HUMAN_POS: [f64; 2] = [6.5, 3.9];
 /// Centres of the two staging slots on the table, first-to-pass first.
 const STAGING: [[f64; 2]; 2] = [[1.75, 2.4], [1.75, 2.05]];
 
-pub(super) const TB_RADIUS_M: f64 = 0.17;
+pub(crate) const TB_RADIUS_M: f64 = 0.17;
 const FETCH_RADIUS_M: f64 = 0.25;
 
 /// World point (m, y up) to continuous pixel coordinates (y down).
@@ -191,16 +189,18 @@ fn draw_turtlebots(c: &mut Canvas, env: &Warehouse) {
     }
 }
 
-/// The frame of `env`'s current state; `team_return` is the undiscounted reward so far.
-pub fn draw(env: &Warehouse, team_return: f64) -> Canvas {
+/// The picture of `env`'s current state.
+pub fn draw(env: &Warehouse) -> Picture {
     let (w, h) = world_px();
-    let mut c = Canvas::new(w, h + hud_height(env, &LABELS, w), Colour::Background);
+    let mut c = Canvas::new(w, h, Colour::Background);
     draw_rooms(&mut c);
     draw_fetch(&mut c, env);
     draw_human(&mut c, env);
     draw_turtlebots(&mut c, env);
-    draw_hud(&mut c, h, env, &LABELS, team_return);
-    c
+    Picture {
+        world: c,
+        agent_labels: &LABELS,
+    }
 }
 
 #[cfg(test)]
@@ -217,7 +217,7 @@ mod tests {
     #[test]
     fn reset_frame_shows_robots_table_and_rooms_where_the_spec_puts_them() {
         let env = Warehouse::paper(150).unwrap();
-        let c = draw(&env, 0.0);
+        let c = draw(&env).world;
         assert_eq!((c.width(), c.height() >= 300), (420, true));
         // Turtlebots: the "0"/"1" label sits on the centre, so look left of it.
         for (i, colour) in [(0, Colour::Agent0), (1, Colour::Agent1)] {
@@ -246,13 +246,13 @@ mod tests {
         let mut env = Warehouse::paper(150).unwrap();
         let mut rng = EnvRng::seed_from_u64(0);
         env.reset(&mut rng);
-        let c = draw(&env, 0.0);
+        let c = draw(&env).world;
         assert_eq!(at(&c, to_px(STAGING[0])), Some(Colour::Table), "empty slot");
         for _ in 0..6 {
             env.step(&[1, 1, 4], &mut rng).unwrap();
         }
         assert_eq!(env.fetch().staged(), &[1]);
-        let c = draw(&env, 0.0);
+        let c = draw(&env).world;
         assert_eq!(at(&c, to_px(STAGING[0])), Some(Colour::Tool1));
         assert_eq!(at(&c, to_px(STAGING[1])), Some(Colour::Table));
     }

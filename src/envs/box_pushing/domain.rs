@@ -1,0 +1,202 @@
+//! Box Pushing as configs, runs and policy files know it: `env_name = "BP_MA"` (alias
+//! `box-pushing`), its keys `grid_dim` and `env_terminate_step` (the reference's names), the
+//! paper's settings for it (spec `algorithms.md` 10.1, 10.2) and its tagged form in policy and
+//! replay files, `{"env": "box-pushing", "grid": 10, "horizon": 100}`.
+
+use super::BoxPushing;
+use crate::envs::domain::{fill_keys, key_table, key_usize, Domain, KeyError, HORIZON_KEY};
+use crate::envs::{AnyEnv, EnvError, EnvSpec};
+
+/// Largest grid side a config may ask for (paper: 10 and 30), far below [`super::MAX_GRID`]
+/// so that a run's memory stays bounded (README "Limits and guarantees").
+pub const MAX_GRID_DIM: usize = 1_000;
+
+/// The reference's `--grid_dim` default, Figure 4a's grid.
+pub const DEFAULT_GRID_DIM: usize = 10;
+
+/// The Box Pushing domain.
+pub struct BoxPushingDomain;
+
+/// The paper's horizon for a grid: 100 steps below 30 x 30 (Figure 4a's 10 x 10), 200 from
+/// 30 x 30 on (Figure 4b) (spec `algorithms.md` 10.1, 10.2).
+fn paper_horizon(grid: usize) -> usize {
+    if grid >= 30 {
+        200
+    } else {
+        100
+    }
+}
+
+/// Box Pushing on a `grid` x `grid` grid with `horizon` primitive steps.
+pub fn spec(grid: usize, horizon: usize) -> EnvSpec {
+    EnvSpec::of(
+        &BoxPushingDomain,
+        &key_table([
+            ("grid_dim", (grid as i64).into()),
+            (HORIZON_KEY, (horizon as i64).into()),
+        ]),
+    )
+    .expect("a valid Box Pushing grid and horizon")
+}
+
+/// Box Pushing at the paper's horizon for its grid (see [`paper_horizon`]).
+pub fn paper_spec(grid: usize) -> EnvSpec {
+    spec(grid, paper_horizon(grid))
+}
+
+/// The config key of a parameter [`BoxPushing::check_params`] names.
+fn key_of(e: EnvError) -> KeyError {
+    match e {
+        EnvError::InvalidParameter {
+            name: "grid",
+            reason,
+        } => KeyError::new("grid_dim", reason),
+        EnvError::InvalidParameter { reason, .. } => KeyError::new(HORIZON_KEY, reason),
+        other => KeyError::new("env_name", other.to_string()),
+    }
+}
+
+impl Domain for BoxPushingDomain {
+    type Env = BoxPushing;
+
+    fn name(&self) -> &'static str {
+        "BP_MA"
+    }
+
+    fn aliases(&self) -> &'static [&'static str] {
+        &["box-pushing"]
+    }
+
+    /// `grid_dim` (default 10), `env_terminate_step` (default: the paper's for the grid), and
+    /// `tb_m_noisy`, which the reference's command line has for every domain and Box Pushing
+    /// runs record as 0: Box Pushing does not read it, so it is always recorded as 0.
+    fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
+        let grid = match given.get("grid_dim") {
+            Some(toml::Value::Integer(n)) if *n > 0 && *n as u64 <= MAX_GRID_DIM as u64 => {
+                *n as usize
+            }
+            Some(toml::Value::Integer(n)) if *n > 0 => {
+                return Err(KeyError::new(
+                    "grid_dim",
+                    format!("must be at most {MAX_GRID_DIM}, got {n}"),
+                ))
+            }
+            Some(v) => {
+                return Err(KeyError::new(
+                    "grid_dim",
+                    format!("expected a positive integer, got {v}"),
+                ))
+            }
+            None => DEFAULT_GRID_DIM,
+        };
+        let mut keys = fill_keys(
+            given,
+            key_table([
+                ("grid_dim", (grid as i64).into()),
+                (HORIZON_KEY, (paper_horizon(grid) as i64).into()),
+                ("tb_m_noisy", 0.0.into()),
+            ]),
+        )?;
+        keys.insert("tb_m_noisy".into(), toml::Value::Float(0.0));
+        BoxPushing::check_params(grid, key_usize(&keys, HORIZON_KEY)?).map_err(key_of)?;
+        Ok(keys)
+    }
+
+    fn build(&self, keys: &toml::Table) -> Result<BoxPushing, KeyError> {
+        BoxPushing::new(key_usize(keys, "grid_dim")?, key_usize(keys, HORIZON_KEY)?).map_err(key_of)
+    }
+
+    /// Figure 4's settings differ by grid only in the window length (10 x 10: 15, 30 x 30: 45,
+    /// also the training period); both discount by 0.98 (spec 10.1, 10.2).
+    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
+        let grid = key_usize(keys, "grid_dim").unwrap_or(DEFAULT_GRID_DIM);
+        let trace_len: i64 = if grid >= 30 { 45 } else { 15 };
+        key_table([
+            ("discount", 0.98.into()),
+            ("trace_len", trace_len.into()),
+            ("train_freq", trace_len.into()),
+        ])
+    }
+
+    fn short_name(&self, keys: &toml::Table) -> String {
+        format!(
+            "bp{}",
+            key_usize(keys, "grid_dim").unwrap_or(DEFAULT_GRID_DIM)
+        )
+    }
+
+    fn tag(&self) -> &'static str {
+        "box-pushing"
+    }
+
+    fn to_tagged(&self, keys: &toml::Table) -> serde_json::Map<String, serde_json::Value> {
+        let mut m = serde_json::Map::new();
+        m.insert(
+            "grid".into(),
+            key_usize(keys, "grid_dim").unwrap_or(0).into(),
+        );
+        m.insert(
+            "horizon".into(),
+            key_usize(keys, HORIZON_KEY).unwrap_or(0).into(),
+        );
+        m
+    }
+
+    fn keys_of_tagged(
+        &self,
+        fields: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<toml::Table, KeyError> {
+        if let Some(k) = fields
+            .keys()
+            .find(|k| !["grid", "horizon"].contains(&k.as_str()))
+        {
+            return Err(KeyError::new(
+                k,
+                "unknown field; box-pushing has `grid` and `horizon`",
+            ));
+        }
+        let int = |k: &str| match fields.get(k) {
+            Some(v) => v.as_i64().filter(|n| *n >= 0).ok_or_else(|| {
+                KeyError::new(k, format!("expected a non-negative integer, got {v}"))
+            }),
+            None => Err(KeyError::new(k, format!("missing field `{k}`"))),
+        };
+        let (grid, horizon) = (int("grid")?, int("horizon")?);
+        Domain::keys(
+            self,
+            &key_table([("grid_dim", grid.into()), (HORIZON_KEY, horizon.into())]),
+        )
+    }
+
+    fn hold(&self, env: BoxPushing) -> AnyEnv {
+        AnyEnv::BoxPushing(env)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_horizon_follows_the_grid_and_keys_are_named() {
+        assert_eq!(paper_spec(10).horizon(), 100);
+        assert_eq!(paper_spec(30).horizon(), 200);
+        assert_eq!(paper_spec(30).short_name(), "bp30");
+        let d = BoxPushingDomain;
+        for (given, key) in [
+            (toml::toml! { grid_dim = 6 }, "grid_dim"),
+            (toml::toml! { grid_dim = 11 }, "grid_dim"),
+            (toml::toml! { grid_dim = 100000 }, "grid_dim"),
+            (toml::toml! { env_terminate_step = 0 }, "env_terminate_step"),
+        ] {
+            assert_eq!(Domain::keys(&d, &given).unwrap_err().key, key, "{given}");
+        }
+    }
+
+    #[test]
+    fn paper_settings_follow_the_grid() {
+        let s = paper_spec(30).paper_settings();
+        assert_eq!(s["trace_len"].as_integer(), Some(45));
+        assert_eq!(paper_spec(10).paper_discount(), Some(0.98));
+    }
+}

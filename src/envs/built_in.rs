@@ -1,0 +1,115 @@
+//! The domains built into macdec: **the one list** a new built-in domain joins. Each line names
+//! the domain's [`AnyEnv`] variant, its environment type and its [`super::domain::Domain`]; the
+//! macro below turns the list into [`AnyEnv`] (one variant per domain, plus [`AnyEnv::Custom`]
+//! for a user's own), its [`MacroEnv`] forwarding, and [`BUILT_IN`] for the registry.
+//!
+//! Everything else about a domain lives in its folder (`src/envs/<domain>/`): its dynamics, its
+//! config keys and their defaults, its paper settings, its optimum, its limits and its drawing.
+
+use super::box_pushing::{BoxPushing, BoxPushingDomain};
+use super::custom_env::CustomEnv;
+use super::domain::DomainEntry;
+use super::warehouse::{Warehouse, WarehouseDomain};
+use super::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
+
+/// Generate [`AnyEnv`], its `MacroEnv` forwarding and [`BUILT_IN`] from the list of domains.
+macro_rules! built_in_domains {
+    ($($variant:ident($env:ty) = $domain:expr,)+) => {
+        /// Any built environment: a built-in domain's, by `match` (no dynamic dispatch on the hot
+        /// path, `Clone`, and a checkpoint's bincode names the variant), or a user's own behind
+        /// [`AnyEnv::Custom`].
+        ///
+        /// The variants differ in size (Warehouse is larger); a run holds one `AnyEnv`, so
+        /// boxing would only add a pointer chase to every step of the hot loop.
+        #[allow(clippy::large_enum_variant)]
+        #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+        pub enum AnyEnv {
+            $($variant($env),)+
+            /// A domain not built in (the variant comes last, so the built-in variants keep
+            /// their bincode indices).
+            Custom(CustomEnv),
+        }
+
+        /// The built-in domains, in list order.
+        pub static BUILT_IN: &[&'static dyn DomainEntry] = &[$(&$domain,)+];
+
+        /// Forward a method call to the variant's environment.
+        macro_rules! dispatch {
+            ($self:expr, $e:ident => $call:expr) => {
+                match $self {
+                    $(AnyEnv::$variant($e) => $call,)+
+                    AnyEnv::Custom($e) => $call,
+                }
+            };
+        }
+    };
+}
+
+built_in_domains! {
+    BoxPushing(BoxPushing) = BoxPushingDomain,
+    Warehouse(Warehouse) = WarehouseDomain,
+}
+
+impl MacroEnv for AnyEnv {
+    fn n_agents(&self) -> usize {
+        dispatch!(self, e => e.n_agents())
+    }
+    fn obs_sizes(&self) -> &[usize] {
+        dispatch!(self, e => e.obs_sizes())
+    }
+    fn n_actions(&self) -> &[usize] {
+        dispatch!(self, e => e.n_actions())
+    }
+    fn action_names(&self, agent: usize) -> &'static [&'static str] {
+        dispatch!(self, e => e.action_names(agent))
+    }
+    fn obs_names(&self, agent: usize) -> Vec<String> {
+        dispatch!(self, e => e.obs_names(agent))
+    }
+    fn horizon(&self) -> usize {
+        dispatch!(self, e => e.horizon())
+    }
+    fn reset(&mut self, rng: &mut EnvRng) {
+        dispatch!(self, e => e.reset(rng))
+    }
+    #[inline]
+    fn step(&mut self, actions: &[usize], rng: &mut EnvRng) -> Result<StepOutcome, EnvError> {
+        dispatch!(self, e => e.step(actions, rng))
+    }
+    #[inline]
+    fn obs(&self, agent: usize) -> &[f32] {
+        dispatch!(self, e => e.obs(agent))
+    }
+    fn executed(&self) -> &[usize] {
+        dispatch!(self, e => e.executed())
+    }
+    #[inline]
+    fn mac_done(&self) -> &[bool] {
+        dispatch!(self, e => e.mac_done())
+    }
+    #[inline]
+    fn is_free(&self, agent: usize) -> bool {
+        dispatch!(self, e => e.is_free(agent))
+    }
+    fn t(&self) -> usize {
+        dispatch!(self, e => e.t())
+    }
+    fn render_ascii(&self) -> String {
+        dispatch!(self, e => e.render_ascii())
+    }
+    fn first_record_obs(&self) -> FirstRecordObs {
+        dispatch!(self, e => e.first_record_obs())
+    }
+    fn deterministic(&self) -> bool {
+        dispatch!(self, e => e.deterministic())
+    }
+    fn optimal_return(&self, discount: f64) -> Option<f64> {
+        dispatch!(self, e => e.optimal_return(discount))
+    }
+    fn describe(&self) -> String {
+        dispatch!(self, e => e.describe())
+    }
+    fn draw(&self) -> Option<crate::draw::Picture> {
+        dispatch!(self, e => e.draw())
+    }
+}

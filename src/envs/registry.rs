@@ -1,0 +1,135 @@
+//! Every domain this binary knows, found by name: the built-in ones (the list in
+//! [`super::built_in`]) and those a program registers at start ([`register`]; a user's binary
+//! does it through [`crate::cli::main_with`]).
+//!
+//! Registration is process-wide because reading any file that names a domain (a config, a run's
+//! `config.toml`, a checkpoint, a policy) must find it, wherever in the program that happens.
+//! Domains are only ever added, and a name can never change meaning.
+
+use std::sync::RwLock;
+
+use super::built_in::BUILT_IN;
+use super::domain::DomainEntry;
+
+/// Domains registered at run time, after the built-in ones.
+static REGISTERED: RwLock<Vec<&'static dyn DomainEntry>> = RwLock::new(Vec::new());
+
+/// Why a domain could not be registered.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RegistryError {
+    #[error(
+        "domain name `{0}` is taken by another domain (every name, alias and tag must be unique)"
+    )]
+    NameTaken(String),
+    #[error("domain name {0:?} must be 1 to 64 letters, digits, `_` or `-`")]
+    BadName(String),
+}
+
+/// Add `domain` to the process's domains. Registering the same domain object again does
+/// nothing; a domain whose name, alias or tag another domain already uses is refused.
+pub fn register(domain: &'static dyn DomainEntry) -> Result<(), RegistryError> {
+    let mut registered = REGISTERED.write().unwrap_or_else(|e| e.into_inner());
+    if registered.iter().any(|d| {
+        std::ptr::addr_eq(
+            *d as *const dyn DomainEntry,
+            domain as *const dyn DomainEntry,
+        )
+    }) {
+        return Ok(());
+    }
+    for name in names_of(domain) {
+        let ok = !name.is_empty()
+            && name.len() <= 64
+            && name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+        if !ok {
+            return Err(RegistryError::BadName(name.to_string()));
+        }
+        let clash = name == CUSTOM_TAG
+            || BUILT_IN
+                .iter()
+                .chain(registered.iter())
+                .any(|d| names_of(*d).any(|n| n == name));
+        if clash {
+            return Err(RegistryError::NameTaken(name.to_string()));
+        }
+    }
+    registered.push(domain);
+    Ok(())
+}
+
+/// The tag older policy files used for any domain not built in (`{"env": "custom", ...}`);
+/// no domain may take it.
+pub const CUSTOM_TAG: &str = "custom";
+
+/// Every name a domain answers to: its name, aliases and tag.
+fn names_of(d: &'static dyn DomainEntry) -> impl Iterator<Item = &'static str> {
+    std::iter::once(d.name())
+        .chain(d.aliases().iter().copied())
+        .chain(std::iter::once(d.tag()))
+}
+
+/// The domain answering to `name` (its `env_name`, an alias or its file tag).
+pub fn find(name: &str) -> Option<&'static dyn DomainEntry> {
+    let registered = REGISTERED.read().unwrap_or_else(|e| e.into_inner());
+    BUILT_IN
+        .iter()
+        .chain(registered.iter())
+        .copied()
+        .find(|d| names_of(*d).any(|n| n == name))
+}
+
+/// The `env_name` of every known domain, built-in first (for messages listing the choices).
+pub fn names() -> Vec<&'static str> {
+    let registered = REGISTERED.read().unwrap_or_else(|e| e.into_inner());
+    BUILT_IN
+        .iter()
+        .chain(registered.iter())
+        .map(|d| d.name())
+        .collect()
+}
+
+/// Every known domain as `name (tag)` (`BP_MA (box-pushing)`), for messages listing choices.
+pub fn names_and_tags() -> String {
+    let registered = REGISTERED.read().unwrap_or_else(|e| e.into_inner());
+    BUILT_IN
+        .iter()
+        .chain(registered.iter())
+        .map(|d| match d.tag() {
+            tag if tag == d.name() => tag.to_string(),
+            tag => format!("{} ({tag})", d.name()),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Whether `name` is a built-in domain's name, alias or tag.
+pub fn is_built_in(name: &str) -> bool {
+    BUILT_IN.iter().any(|d| names_of(*d).any(|n| n == name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn built_in_domains_are_found_by_name_alias_and_tag() {
+        assert_eq!(find("BP_MA").unwrap().name(), "BP_MA");
+        assert_eq!(find("box-pushing").unwrap().name(), "BP_MA");
+        assert_eq!(find("OSD_S_4").unwrap().name(), "OSD_S_4");
+        assert_eq!(find("warehouse").unwrap().name(), "OSD_S_4");
+        assert!(find("Pong").is_none());
+        assert_eq!(&names()[..2], ["BP_MA", "OSD_S_4"]);
+    }
+
+    #[test]
+    fn a_built_in_name_cannot_be_registered_again() {
+        let bp = find("BP_MA").unwrap();
+        // The same object is accepted (idempotent) ...
+        let err = register(super::super::built_in::BUILT_IN[1]);
+        // ... but built-in objects are not in the run-time list, so re-registering one clashes.
+        assert_eq!(err, Err(RegistryError::NameTaken("OSD_S_4".into())));
+        assert_eq!(bp.name(), "BP_MA");
+    }
+}
