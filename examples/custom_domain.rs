@@ -1,26 +1,28 @@
-//! Your own domain in one file: a small macro-action task defined here, trained with Our-1 and
-//! Dec-HDDRQN through the library entry point `macdec::train_policy`, learning curves printed, the
-//! known optimum checked, and the Our-1 policy exported as a policy directory that `macdec robot`
-//! serves.
+//! Your own domain with macdec's whole command line: a small macro-action task defined here, and
+//! a `main` that is macdec's command line with the task registered.
 //!
 //! Rendezvous: two robots on a corridor of 9 cells must meet at one of three waypoints (cells 0,
 //! 4 and 8). Robot 0 starts at cell 1, robot 1 at cell 7. Each macro-action is "go to waypoint k"
 //! and lasts until the robot is there (one step of waiting if it already is). Every primitive step
 //! costs 1; the episode ends with a bonus when both robots stand on the same waypoint (20 at
-//! the left end, 5 in the middle, 8 at the right end), or after 20 steps. Each robot sees only its
-//! own cell, so the team must agree on the far, rich left waypoint without communicating; the
-//! near middle one is the trap.
+//! the left end, 5 in the middle, 8 at the right end), or after `env_terminate_step` steps
+//! (default 20). Each robot sees only its own cell, so the team must agree on the far, rich left
+//! waypoint without communicating; the near middle one is the trap.
 //!
-//! Run: `cargo run --release --example custom_domain [-- OUT_DIR]`. With `OUT_DIR` the curves are
-//! also written as `OUT_DIR/custom_domain/<method>/seed-0/metrics.csv`, which
-//! `macdec plot --results OUT_DIR` draws like any other experiment.
+//! ```text
+//! cargo run --release --example custom_domain -- train --config examples/custom_domain.toml --out results
+//! cargo run --release --example custom_domain -- plot --results results --out results
+//! cargo run --release --example custom_domain -- export --run results/custom_domain/our1/seed-0 --out policy
+//! cargo run --release --example custom_domain -- eval --policy policy
+//! ```
 //!
-//! The Our-1 policy is written to `<temp dir>/macdec-rendezvous-our1` (rewritten on every run);
-//! serve agent 0 with `macdec robot --policy <that dir> --agent 0`. `macdec eval`, `deploy`,
-//! `domain` and `render` refuse it: Rendezvous is not built into the binary.
+//! Configs select the task with `env_name = "rendezvous"`; its one key is `env_terminate_step`.
+//! Runs resume after a kill, plots draw its optimal return, and `render` says it has no picture
+//! (implement `MacroEnv::draw` to give it one). A crate of your own does the same: depend on
+//! macdec, implement `MacroEnv` and `Domain`, and call `macdec::cli::main_with`.
 
-use macdec::experiment::metrics;
-use macdec::{paper_defaults, EnvError, EnvRng, MacroEnv, Method, PolicyEnv, StepOutcome};
+use macdec::envs::domain::{fill_keys, key_table, key_usize, Domain, KeyError, HORIZON_KEY};
+use macdec::{EnvError, EnvRng, MacroEnv, StepOutcome};
 
 /// Corridor cells.
 const CELLS: usize = 9;
@@ -32,10 +34,8 @@ const BONUS: [f64; 3] = [20.0, 5.0, 8.0];
 const STARTS: [usize; 2] = [1, 7];
 /// Team cost of one primitive step.
 const STEP_COST: f64 = 1.0;
-/// Horizon in primitive steps.
+/// Default horizon in primitive steps.
 const HORIZON: usize = 20;
-/// Discount per primitive step in evaluation (and per macro-transition in the targets).
-const DISCOUNT: f64 = 0.95;
 
 const ACTION_NAMES: [&str; 3] = ["go_left_end", "go_middle", "go_right_end"];
 
@@ -51,10 +51,11 @@ struct Rendezvous {
     obs: [[f32; CELLS]; 2],
     t: usize,
     done: bool,
+    horizon: usize,
 }
 
 impl Rendezvous {
-    fn new() -> Self {
+    fn new(horizon: usize) -> Self {
         let mut env = Rendezvous {
             pos: STARTS,
             target: [0; 2],
@@ -63,6 +64,7 @@ impl Rendezvous {
             obs: [[0.0; CELLS]; 2],
             t: 0,
             done: false,
+            horizon,
         };
         env.reset(&mut <EnvRng as rand::SeedableRng>::seed_from_u64(0));
         env
@@ -91,7 +93,7 @@ impl MacroEnv for Rendezvous {
         (0..CELLS).map(|c| format!("at_cell_{c}")).collect()
     }
     fn horizon(&self) -> usize {
-        HORIZON
+        self.horizon
     }
 
     fn reset(&mut self, _rng: &mut EnvRng) {
@@ -149,7 +151,7 @@ impl MacroEnv for Rendezvous {
         if let Some(bonus) = met {
             reward += bonus;
         }
-        self.done = met.is_some() || self.t >= HORIZON;
+        self.done = met.is_some() || self.t >= self.horizon;
         if self.done {
             // Every macro-action ends with the episode.
             self.mac_done = [true; 2];
@@ -189,8 +191,12 @@ impl MacroEnv for Rendezvous {
 
     /// Both robots walk straight to one waypoint: meeting at waypoint w cannot happen before
     /// the farther robot arrives, the bonus is paid only at the meeting and every step costs the
-    /// same, so the best return is the best such walk.
+    /// same, so the best return is the best such walk (at the default horizon, which all walks
+    /// fit in).
     fn optimal_return(&self, discount: f64) -> Option<f64> {
+        if self.horizon != HORIZON {
+            return None;
+        }
         WAYPOINTS
             .iter()
             .zip(BONUS)
@@ -205,79 +211,38 @@ impl MacroEnv for Rendezvous {
     }
 
     fn describe(&self) -> String {
-        format!("Rendezvous corridor, horizon {HORIZON}")
+        format!("Rendezvous corridor, horizon {}", self.horizon)
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out_dir = std::env::args().nth(1).map(std::path::PathBuf::from);
-    let optimum = Rendezvous::new()
-        .optimal_return(DISCOUNT)
-        .expect("the optimum is known");
-    println!("Rendezvous: optimal return {optimum:.4}");
-    let mut all_reached = true;
-    for method in [Method::Our1, Method::DecHddrqn] {
-        // Start from the paper's Warehouse settings (whole-episode replay) and scale them down.
-        // The config's `env` stays Warehouse's: `macdec::train` trains on Rendezvous instead and
-        // takes the horizon from it.
-        let mut config = paper_defaults(&macdec::envs::warehouse::paper_spec(), method);
-        config.discount = DISCOUNT;
-        config.total_epi = 3000;
-        config.eps_l_d_steps = 1500;
-        config.h_stable_at = 1500;
-        config.eps_end = 0.05;
-        config.replay_buffer_size = 500;
-        config.batch_size = 16;
-        config.train_freq = 5;
-        config.target_update_freq = 200;
-        config.l_rate = 0.001;
-        config.dec_rnn_h_size = 32;
-        config.cen_rnn_h_size = 32;
-        config.eval_freq = 200;
-        let trained = macdec::train_policy(Rendezvous::new_ok, &config, method, 0, |_| {})?;
-        let evals = &trained.evals;
-        println!("\n{} ({}):", method.legend(), method);
-        println!("  episode   return");
-        for e in evals {
-            println!("  {:>7}  {:>7.3}", e.episode, e.eval_return);
-        }
-        let last = evals.last().map_or(f64::NEG_INFINITY, |e| e.eval_return);
-        let reached = (last - optimum).abs() < 1e-9;
-        all_reached &= reached;
-        println!(
-            "  final {last:.4}: {}",
-            if reached { "optimal" } else { "NOT optimal" }
-        );
-        if let Some(dir) = &out_dir {
-            let run = dir.join("custom_domain").join(method.name()).join("seed-0");
-            std::fs::create_dir_all(&run)?;
-            metrics::write(
-                &run.join(metrics::METRICS_FILE),
-                trained.metric_columns,
-                evals,
-            )?;
-        }
-        if method == Method::Our1 {
-            // The layout (observation and macro-action names) comes from the env object.
-            let env = Rendezvous::new();
-            let policy = std::env::temp_dir().join("macdec-rendezvous-our1");
-            trained.export(&policy, &env, PolicyEnv::custom("rendezvous", &env))?;
-            println!(
-                "  policy exported to {}\n  serve agent 0: macdec robot --policy {} --agent 0",
-                policy.display(),
-                policy.display()
-            );
-        }
+/// The task as configs, runs and policy files know it.
+struct RendezvousDomain;
+
+impl Domain for RendezvousDomain {
+    type Env = Rendezvous;
+
+    fn name(&self) -> &'static str {
+        "rendezvous"
     }
-    if !all_reached {
-        return Err("a method did not reach the optimum".into());
+
+    /// One key, the horizon; the walks to the waypoints need at least 7 steps.
+    fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
+        let keys = fill_keys(given, key_table([(HORIZON_KEY, (HORIZON as i64).into())]))?;
+        let horizon = key_usize(&keys, HORIZON_KEY)?;
+        if !(7..=10_000).contains(&horizon) {
+            return Err(KeyError::new(
+                HORIZON_KEY,
+                format!("must be 7 to 10000 (a meeting takes 7 steps), got {horizon}"),
+            ));
+        }
+        Ok(keys)
     }
-    Ok(())
+
+    fn build(&self, keys: &toml::Table) -> Result<Rendezvous, KeyError> {
+        Ok(Rendezvous::new(key_usize(keys, HORIZON_KEY)?))
+    }
 }
 
-impl Rendezvous {
-    /// The factory `macdec::train` calls for every environment it needs.
-    fn new_ok() -> Result<Self, EnvError> {
-        Ok(Self::new())
-    }
+fn main() -> std::process::ExitCode {
+    macdec::cli::main_with(&[&RendezvousDomain])
 }

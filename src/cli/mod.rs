@@ -388,6 +388,36 @@ fn parse_net_role(text: &str) -> Result<NetRole, String> {
     }
 }
 
+/// The whole `macdec` command line over the built-in domains and `domains`, a program's own
+/// ([`crate::envs::Domain`]): configs select them by `env_name`, and `train` (with `--jobs`,
+/// resume and `finished` markers), `plot` (with the domain's optimum), `export`, `eval`,
+/// `deploy`, `robot`, `domain`, `audit`, `slurm` and `render` (if the domain draws) work on them
+/// as on the built-in ones.
+///
+/// ```no_run
+/// # struct MyDomain;
+/// # impl macdec::envs::Domain for MyDomain {
+/// #     type Env = macdec::envs::box_pushing::BoxPushing;
+/// #     fn name(&self) -> &'static str { "mine" }
+/// #     fn keys(&self, g: &toml::Table) -> Result<toml::Table, macdec::envs::domain::KeyError> { unimplemented!() }
+/// #     fn build(&self, k: &toml::Table) -> Result<Self::Env, macdec::envs::domain::KeyError> { unimplemented!() }
+/// # }
+/// fn main() -> std::process::ExitCode {
+///     macdec::cli::main_with(&[&MyDomain])
+/// }
+/// ```
+pub fn main_with(
+    domains: &[&'static dyn crate::envs::domain::DomainEntry],
+) -> std::process::ExitCode {
+    for domain in domains {
+        if let Err(e) = crate::envs::registry::register(*domain) {
+            eprintln!("Error: registering domain `{}`: {e}", domain.name());
+            return std::process::ExitCode::FAILURE;
+        }
+    }
+    main()
+}
+
 /// The `macdec` command line over the built-in domains: parse `std::env::args`, run the
 /// subcommand, print any error with its causes, and return the exit code.
 pub fn main() -> std::process::ExitCode {

@@ -37,7 +37,7 @@ pub struct CustomEnv {
 
 /// A command that must simulate the domain was given a policy of a custom domain.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("the policy's domain `{name}` is a custom domain, not built into this binary (it has box-pushing and warehouse): `macdec robot` serves its agents, but running its episodes needs its simulator, so drive the robots from your own program (macdec::deploy::run_episodes with your MacroEnv and JsonLink::connect)")]
+#[error("the policy's domain `{name}` is not in this binary (it has {}): `macdec robot` serves its agents, but running its episodes needs its simulator: use a binary that registers the domain (`macdec::cli::main_with`, see examples/custom_domain.rs), or drive the robots from your own program (macdec::deploy::run_episodes with your MacroEnv and JsonLink::connect)", crate::envs::registry::names_and_tags())]
 pub struct NotBuiltIn {
     pub name: String,
 }
@@ -168,6 +168,25 @@ impl<'de> Deserialize<'de> for PolicyEnv {
             return serde_json::from_value(value)
                 .map(PolicyEnv::Custom)
                 .map_err(|e| D::Error::custom(format!("custom env: {e}")));
+        }
+        // A domain this binary does not have (a user's own, served by `macdec robot`): keep its
+        // name and horizon, as for the older custom form.
+        if let Some(tag) = value.get("env").and_then(|t| t.as_str()) {
+            if crate::envs::registry::find(tag).is_none() {
+                let horizon = value
+                    .get(crate::envs::domain::HORIZON_KEY)
+                    .and_then(|h| h.as_u64())
+                    .and_then(|h| usize::try_from(h).ok());
+                if let Some(horizon) = horizon {
+                    let env = CustomEnv {
+                        name: tag.to_string(),
+                        horizon,
+                    };
+                    env.validate()
+                        .map_err(|(k, m)| D::Error::custom(format!("{k}: {m}")))?;
+                    return Ok(PolicyEnv::Custom(env));
+                }
+            }
         }
         serde_json::from_value(value)
             .map(PolicyEnv::BuiltIn)
