@@ -212,7 +212,7 @@ fn commands_that_simulate_the_domain_refuse_a_custom_policy_by_name() {
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
         assert!(
             err.contains(&format!("`{NAME}`"))
-                && err.contains("not built into this binary")
+                && err.contains("not in this binary")
                 && !err.contains("panicked"),
             "{args:?}: {err}"
         );

@@ -265,7 +265,9 @@ mod tests {
         });
         let err = env.build().unwrap_err().to_string();
         assert!(
-            err.contains("`rendezvous`") && err.contains("not built into this binary"),
+            err.contains("`rendezvous`")
+                && err.contains("not in this binary")
+                && err.contains("main_with"),
             "{err}"
         );
         assert!(PolicyEnv::BuiltIn(crate::envs::warehouse::paper_spec())
