@@ -1,6 +1,8 @@
-//! The decentralized Q-net's architecture as an exported file describes it: the reference's
-//! `DDRQN` module (spec `algorithms.md` 2), whose PyTorch `state_dict` names and shapes the
-//! exported safetensors files keep, so the weights load into the reference's module unchanged.
+//! A net's architecture as a policy file describes it: today the reference's `DDRQN` module (spec
+//! `algorithms.md` 2), whose PyTorch `state_dict` names and shapes the safetensors files keep, so
+//! the weights load into the reference's module unchanged. Every net entry of `policy.json`
+//! carries one ([`crate::policy_files::NetEntry`]), so a net of another architecture (a GRU
+//! actor, a centralized critic) is a new `kind` here, not a new file format.
 //!
 //! ```text
 //! obs (input) -> fc1 -> leaky_relu(0.01) -> fc2 -> leaky_relu -> LSTM(H, H) -> fc3 -> leaky_relu
@@ -20,8 +22,8 @@ pub const DDRQN: &str = "ddrqn";
 /// Negative slope of every leaky ReLU (PyTorch's `F.leaky_relu` default, used by the reference).
 pub const LEAKY_RELU_SLOPE: f32 = 0.01;
 
-/// Layer sizes of an exported net, shared by every agent of a policy (the observation and action
-/// counts are per agent, in [`crate::deploy::manifest::AgentEntry`]).
+/// Hidden-layer sizes of one net (its input and output lengths are in its
+/// [`crate::policy_files::NetEntry`], since they differ between an agent's net and the joint one).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Architecture {
