@@ -110,6 +110,13 @@ fn version_1_exports_load_for_robots_with_the_same_nets() {
     }
     let custom = Manifest::read(&fixtures().join("export-custom")).unwrap();
     assert!(matches!(custom.env, PolicyEnv::Custom(_)));
+
+    // A run's policy/ is a policy directory of the same format: robots can load it directly.
+    let run_policy = fixtures().join("run/policy");
+    let (manifest, verified) = load_all(&run_policy).unwrap();
+    for v in &verified {
+        assert_eq!(load_net(&manifest, v).unwrap(), run_nets[v.index]);
+    }
 }
 
 #[test]

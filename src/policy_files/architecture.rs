@@ -10,7 +10,7 @@
 //! ```
 
 use crate::nn::safetensors_io::{from_safetensors_bytes, WeightsError as NnWeightsError};
-use crate::nn::{QNetConfig, TENSOR_NAMES};
+use crate::nn::{QNet, QNetConfig, TENSOR_NAMES};
 use safetensors::Dtype;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -77,12 +77,22 @@ impl Architecture {
         obs_len: usize,
         n_actions: usize,
     ) -> Result<(), WeightsError> {
+        self.qnet(bytes, obs_len, n_actions).map(|_| ())
+    }
+
+    /// The Q-net a safetensors file holds, checked as [`Self::check_weights`] describes.
+    pub fn qnet(
+        &self,
+        bytes: &[u8],
+        obs_len: usize,
+        n_actions: usize,
+    ) -> Result<QNet, WeightsError> {
         if self.kind != DDRQN {
             return Err(WeightsError::UnknownKind(self.kind.clone()));
         }
         let cfg = self.qnet_config(obs_len, n_actions);
         match from_safetensors_bytes(bytes, cfg, Path::new("")) {
-            Ok(_) => Ok(()),
+            Ok(params) => Ok(QNet { params }),
             Err(e) => Err(match e {
                 NnWeightsError::Io { source, .. } => WeightsError::Unreadable(source.to_string()),
                 NnWeightsError::Format { reason, .. } => WeightsError::Unreadable(reason),

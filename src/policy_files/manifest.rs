@@ -8,7 +8,7 @@ use super::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::read_regular_file;
-use crate::nn::safetensors_io::{from_safetensors_bytes, to_safetensors_bytes};
+use crate::nn::safetensors_io::to_safetensors_bytes;
 use crate::nn::{QNet, QNetConfig};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -678,17 +678,17 @@ impl Manifest {
         self.qnet_from_bytes(dir, index, &bytes)
     }
 
-    /// Build net `index`'s Q-net from its checked bytes.
+    /// Build net `index`'s Q-net from its bytes, checked against its entry (the bytes may come
+    /// from elsewhere than [`Self::read_net`], e.g. a [`VerifiedAgent`] built by a caller).
     fn qnet_from_bytes(&self, dir: &Path, index: usize, bytes: &[u8]) -> Result<QNet, PolicyError> {
         let entry = &self.nets[index];
-        let path = dir.join(&entry.file);
-        let params = from_safetensors_bytes(bytes, entry.qnet_config(), &path).map_err(|e| {
-            PolicyError::Io {
-                path: path.clone(),
-                message: e.to_string(),
-            }
-        })?;
-        Ok(QNet { params })
+        entry
+            .architecture
+            .qnet(bytes, entry.input, entry.output)
+            .map_err(|source| PolicyError::Weights {
+                path: dir.join(&entry.file),
+                source,
+            })
     }
 
     /// The index in `nets` of agent `agent`'s decentralized Q-net: the net a robot runs.
