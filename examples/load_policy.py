@@ -49,14 +49,23 @@ def main():
     parser.add_argument("--obs", type=float, nargs="+", action="append", required=True)
     args = parser.parse_args()
 
-    manifest = json.loads((args.policy / "manifest.json").read_text())
-    entry = manifest["agents"][args.agent]
-    path = args.policy / entry["weights"]
+    if (args.policy / "policy.json").exists():
+        # format_version 2: the agent's layout in "agents", its net among "nets".
+        description = json.loads((args.policy / "policy.json").read_text())
+        entry = description["agents"][args.agent]
+        net_entry = next(n for n in description["nets"] if n["kind"] == "q"
+                         and n["role"] == "dec" and n.get("agent") == args.agent)
+        weights, sha256, arch = net_entry["file"], net_entry["sha256"], net_entry["architecture"]
+    else:
+        # An export from before format_version 2: manifest.json, one entry per agent.
+        description = json.loads((args.policy / "manifest.json").read_text())
+        entry = description["agents"][args.agent]
+        weights, sha256, arch = entry["weights"], entry["sha256"], description["architecture"]
+    path = args.policy / weights
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
-    if digest != entry["sha256"]:
-        raise SystemExit(f"{path}: SHA-256 {digest} differs from the manifest's {entry['sha256']}")
+    if digest != sha256:
+        raise SystemExit(f"{path}: SHA-256 {digest} differs from the description's {sha256}")
 
-    arch = manifest["architecture"]
     net = DDRQN(entry["obs_size"], entry["n_actions"], arch["mlp_layer_size"],
                 arch["rnn_h_size"], arch["leaky_relu_slope"])
     net.load_state_dict(load_file(str(path)), strict=True)

@@ -213,7 +213,9 @@ def main():
     parser.add_argument("--check-diagnostics", action="store_true")
     args = parser.parse_args(rospy.myargv()[1:])
     policy = os.path.abspath(args.policy)
-    with open(os.path.join(policy, "manifest.json")) as f:
+    # policy.json since format_version 2; manifest.json in exports written before.
+    name = "policy.json" if os.path.exists(os.path.join(policy, "policy.json")) else "manifest.json"
+    with open(os.path.join(policy, name)) as f:
         agents = json.load(f)["agents"]
 
     rospy.init_node("domain", anonymous=True)

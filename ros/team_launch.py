@@ -44,11 +44,14 @@ def main():
     for path in (policy, os.path.abspath(args.macdec)):
         if any(c.isspace() for c in path):
             sys.exit("team_launch.py: paths with spaces cannot go into node args: %r" % path)
+    # policy.json since format_version 2; manifest.json in exports written before. Both list
+    # the agents' layouts under "agents".
+    name = "policy.json" if os.path.exists(os.path.join(policy, "policy.json")) else "manifest.json"
     try:
-        with open(os.path.join(policy, "manifest.json")) as f:
+        with open(os.path.join(policy, name)) as f:
             agents = json.load(f)["agents"]
     except (OSError, ValueError, KeyError) as e:
-        sys.exit("team_launch.py: reading %s/manifest.json: %s" % (policy, e))
+        sys.exit("team_launch.py: reading %s/%s: %s" % (policy, name, e))
     macdec = os.path.abspath(args.macdec) if os.sep in args.macdec else args.macdec
     sys.stdout.write(launch_xml(policy, macdec, args.namespace, agents))
 

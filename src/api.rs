@@ -12,16 +12,16 @@ use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::algos::training_loop::{Advance, EvalPoint, TrainError};
 use crate::deploy::export::{export_nets, ExportError};
-use crate::deploy::manifest::{Manifest, RunInfo};
-use crate::deploy::policy_env::PolicyEnv;
 use crate::envs::{EnvError, MacroEnv};
 use crate::experiment::config::validate;
 use crate::experiment::run_settings::RunSettings;
 use crate::experiment::train_run::run_rngs;
 use crate::nn::QNet;
+use crate::policy_files::policy_env::PolicyEnv;
+use crate::policy_files::{Manifest, RunInfo};
 use std::path::Path;
 
-/// The `experiment` an exported library policy names in its manifest's `run`.
+/// The `experiment` an exported library policy names in its `policy.json`.
 pub const LIBRARY_EXPERIMENT: &str = "library";
 
 /// Why [`train`] refused or stopped.
@@ -104,7 +104,7 @@ pub fn train_policy<E: MacroEnv>(
 }
 
 impl TrainedPolicy {
-    /// Write the decentralized nets as an exported policy directory `out` (`manifest.json` and
+    /// Write the decentralized nets as an exported policy directory `out` (`policy.json` and
     /// `agent-<i>.safetensors`) that `macdec robot --policy OUT --agent I` serves. The layout
     /// (observation sizes and names, macro-action names) comes from `env` through its
     /// [`MacroEnv`] methods; `domain` names it: [`PolicyEnv::custom`] for a domain of your own
@@ -118,7 +118,7 @@ impl TrainedPolicy {
         domain: PolicyEnv,
     ) -> Result<Manifest, ExportError> {
         // A built-in domain is recorded as a run's config.toml records it; a custom one by the
-        // manifest's `env` alone.
+        // description's `env` alone.
         let config = match &domain {
             PolicyEnv::BuiltIn(spec) => serde_json::to_value(RunSettings {
                 env: spec.clone(),
@@ -182,8 +182,8 @@ mod tests {
 
     #[test]
     fn an_exported_library_policy_holds_the_trained_nets_for_either_kind_of_domain() {
-        use crate::deploy::manifest::load_agent;
         use crate::deploy::qnet_policy::load_net;
+        use crate::policy_files::load_agent;
         let c = short(Method::Our1);
         let spec = spec();
         let trained = train_policy(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();

@@ -21,6 +21,7 @@ pub mod experiment;
 pub mod files;
 pub mod nn;
 pub mod plot;
+pub mod policy_files;
 pub mod render;
 
 pub use algos::any_loop::AnyLoop;

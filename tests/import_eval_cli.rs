@@ -52,7 +52,7 @@ fn imported_policies_evaluate_exactly_as_deployed_on_robot_processes() {
         );
         let (manifest, _) = load_all(&policy).unwrap();
         assert_eq!(manifest.env, env);
-        assert_eq!(manifest.architecture, arch);
+        assert!(manifest.nets.iter().all(|n| n.architecture == arch));
         assert_eq!(manifest.run.method, "imported");
         assert_eq!(
             manifest.run.config["files"][0]["file"],

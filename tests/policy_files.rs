@@ -101,14 +101,17 @@ fn policy_files_outlive_the_checkpoint_and_tolerate_added_and_missing_keys() {
     assert_eq!(policy.cen.as_ref(), trainer.saved_nets().cen);
     assert_eq!(
         (
-            policy.run.method.as_str(),
-            policy.run.seed,
-            policy.run.episodes_trained
+            policy.manifest.run.method.as_str(),
+            policy.manifest.run.seed,
+            policy.manifest.run.episodes_trained
         ),
         ("our1", 2, 40)
     );
-    assert_eq!(policy.run.evaluated, NetRole::Dec);
-    assert_eq!(read_policy_files(&cen).unwrap().run.evaluated, NetRole::Cen);
+    assert_eq!(policy.manifest.evaluated, NetRole::Dec);
+    assert_eq!(
+        read_policy_files(&cen).unwrap().manifest.evaluated,
+        NetRole::Cen
+    );
 
     // Export and render need no checkpoint.
     let gif_before = dir.path().join("before.gif");

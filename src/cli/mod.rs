@@ -85,7 +85,7 @@ enum Command {
     /// Write a Slurm job-array script (one task per run) to stdout.
     Slurm(SlurmArgs),
     /// Export a trained run's decentralized Q-nets for robots: one safetensors file per agent and
-    /// manifest.json (domain, layout, architecture, run, SHA-256 of each file).
+    /// policy.json (domain, layout, architectures, run, SHA-256 of each file).
     Export {
         /// A run directory: <results>/<experiment>/<method>/seed-<k>.
         #[arg(long)]
@@ -250,7 +250,7 @@ struct SlurmArgs {
 
 #[derive(clap::Args)]
 struct RobotArgs {
-    /// Exported policy directory (manifest.json and one safetensors file per agent).
+    /// Exported policy directory (policy.json and one safetensors file per agent).
     #[arg(long)]
     policy: PathBuf,
     /// Which agent this robot is (0-based).
@@ -854,9 +854,10 @@ fn bench_envs() -> Result<()> {
 /// `render --run` takes a run directory; an exported policy directory given instead is refused
 /// with what it is (a custom domain's by name: the binary cannot simulate it).
 fn refuse_policy_dir_as_run(dir: &Path) -> Result<()> {
-    use crate::deploy::manifest::{Manifest, MANIFEST_FILE};
+    use crate::policy_files::{legacy::MANIFEST_FILE_V1, Manifest, POLICY_FILE};
     let run_policy = dir.join(results_tree::POLICY_DIR);
-    if !dir.join(MANIFEST_FILE).is_file() || run_policy.exists() {
+    let described = [POLICY_FILE, MANIFEST_FILE_V1].map(|f| dir.join(f).is_file());
+    if !described.contains(&true) || run_policy.exists() {
         return Ok(());
     }
     let manifest = Manifest::read(dir).with_context(|| format!("reading {}", dir.display()))?;
@@ -1088,8 +1089,8 @@ fn import(args: ImportArgs) -> Result<()> {
         "imported {} agent(s) of {} (DDRQN M = {}, H = {}, discount {}) to {}",
         manifest.agents.len(),
         manifest.env.name(),
-        manifest.architecture.mlp_layer_size,
-        manifest.architecture.rnn_h_size,
+        manifest.nets[0].architecture.mlp_layer_size,
+        manifest.nets[0].architecture.rnn_h_size,
         manifest.discount,
         args.out.display()
     );

@@ -8,7 +8,7 @@
 //! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
 //! CLI's hidden `--mock` flag). [`remote`] drives robots that already run elsewhere (`macdec
 //! domain`, the ROS bridge of issue 14). Only [`export`] reads a run directory, and only its
-//! policy files ([`crate::experiment::policy_files`]), never its checkpoint; deploy imports nothing
+//! policy files ([`crate::policy_files`]), never its checkpoint; deploy imports nothing
 //! of the learner (`src/algos`). [`import`] builds the same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
 //! any policy directory's greedy episodes in-process, exactly as deployment does. A policy may be
 //! of a domain defined outside this binary ([`policy_env`]): robots serve it, the commands that
@@ -29,7 +29,7 @@ pub use serve::{deadline, line_reader, protocol, robot, server};
 
 pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};
 pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
-pub use manifest::{Manifest, ManifestError, VerifiedAgent};
+pub use manifest::{Manifest, VerifiedAgent};
 pub use policy_env::{CustomEnv, NotBuiltIn, PolicyEnv};
 pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};
 pub use server::{serve_tcp, spawn_server, Limits, RobotServer};

@@ -5,9 +5,9 @@ use crate::algos::value::acting::ActScratch;
 use crate::algos::value::evaluate::GreedyActor;
 use crate::algos::value::evaluate::GreedyPolicy;
 use crate::envs::MacroEnv;
-use crate::experiment::policy_files::{read_policy_files, NetRole, PolicyFilesError};
 use crate::experiment::seeds::{stream, Role};
 use crate::nn::QNet;
+use crate::policy_files::{read_policy_files, NetRole, PolicyError};
 use crate::render::{record_episode, write_gif, RenderError};
 use std::path::Path;
 
@@ -15,9 +15,11 @@ use std::path::Path;
 #[derive(Debug, thiserror::Error)]
 pub enum RolloutError {
     #[error(transparent)]
-    Policy(#[from] PolicyFilesError),
+    Policy(#[from] PolicyError),
     #[error(transparent)]
     Render(#[from] RenderError),
+    #[error("{0}: {1}")]
+    NotBuiltIn(String, crate::policy_files::NotBuiltIn),
     #[error("{0}: cannot build the run's environment: {1}")]
     Env(String, crate::envs::EnvError),
     #[error("{0}: the policy files' nets do not fit the domain: {1}")]
@@ -41,15 +43,23 @@ pub fn render_run(
     frame_ms: u32,
 ) -> Result<Vec<f64>, RolloutError> {
     let run = read_policy_files(run_dir)?;
-    let mut env = run
-        .run
+    let spec = run
+        .manifest
         .env
+        .built_in()
+        .map_err(|e| RolloutError::NotBuiltIn(run_dir.display().to_string(), e))?;
+    let mut env = spec
         .build()
         .map_err(|e| RolloutError::Env(run_dir.display().to_string(), e))?;
     let dec: Vec<&QNet> = run.dec.iter().collect();
-    let missing =
-        |what| RolloutError::NoNet(run_dir.display().to_string(), what, run.run.method.clone());
-    let policy = match (net.unwrap_or(run.run.evaluated), &run.cen) {
+    let missing = |what| {
+        RolloutError::NoNet(
+            run_dir.display().to_string(),
+            what,
+            run.manifest.run.method.clone(),
+        )
+    };
+    let policy = match (net.unwrap_or(run.manifest.evaluated), &run.cen) {
         (NetRole::Cen, Some(cen)) => GreedyPolicy::Cen(cen),
         (NetRole::Cen, None) => return Err(missing("centralized")),
         (NetRole::Dec, _) if dec.is_empty() => return Err(missing("decentralized")),
@@ -57,7 +67,7 @@ pub fn render_run(
     };
     check_sizes(&env, policy)
         .map_err(|m| RolloutError::NetSize(run_dir.display().to_string(), m))?;
-    let mut rng = stream(run.run.seed, Role::EvalEnv);
+    let mut rng = stream(run.manifest.run.seed, Role::EvalEnv);
     let mut scratch = ActScratch::new(&env);
     let mut frames = Vec::new();
     let mut returns = Vec::new();

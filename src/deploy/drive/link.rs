@@ -4,9 +4,9 @@
 //! directly (in-process greedy execution, the reference the protocol path must equal).
 
 use crate::deploy::line_reader::{LineEvent, LineReader};
-use crate::deploy::manifest::Manifest;
 use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
+use crate::policy_files::Manifest;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;

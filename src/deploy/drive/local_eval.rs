@@ -5,16 +5,16 @@
 
 use crate::deploy::driver::{run_episodes_with, DeployError, EpisodeTrace};
 use crate::deploy::link::LocalLink;
-use crate::deploy::manifest::{Manifest, ManifestError, VerifiedAgent};
 use crate::deploy::qnet_policy::{load_net, QNetPolicy};
 use crate::envs::EnvRng;
+use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};
 use std::sync::Arc;
 
 /// One in-process link per agent, each running that agent's verified net from a zero state.
 pub fn local_links(
     manifest: &Manifest,
     verified: &[VerifiedAgent],
-) -> Result<Vec<LocalLink<QNetPolicy>>, ManifestError> {
+) -> Result<Vec<LocalLink<QNetPolicy>>, PolicyError> {
     verified
         .iter()
         .map(|v| {
@@ -53,8 +53,7 @@ pub fn eval_policy(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::manifest::load_all;
-
+    use crate::policy_files::load_all;
     use rand::SeedableRng;
 
     #[test]

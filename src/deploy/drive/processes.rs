@@ -8,8 +8,8 @@
 
 use crate::deploy::driver::{run_episode, DeployError, EpisodeTrace};
 use crate::deploy::link::JsonLink;
-use crate::deploy::manifest::Manifest;
 use crate::envs::EnvRng;
+use crate::policy_files::Manifest;
 use serde::{Deserialize, Serialize};
 use std::io::{BufRead, BufReader, Read};
 use std::net::SocketAddr;

@@ -7,8 +7,8 @@
 
 use crate::deploy::driver::{run_episodes_with, DeployError, EpisodeTrace};
 use crate::deploy::link::JsonLink;
-use crate::deploy::manifest::Manifest;
 use crate::envs::EnvRng;
+use crate::policy_files::Manifest;
 use std::net::SocketAddr;
 use std::time::Duration;
 

@@ -1,35 +1,26 @@
-//! `macdec export`: turn a trained run directory into a policy directory (issue 7): each
-//! agent's decentralized Q-net from the run's policy files (issue 11; written with every
-//! checkpoint) as a safetensors file, and the manifest naming the domain, layout, architecture
-//! and run. Reads nothing of the trainer: no checkpoint, no learner types. [`export_nets`] writes
+//! `macdec export`: turn a trained run directory into a policy directory for robots (issue 7):
+//! the run's `policy/` files (issue 11; written with every checkpoint) in the same format,
+//! holding each agent's decentralized Q-net only (as `agent-<i>.safetensors`) beside the layout,
+//! domain and run. Reads nothing of the trainer: no checkpoint, no learner types. [`export_nets`] writes
 //! the same directory from plain nets and any [`MacroEnv`], for domains defined outside this
 //! binary (the library's `TrainedPolicy::export`).
 
-use crate::deploy::architecture::Architecture;
-use crate::deploy::manifest::{Manifest, ManifestError, RunInfo, MANIFEST_FILE};
-use crate::deploy::policy_env::PolicyEnv;
 use crate::envs::MacroEnv;
-use crate::experiment::policy_files::{read_description, NetRole, PolicyFilesError};
-use crate::nn::safetensors_io::to_safetensors_bytes;
 use crate::nn::QNet;
+use crate::policy_files::legacy::MANIFEST_FILE_V1;
+use crate::policy_files::{
+    read_policy_files, weights_file_name, AgentLayout, Manifest, NetFile, NetRole, PolicyEnv,
+    PolicyError, RunInfo, POLICY_FILE,
+};
 use std::path::{Path, PathBuf};
 
 /// Why a run could not be exported.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
     #[error(transparent)]
-    PolicyFiles(#[from] PolicyFilesError),
+    Policy(#[from] PolicyError),
     #[error("{dir}: the run trained {method}, which has no decentralized Q-nets to put on robots (export a dec-hddrqn, our1, our1-r or our2 run)")]
     NotDecentralized { dir: PathBuf, method: String },
-    #[error("{dir}: agent {agent}'s net has sizes {found}, expected {expected}")]
-    NetSize {
-        dir: PathBuf,
-        agent: usize,
-        found: String,
-        expected: String,
-    },
-    #[error(transparent)]
-    Manifest(#[from] ManifestError),
     #[error("{dir}: holds {file}, which is not part of a policy export; choose an empty or new --out directory")]
     NotAPolicyDir { dir: PathBuf, file: String },
     #[error("{path}: {message}")]
@@ -42,12 +33,14 @@ pub enum ExportError {
     },
 }
 
-/// Whether `name` is a file an export writes (or its atomic-write temp file).
+/// Whether `name` is a file an export writes or wrote before format_version 2 (or its
+/// atomic-write temp file).
 fn is_export_file(name: &str) -> bool {
     let name = name.strip_prefix('.').unwrap_or(name);
     let base = name.split(".safetensors").next().unwrap_or(name);
-    name == MANIFEST_FILE
-        || name.starts_with(&format!("{MANIFEST_FILE}."))
+    [POLICY_FILE, MANIFEST_FILE_V1]
+        .iter()
+        .any(|f| name == *f || name.starts_with(&format!("{f}.")))
         || (base.starts_with("agent-")
             && base[6..].chars().all(|c| c.is_ascii_digit())
             && name.contains(".safetensors"))
@@ -79,66 +72,27 @@ fn previous_export_files(out: &Path) -> Result<Vec<PathBuf>, ExportError> {
     Ok(files)
 }
 
-/// Export the run in `run_dir` (its `policy/` files, see [`crate::experiment::policy_files`];
-/// never its checkpoint) to the policy directory `out`. The nets are exported as the last
-/// checkpoint wrote them: a run still training exports its current nets (`episodes_trained` in
-/// the manifest says how far it got).
+/// Export the run in `run_dir` (its `policy/` files of any format version, see
+/// [`crate::policy_files`]; never its checkpoint) to the policy directory `out`: the same
+/// format, holding only each agent's decentralized Q-net. The nets are exported as the last
+/// checkpoint wrote them: a run still training exports its current nets (`episodes_trained`
+/// says how far it got).
 pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
     let previous = previous_export_files(out)?;
-    let description = read_description(run_dir)?;
-    let run = &description.run;
-    let dec: Vec<_> = description
-        .nets
-        .iter()
-        .filter(|n| n.role == NetRole::Dec)
-        .collect();
-    if dec.is_empty() {
+    let policy = read_policy_files(run_dir)?;
+    let m = policy.manifest;
+    if policy.dec.is_empty() {
         return Err(ExportError::NotDecentralized {
             dir: run_dir.to_path_buf(),
-            method: run.method.clone(),
+            method: m.run.method,
         });
     }
-    let (mlp, hidden) = (dec[0].sizes.mlp, dec[0].sizes.hidden);
-    let mut weights = Vec::with_capacity(dec.len());
-    for (agent, entry) in dec.iter().enumerate() {
-        if (entry.sizes.mlp, entry.sizes.hidden) != (mlp, hidden) {
-            return Err(ExportError::NetSize {
-                dir: run_dir.to_path_buf(),
-                agent,
-                found: format!("M = {}, H = {}", entry.sizes.mlp, entry.sizes.hidden),
-                expected: format!("M = {mlp}, H = {hidden} (agent 0's)"),
-            });
-        }
-        // nn's loader checks the checksum and every tensor; the export writes the checked net.
-        let net = description.load_net(run_dir, entry)?;
-        weights.push(to_safetensors_bytes(&net.params));
-    }
-    let info = RunInfo {
-        experiment: run.experiment.clone(),
-        method: run.method.clone(),
-        variant: run.variant.clone(),
-        seed: run.seed,
-        episodes_trained: run.episodes_trained,
-        config: run.config.clone(),
-    };
-    let domain = run
-        .env
-        .build()
-        .map_err(|e| ManifestError::Env(e.to_string()))?;
-    write_export(
-        out,
-        previous,
-        run.env.clone().into(),
-        &domain,
-        run.discount,
-        Architecture::ddrqn(mlp, hidden),
-        info,
-        &weights,
-    )
+    let nets: Vec<&QNet> = policy.dec.iter().collect();
+    write_export(out, previous, m.env, m.agents, m.discount, m.run, &nets)
 }
 
 /// Write agent i's decentralized net `nets[i]` of a policy trained on `domain` (any
-/// [`MacroEnv`]; its layout goes into the manifest) to the policy directory `out`, naming the
+/// [`MacroEnv`]; its layout goes into `policy.json`) to the policy directory `out`, naming the
 /// domain `env` (built-in, or [`PolicyEnv::custom`]). `out` must be new, empty or an earlier
 /// export, as for [`export_run`].
 pub fn export_nets(
@@ -163,52 +117,31 @@ pub fn export_nets(
             got: nets.len(),
         });
     }
-    let (mlp, hidden) = (nets[0].config().mlp, nets[0].config().hidden);
-    for (agent, net) in nets.iter().enumerate() {
-        let c = net.config();
-        if (c.mlp, c.hidden) != (mlp, hidden) {
-            return Err(ExportError::NetSize {
-                dir: out.to_path_buf(),
-                agent,
-                found: format!("M = {}, H = {}", c.mlp, c.hidden),
-                expected: format!("M = {mlp}, H = {hidden} (agent 0's)"),
-            });
-        }
-    }
-    let weights: Vec<Vec<u8>> = nets
-        .iter()
-        .map(|n| to_safetensors_bytes(&n.params))
-        .collect();
-    write_export(
-        out,
-        previous,
-        env,
-        domain,
-        discount,
-        Architecture::ddrqn(mlp, hidden),
-        run,
-        &weights,
-    )
+    let agents = AgentLayout::of_domain(domain);
+    write_export(out, previous, env, agents, discount, run, nets)
 }
 
-/// Write the policy directory and remove what an earlier export there (`previous`) left that
-/// the new manifest no longer names.
-#[allow(clippy::too_many_arguments)]
+/// Write the policy directory (agent i's net as `agent-<i>.safetensors`) and remove what an
+/// earlier export there (`previous`) left that the new description no longer names.
 fn write_export(
     out: &Path,
     previous: Vec<PathBuf>,
     env: PolicyEnv,
-    domain: &impl MacroEnv,
+    agents: Vec<AgentLayout>,
     discount: f64,
-    architecture: Architecture,
     run: RunInfo,
-    weights: &[Vec<u8>],
+    nets: &[&QNet],
 ) -> Result<Manifest, ExportError> {
-    let manifest =
-        Manifest::write_policy_for(out, env, domain, discount, architecture, run, weights)?;
-    // An earlier export with more agents would leave weight files the manifest no longer names.
-    let current: Vec<PathBuf> = std::iter::once(out.join(MANIFEST_FILE))
-        .chain(manifest.agents.iter().map(|a| out.join(&a.weights)))
+    let files: Vec<NetFile> = nets
+        .iter()
+        .enumerate()
+        .map(|(i, n)| NetFile::qnet(NetRole::Dec, Some(i), weights_file_name(i), n))
+        .collect();
+    let manifest = Manifest::write_new(out, env, agents, discount, NetRole::Dec, run, &files)?;
+    // An earlier export with more agents, or of format_version 1 (manifest.json), would leave
+    // files the new description no longer names.
+    let current: Vec<PathBuf> = std::iter::once(out.join(POLICY_FILE))
+        .chain(manifest.nets.iter().map(|n| out.join(&n.file)))
         .collect();
     for stale in previous.iter().filter(|p| !current.contains(p)) {
         std::fs::remove_file(stale).map_err(|e| ExportError::Io {
@@ -231,13 +164,14 @@ mod tests {
             .is_empty());
         assert!(previous_export_files(dir.path()).unwrap().is_empty());
         for f in [
+            "policy.json",
             "manifest.json",
             "agent-0.safetensors",
             "agent-2.safetensors",
         ] {
             std::fs::write(dir.path().join(f), b"x").unwrap();
         }
-        assert_eq!(previous_export_files(dir.path()).unwrap().len(), 3);
+        assert_eq!(previous_export_files(dir.path()).unwrap().len(), 4);
         std::fs::write(dir.path().join("notes.txt"), b"mine").unwrap();
         let err = previous_export_files(dir.path()).unwrap_err().to_string();
         assert!(err.contains("notes.txt"), "{err}");

@@ -7,11 +7,11 @@
 //! The reference names the LSTM `lstm` in `MA_dec_cen_hddrqn` (MacDec-MADDRQN, Our-1/Our-2) and
 //! `rnn` in `MA_hddrqn` (Dec-HDDRQN); both are accepted.
 
-use crate::deploy::architecture::Architecture;
-use crate::deploy::manifest::{sha256_hex, Manifest, ManifestError, RunInfo};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::nn::safetensors_io::{from_safetensors_bytes, to_safetensors_bytes};
 use crate::nn::QNetConfig;
+use crate::policy_files::architecture::Architecture;
+use crate::policy_files::{sha256_hex, Manifest, PolicyError, RunInfo};
 use safetensors::tensor::Dtype;
 use safetensors::SafeTensors;
 use serde::Serialize;
@@ -103,7 +103,7 @@ pub enum ImportError {
     #[error("environment: {0}")]
     Env(String),
     #[error(transparent)]
-    Manifest(#[from] ManifestError),
+    Policy(#[from] PolicyError),
 }
 
 /// Which name the file gave the LSTM.
@@ -405,14 +405,16 @@ pub fn reference_state_dict(
         Naming::Rnn => name.replacen(LSTM_PREFIX, RNN_PREFIX, 1),
         Naming::Lstm => name.to_string(),
     };
-    crate::deploy::architecture::synthetic_weights_named(arch, obs_len, n_actions, rename, value)
+    crate::policy_files::architecture::synthetic_weights_named(
+        arch, obs_len, n_actions, rename, value,
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::architecture::synthetic_weights;
-    use crate::deploy::manifest::load_all;
+    use crate::policy_files::architecture::synthetic_weights;
+    use crate::policy_files::load_all;
     use safetensors::tensor::TensorView;
 
     fn bp10() -> EnvSpec {
@@ -639,7 +641,7 @@ mod tests {
         let (manifest, verified) = load_all(&out).unwrap();
         assert_eq!(manifest, written);
         assert_eq!(manifest.discount, 0.98);
-        assert_eq!(manifest.architecture, arch);
+        assert!(manifest.nets.iter().all(|n| n.architecture == arch));
         assert_eq!(manifest.run.method, "imported");
         let files = &manifest.run.config["files"];
         assert_eq!(files[1]["file"], a1.display().to_string());
@@ -701,7 +703,10 @@ mod tests {
         };
         let m = import_policy(&request, &dir.path().join("p")).unwrap();
         assert_eq!(
-            (m.architecture.mlp_layer_size, m.architecture.rnn_h_size),
+            (
+                m.nets[2].architecture.mlp_layer_size,
+                m.nets[2].architecture.rnn_h_size
+            ),
             (32, 64)
         );
         // Agent files in the wrong order do not fit the agents' layouts (the Fetch robot differs).

@@ -3,10 +3,10 @@
 //! last reset, so any bug that loses, shares or wrongly advances a robot's hidden state changes
 //! its answers.
 
-use crate::deploy::architecture::{synthetic_weights, Architecture};
-use crate::deploy::manifest::{Manifest, ManifestError, RunInfo};
 use crate::deploy::AgentPolicy;
 use crate::envs::{EnvSpec, MacroEnv};
+use crate::policy_files::architecture::{synthetic_weights, Architecture};
+use crate::policy_files::{Manifest, PolicyError, RunInfo, POLICY_FILE};
 use std::path::Path;
 
 /// `state_k <- 0.5 state_k + b_k + sum_j w_kj obs_j + 2 ((calls (k + 1)) mod 5)`,
@@ -100,8 +100,11 @@ fn mock_run() -> RunInfo {
 }
 
 /// Placeholder weights (zeros) for every agent of `env`, in the mock architecture.
-fn mock_weights(env: EnvSpec) -> Result<Vec<Vec<u8>>, ManifestError> {
-    let built = env.build().map_err(|e| ManifestError::Env(e.to_string()))?;
+fn mock_weights(env: EnvSpec) -> Result<Vec<Vec<u8>>, PolicyError> {
+    let built = env.build().map_err(|e| PolicyError::Env {
+        path: POLICY_FILE.into(),
+        message: e.to_string(),
+    })?;
     let arch = mock_architecture();
     Ok((0..built.n_agents())
         .map(|i| {
@@ -115,7 +118,7 @@ fn mock_weights(env: EnvSpec) -> Result<Vec<Vec<u8>>, ManifestError> {
 /// Write a complete, verifiable policy directory for `env` with placeholder weights (zeros):
 /// `macdec robot --mock` and `macdec deploy --mock` load it, check it, and run [`MockPolicy`]
 /// instead of the weights.
-pub fn write_mock_policy(dir: &Path, env: EnvSpec) -> Result<Manifest, ManifestError> {
+pub fn write_mock_policy(dir: &Path, env: EnvSpec) -> Result<Manifest, PolicyError> {
     let weights = mock_weights(env.clone())?;
     Manifest::write_policy(dir, env, 0.98, mock_architecture(), mock_run(), &weights)
 }
@@ -174,7 +177,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let env = crate::envs::warehouse::spec(150, 0.0);
         let written = write_mock_policy(dir.path(), env.clone()).unwrap();
-        let (read, agents) = crate::deploy::manifest::load_all(dir.path()).unwrap();
+        let (read, agents) = crate::policy_files::load_all(dir.path()).unwrap();
         assert_eq!(read, written);
         assert_eq!(agents.len(), 3);
         assert_eq!(mock_manifest(env.clone()), written);

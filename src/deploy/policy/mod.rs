@@ -1,12 +1,12 @@
-//! The exported policy directory: its manifest and checks ([`manifest`]), the nets' architecture
-//! ([`architecture`]), writing it from a run ([`export`]) or from the reference's PyTorch files
-//! ([`import`]), the domain it names ([`policy_env`]), the Q-net that acts from it
-//! ([`qnet_policy`]) and a mock policy for tests ([`mock`]).
+//! Policies for robots: writing a policy directory (the one format of [`crate::policy_files`])
+//! from a run ([`export`]) or from the reference's PyTorch files ([`import`]), the Q-net that acts
+//! from it ([`qnet_policy`]) and a mock policy for tests ([`mock`]). [`manifest`],
+//! [`architecture`] and [`policy_env`] re-export the format's parts under their older paths.
 
-pub mod architecture;
 pub mod export;
 pub mod import;
 pub mod manifest;
 pub mod mock;
-pub mod policy_env;
 pub mod qnet_policy;
+
+pub use crate::policy_files::{architecture, policy_env};

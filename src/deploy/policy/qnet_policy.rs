@@ -1,12 +1,10 @@
 //! The real policy behind a robot: one exported agent's recurrent Q-net and its LSTM state,
 //! stepped with the same no-tape acting forward greedy evaluation uses (`QNet::act_step`).
 
-use crate::deploy::manifest::{Manifest, ManifestError, VerifiedAgent};
 use crate::deploy::server::PolicyFactory;
 use crate::deploy::AgentPolicy;
-use crate::nn::safetensors_io::from_safetensors_bytes;
-use crate::nn::{LstmState, QNet, QNetConfig};
-use std::path::Path;
+use crate::nn::{LstmState, QNet};
+use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};
 use std::sync::Arc;
 
 /// A Q-net shared between connections, with this connection's hidden state.
@@ -52,18 +50,9 @@ impl AgentPolicy for QNetPolicy {
     }
 }
 
-/// Build agent `verified.index`'s net from its verified weight bytes, sized by the manifest.
-pub fn load_net(manifest: &Manifest, verified: &VerifiedAgent) -> Result<QNet, ManifestError> {
-    let entry = &manifest.agents[verified.index];
-    let cfg = QNetConfig {
-        input: entry.obs_size,
-        mlp: manifest.architecture.mlp_layer_size,
-        hidden: manifest.architecture.rnn_h_size,
-        output: entry.n_actions,
-    };
-    let params = from_safetensors_bytes(&verified.weights, cfg, Path::new(&entry.weights))
-        .map_err(|e| ManifestError::Net(e.to_string()))?;
-    Ok(QNet { params })
+/// Build agent `verified.index`'s net from its verified weight bytes, sized by its net entry.
+pub fn load_net(manifest: &Manifest, verified: &VerifiedAgent) -> Result<QNet, PolicyError> {
+    manifest.agent_qnet(verified)
 }
 
 /// A factory giving each connection the same net with a fresh zero state.
@@ -75,10 +64,10 @@ pub fn qnet_factory(net: QNet) -> PolicyFactory {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::architecture::Architecture;
-    use crate::deploy::manifest::{load_agent, RunInfo};
-
     use crate::nn::safetensors_io::to_safetensors_bytes;
+    use crate::nn::QNetConfig;
+    use crate::policy_files::architecture::Architecture;
+    use crate::policy_files::{load_agent, RunInfo};
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 

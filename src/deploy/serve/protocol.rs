@@ -14,7 +14,7 @@
 //!
 //! Any bad request gets `{"error": "..."}` naming what was wrong and leaves the state unchanged.
 
-use crate::deploy::manifest::Manifest;
+use crate::policy_files::Manifest;
 use serde::{Deserialize, Serialize};
 
 /// A validated request.

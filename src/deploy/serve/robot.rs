@@ -3,9 +3,9 @@
 //! any byte stream (stdin/stdout, one TCP connection) with the bounded line reader.
 
 use crate::deploy::line_reader::{LineEvent, LineReader};
-use crate::deploy::manifest::Manifest;
 use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
+use crate::policy_files::Manifest;
 use std::io::{self, BufRead, Write};
 use std::sync::Arc;
 

@@ -10,8 +10,8 @@ pub const CONFIG: &str = "config.toml";
 pub use crate::experiment::metrics::{METRICS_FILE, METRICS_FILE_GZ};
 /// The whole training loop, for resuming only (never committed).
 pub const CHECKPOINT: &str = "checkpoint.bin";
-/// The run's nets as policy files, see [`crate::experiment::policy_files`].
-pub const POLICY_DIR: &str = "policy";
+/// The run's nets as policy files, see [`crate::policy_files`].
+pub use crate::policy_files::POLICY_DIR;
 /// Written last, once a run has trained all its episodes.
 pub const FINISHED: &str = "finished";
 /// The file a training process holds an exclusive lock on while it trains a run.

@@ -4,7 +4,7 @@
 //! method and seed), `metrics.csv` (see [`crate::experiment::metrics`]), `checkpoint.bin` (the
 //! whole trainer: nets, Adam moments, replay, RNG states, counters; for resuming only),
 //! `policy/` (the nets as safetensors plus `policy.json`, written with every checkpoint; see
-//! [`crate::experiment::policy_files`]), `finished` once done, and `.lock`, which the training
+//! [`crate::policy_files`]), `finished` once done, and `.lock`, which the training
 //! process holds locked.
 //! Every file is written atomically; a killed run resumes from its last checkpoint and ends with
 //! the metrics an uninterrupted run would have written.
@@ -15,15 +15,13 @@ use crate::algos::training_loop::{Advance, RunRngs, TrainError};
 use crate::experiment::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::config::RunSpec;
 use crate::experiment::metrics::{self, METRICS_FILE};
-use crate::experiment::policy_files::{
-    write_policy_files, NetRole, PolicyFilesError, RunPolicyInfo,
-};
 use crate::experiment::provenance::Provenance;
 use crate::experiment::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
 use crate::experiment::run_settings::RunSettings;
 use crate::experiment::runner::{Progress, RunEnd};
 use crate::experiment::seeds::{stream, Role};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
+use crate::policy_files::{write_policy_files, AgentLayout, NetRole, PolicyError, RunInfo};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -213,7 +211,8 @@ pub enum RunError {
     #[error(transparent)]
     Train(#[from] TrainError),
     #[error(transparent)]
-    PolicyFiles(#[from] PolicyFilesError),
+    /// Boxed: the policy-file error is large, and a run error travels through every job.
+    PolicyFiles(#[from] Box<PolicyError>),
 }
 
 fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
@@ -290,7 +289,7 @@ fn save_checkpoint(
     write_atomic(path, &bytes).map_err(|e| io(path, e))
 }
 
-/// Write the trainer's nets as the run's policy files (see [`crate::experiment::policy_files`]).
+/// Write the trainer's nets as the run's policy files (see [`crate::policy_files`]).
 fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<(), RunError> {
     let nets = trainer.saved_nets();
     let evaluated = if nets.evaluated_is_centralized {
@@ -299,22 +298,31 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<()
         NetRole::Dec
     };
     let config = trainer.config();
-    let info = RunPolicyInfo {
+    let run = RunInfo {
         experiment: spec.experiment.clone(),
         method: trainer.method().name().to_string(),
         variant: spec.variant.clone(),
         seed: trainer.seed(),
         episodes_trained: trainer.episodes(),
-        env: spec.env.clone(),
-        discount: config.discount,
-        evaluated,
         config: serde_json::to_value(RunSettings {
             env: spec.env.clone(),
             config: config.clone(),
         })
         .map_err(|e| io(dir, e))?,
     };
-    write_policy_files(dir, info, &nets.dec, nets.cen)?;
+    // The layout robots and `render` check the nets against; building the domain draws nothing.
+    let domain = spec.env.build().map_err(|e| io(dir, e))?;
+    write_policy_files(
+        dir,
+        spec.env.clone().into(),
+        AgentLayout::of_domain(&domain),
+        config.discount,
+        evaluated,
+        run,
+        &nets.dec,
+        nets.cen,
+    )
+    .map_err(Box::new)?;
     Ok(())
 }
 

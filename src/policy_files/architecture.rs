@@ -1,6 +1,8 @@
-//! The decentralized Q-net's architecture as an exported file describes it: the reference's
-//! `DDRQN` module (spec `algorithms.md` 2), whose PyTorch `state_dict` names and shapes the
-//! exported safetensors files keep, so the weights load into the reference's module unchanged.
+//! A net's architecture as a policy file describes it: today the reference's `DDRQN` module (spec
+//! `algorithms.md` 2), whose PyTorch `state_dict` names and shapes the safetensors files keep, so
+//! the weights load into the reference's module unchanged. Every net entry of `policy.json`
+//! carries one ([`crate::policy_files::NetEntry`]), so a net of another architecture (a GRU
+//! actor, a centralized critic) is a new `kind` here, not a new file format.
 //!
 //! ```text
 //! obs (input) -> fc1 -> leaky_relu(0.01) -> fc2 -> leaky_relu -> LSTM(H, H) -> fc3 -> leaky_relu
@@ -8,7 +10,7 @@
 //! ```
 
 use crate::nn::safetensors_io::{from_safetensors_bytes, WeightsError as NnWeightsError};
-use crate::nn::{QNetConfig, TENSOR_NAMES};
+use crate::nn::{QNet, QNetConfig, TENSOR_NAMES};
 use safetensors::Dtype;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -20,8 +22,8 @@ pub const DDRQN: &str = "ddrqn";
 /// Negative slope of every leaky ReLU (PyTorch's `F.leaky_relu` default, used by the reference).
 pub const LEAKY_RELU_SLOPE: f32 = 0.01;
 
-/// Layer sizes of an exported net, shared by every agent of a policy (the observation and action
-/// counts are per agent, in [`crate::deploy::manifest::AgentEntry`]).
+/// Hidden-layer sizes of one net (its input and output lengths are in its
+/// [`crate::policy_files::NetEntry`], since they differ between an agent's net and the joint one).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Architecture {
@@ -75,12 +77,22 @@ impl Architecture {
         obs_len: usize,
         n_actions: usize,
     ) -> Result<(), WeightsError> {
+        self.qnet(bytes, obs_len, n_actions).map(|_| ())
+    }
+
+    /// The Q-net a safetensors file holds, checked as [`Self::check_weights`] describes.
+    pub fn qnet(
+        &self,
+        bytes: &[u8],
+        obs_len: usize,
+        n_actions: usize,
+    ) -> Result<QNet, WeightsError> {
         if self.kind != DDRQN {
             return Err(WeightsError::UnknownKind(self.kind.clone()));
         }
         let cfg = self.qnet_config(obs_len, n_actions);
         match from_safetensors_bytes(bytes, cfg, Path::new("")) {
-            Ok(_) => Ok(()),
+            Ok(params) => Ok(QNet { params }),
             Err(e) => Err(match e {
                 NnWeightsError::Io { source, .. } => WeightsError::Unreadable(source.to_string()),
                 NnWeightsError::Format { reason, .. } => WeightsError::Unreadable(reason),
