@@ -67,6 +67,25 @@ impl EnvSpec {
         Ok(EnvSpec { domain, keys })
     }
 
+    /// `domain` with the keys of `table` that are its own ([`DomainEntry::keys`] of an empty
+    /// table lists them); the table may hold anything else too (a config's hyperparameters).
+    pub fn from_keys_in(
+        domain: &'static dyn DomainEntry,
+        table: &toml::Table,
+    ) -> Result<EnvSpec, SpecError> {
+        let key_error = |source| SpecError::Key {
+            domain: domain.name(),
+            source,
+        };
+        let own = domain.keys(&toml::Table::new()).map_err(key_error)?;
+        let given: toml::Table = table
+            .iter()
+            .filter(|(k, _)| own.contains_key(*k))
+            .map(|(k, v)| (k.clone(), v.clone()))
+            .collect();
+        Self::of(domain, &given)
+    }
+
     /// The named domain at its default keys (see [`Self::new`]); panics on an unknown name, so
     /// only for names known to be built in.
     pub fn built_in(name: &str) -> EnvSpec {

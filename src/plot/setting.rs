@@ -43,17 +43,7 @@ impl EnvSetting {
         };
         let env = match registry::find(&name) {
             None => Err(name),
-            Some(domain) => {
-                let known = domain
-                    .keys(&toml::Table::new())
-                    .map_err(|e| e.to_string())?;
-                // Movement noise decides neither the optimum nor the title.
-                let given: toml::Table = table
-                    .into_iter()
-                    .filter(|(k, _)| known.contains_key(k) && k != "tb_m_noisy")
-                    .collect();
-                Ok(EnvSpec::of(domain, &given).map_err(|e| e.to_string())?)
-            }
+            Some(domain) => Ok(EnvSpec::from_keys_in(domain, &table).map_err(|e| e.to_string())?),
         };
         Ok(EnvSetting { env, discount })
     }

@@ -518,15 +518,7 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
             ),
         )
     })?;
-    let domain_keys = domain
-        .keys(&toml::Table::new())
-        .map_err(|e| bad(&e.key, e.message))?;
-    let given: toml::Table = point
-        .iter()
-        .filter(|(k, _)| domain_keys.contains_key(*k))
-        .map(|(k, v)| (k.clone(), v.clone()))
-        .collect();
-    let env = EnvSpec::of(domain, &given).map_err(|e| bad(e.key(), e.to_string()))?;
+    let env = EnvSpec::from_keys_in(domain, point).map_err(|e| bad(e.key(), e.to_string()))?;
     let defaults = RunSettings::paper(env, method);
     let mut table = toml::Table::try_from(&defaults).expect("RunSettings serializes to a table");
     for (key, value) in point {

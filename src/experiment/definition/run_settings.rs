@@ -51,16 +51,10 @@ impl RunSettings {
                 crate::envs::registry::names_and_tags()
             )
         })?;
-        let known = domain
-            .keys(&toml::Table::new())
-            .map_err(|e| e.to_string())?;
-        let mut given = toml::Table::new();
-        for key in known.keys() {
-            if let Some(value) = table.remove(key) {
-                given.insert(key.clone(), value);
-            }
+        let env = EnvSpec::from_keys_in(domain, &table).map_err(|e| e.to_string())?;
+        for key in env.keys().keys() {
+            table.remove(key);
         }
-        let env = EnvSpec::of(domain, &given).map_err(|e| e.to_string())?;
         let config = RunConfig::deserialize(toml::Value::Table(table))
             .map_err(|e| e.message().to_string())?;
         Ok(RunSettings { env, config })
