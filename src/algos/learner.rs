@@ -13,7 +13,7 @@
 
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
-use crate::algos::training_loop::TrainError;
+use crate::algos::train_error::TrainError;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::QNet;
 use rand_chacha::ChaCha8Rng;

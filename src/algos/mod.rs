@@ -14,5 +14,6 @@ pub mod any_loop;
 pub mod hyper;
 pub mod learner;
 pub mod method;
+pub mod train_error;
 pub mod training_loop;
 pub mod value;

@@ -8,8 +8,6 @@
 use crate::algos::hyper::RunConfig;
 use crate::algos::learner::{Learner, LearnerRngs, SavedNets, Schedule};
 use crate::algos::method::Method;
-use crate::algos::value::update::UpdateError;
-use crate::algos::value::ReplayError;
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -27,29 +25,7 @@ pub struct RunRngs {
     pub eval_env: EnvRng,
 }
 
-/// Why training stopped early.
-#[derive(Debug, thiserror::Error)]
-pub enum TrainError {
-    #[error(transparent)]
-    Env(#[from] EnvError),
-    #[error(transparent)]
-    Replay(#[from] ReplayError),
-    #[error(transparent)]
-    Update(#[from] UpdateError),
-    #[error("{method} seed {seed}: non-finite {what} at episode {episode}")]
-    NonFinite {
-        method: Method,
-        seed: u64,
-        what: &'static str,
-        episode: u64,
-    },
-    #[error("{method} asks for {asked} training lanes; runs have random streams for {available}")]
-    TooManyLanes {
-        method: Method,
-        asked: usize,
-        available: usize,
-    },
-}
+pub use super::train_error::TrainError;
 
 /// One evaluation point, as the metrics file records it (one `metrics.csv` row).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

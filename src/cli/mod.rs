@@ -407,7 +407,7 @@ fn parse_net_role(text: &str) -> Result<NetRole, String> {
 /// }
 /// ```
 pub fn main_with(
-    domains: &[&'static dyn crate::envs::domain::DomainEntry],
+    domains: &[&'static dyn crate::envs::registry::DomainEntry],
 ) -> std::process::ExitCode {
     for domain in domains {
         if let Err(e) = crate::envs::registry::register(*domain) {

@@ -1,19 +1,31 @@
-//! The domains built into macdec: **the one list** a new built-in domain joins. Each line names
-//! the domain's [`AnyEnv`] variant, its environment type and its [`super::domain::Domain`]; the
-//! macro below turns the list into [`AnyEnv`] (one variant per domain, plus [`AnyEnv::Custom`]
-//! for a user's own), its [`MacroEnv`] forwarding, and [`BUILT_IN`] for the registry.
+//! The domains built into macdec: **the one list** a new built-in domain joins
+//! ([`built_in_domains`]). Each line names the domain's [`AnyEnv`] variant, its environment type
+//! and its [`super::domain::Domain`]; the list becomes [`AnyEnv`] (one variant per domain, plus
+//! [`AnyEnv::Custom`] for a user's own) and its [`MacroEnv`] forwarding here, and the registry's
+//! built-in entries in [`super::registry`].
 //!
 //! Everything else about a domain lives in its folder (`src/envs/<domain>/`): its dynamics, its
 //! config keys and their defaults, its paper settings, its optimum, its limits and its drawing.
 
-use super::box_pushing::{BoxPushing, BoxPushingDomain};
-use super::custom_env::CustomEnv;
-use super::domain::DomainEntry;
-use super::warehouse::{Warehouse, WarehouseDomain};
+use std::any::Any;
+
+use super::custom_env::{CustomEnv, ErasedEnv};
 use super::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
 
-/// Generate [`AnyEnv`], its `MacroEnv` forwarding and [`BUILT_IN`] from the list of domains.
+/// The list of built-in domains, handed to the macro `$then` (which generates what the list
+/// decides).
 macro_rules! built_in_domains {
+    ($then:ident) => {
+        $then! {
+            BoxPushing(crate::envs::box_pushing::BoxPushing) = crate::envs::box_pushing::BoxPushingDomain,
+            Warehouse(crate::envs::warehouse::Warehouse) = crate::envs::warehouse::WarehouseDomain,
+        }
+    };
+}
+pub(crate) use built_in_domains;
+
+/// Generate [`AnyEnv`], [`AnyEnv::hold`] and the forwarding macro from the list.
+macro_rules! any_env {
     ($($variant:ident($env:ty) = $domain:expr,)+) => {
         /// Any built environment: a built-in domain's, by `match` (no dynamic dispatch on the hot
         /// path, `Clone`, and a checkpoint's bincode names the variant), or a user's own behind
@@ -30,8 +42,20 @@ macro_rules! built_in_domains {
             Custom(CustomEnv),
         }
 
-        /// The built-in domains, in list order.
-        pub static BUILT_IN: &[&'static dyn DomainEntry] = &[$(&$domain,)+];
+        impl AnyEnv {
+            /// `env` of the domain named `domain` as the pipeline holds it: a built-in
+            /// environment type in its own variant, any other behind [`AnyEnv::Custom`].
+            pub fn hold<E: ErasedEnv + 'static>(domain: &'static str, env: E) -> AnyEnv {
+                let mut slot = Some(env);
+                let any: &mut dyn Any = &mut slot;
+                $(
+                    if let Some(built_in) = any.downcast_mut::<Option<$env>>() {
+                        return AnyEnv::$variant(built_in.take().expect("just filled"));
+                    }
+                )+
+                AnyEnv::Custom(CustomEnv::new(domain, slot.take().expect("just filled")))
+            }
+        }
 
         /// Forward a method call to the variant's environment.
         macro_rules! dispatch {
@@ -44,11 +68,7 @@ macro_rules! built_in_domains {
         }
     };
 }
-
-built_in_domains! {
-    BoxPushing(BoxPushing) = BoxPushingDomain,
-    Warehouse(Warehouse) = WarehouseDomain,
-}
+built_in_domains!(any_env);
 
 impl MacroEnv for AnyEnv {
     fn n_agents(&self) -> usize {

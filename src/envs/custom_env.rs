@@ -1,12 +1,12 @@
 //! An environment of a domain that is not built in (a user's own [`super::domain::Domain`]), held
 //! behind a trait object so the pipeline can keep it in an [`super::AnyEnv`], clone it and save it
-//! in a checkpoint. Saving writes the domain's name and the environment's bincode; loading finds
-//! the domain in the [`super::registry`] and asks it to rebuild the environment, so a checkpoint
+//! in a checkpoint. Saving writes the domain's name and the environment's bincode; loading (in
+//! [`super::registry`]) finds the domain and asks it to rebuild the environment, so a checkpoint
 //! of a domain the running binary does not have is refused by name.
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Deserialize, Serialize, Serializer};
 
-use super::{registry, EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
+use super::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
 
 /// What [`CustomEnv`] asks of an environment besides [`MacroEnv`]: to be cloned and saved.
 /// Implemented for every `MacroEnv + Clone + Serialize + Send`.
@@ -62,42 +62,22 @@ impl std::fmt::Debug for CustomEnv {
     }
 }
 
-/// The saved form: the domain's name, then the environment's bytes.
+/// The saved form: the domain's name, then the environment's bytes (read back by the
+/// registry, which finds the domain: `impl Deserialize for CustomEnv` is in `registry.rs`).
 #[derive(Serialize, Deserialize)]
-struct Saved {
-    domain: String,
-    env: Vec<u8>,
+pub(crate) struct SavedEnv {
+    pub(crate) domain: String,
+    pub(crate) env: Vec<u8>,
 }
 
 impl Serialize for CustomEnv {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let env = self.env.save().map_err(serde::ser::Error::custom)?;
-        Saved {
+        SavedEnv {
             domain: self.domain.to_string(),
             env,
         }
         .serialize(s)
-    }
-}
-
-impl<'de> Deserialize<'de> for CustomEnv {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use serde::de::Error;
-        let saved = Saved::deserialize(d)?;
-        let domain = registry::find(&saved.domain).ok_or_else(|| {
-            D::Error::custom(format!(
-                "the saved environment is of domain `{}`, which this binary does not have (it has {})",
-                saved.domain,
-                registry::names_and_tags()
-            ))
-        })?;
-        match domain.restore(&saved.env).map_err(D::Error::custom)? {
-            super::AnyEnv::Custom(env) => Ok(env),
-            _ => Err(D::Error::custom(format!(
-                "domain `{}` is built in; its environment is not saved as a custom one",
-                saved.domain
-            ))),
-        }
     }
 }
 

@@ -6,8 +6,8 @@
 //! `src/envs/warehouse/domain.rs`) or in a user's own crate, and every command works on it:
 //! configs select it by `env_name`, runs record its keys in `config.toml`, checkpoints hold its
 //! environment, plots ask it for its optimum and policies name it. The pipeline holds domains as
-//! [`DomainEntry`] trait objects (every [`Domain`] is one), found by name in
-//! [`crate::envs::registry`].
+//! [`crate::envs::registry::DomainEntry`] trait objects (every [`Domain`] is one), found by name
+//! in [`crate::envs::registry`].
 //!
 //! Keys are TOML values so that one code path reads, checks, records and compares them for every
 //! domain; a domain reads them into its own typed parameters with [`key_usize`] and [`key_f64`].
@@ -15,7 +15,7 @@
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-use super::{custom_env::CustomEnv, AnyEnv, MacroEnv};
+use super::MacroEnv;
 
 /// The config key every domain has: the horizon in primitive steps (the references' name).
 pub const HORIZON_KEY: &str = "env_terminate_step";
@@ -154,77 +154,6 @@ pub trait Domain: Send + Sync + 'static {
             return Err(KeyError::new(k, format!("{} has no such key", self.name())));
         }
         self.keys(&given)
-    }
-
-    /// The built environment as the pipeline holds it. Built-in domains return their own
-    /// [`AnyEnv`] variant; any other domain is held behind [`AnyEnv::Custom`] (the default).
-    fn hold(&self, env: Self::Env) -> AnyEnv {
-        AnyEnv::Custom(CustomEnv::new(self.name(), env))
-    }
-}
-
-/// A [`Domain`] with its environment type erased, as the registry and [`super::EnvSpec`] hold
-/// it. Every [`Domain`] is one; there is nothing to implement.
-pub trait DomainEntry: Send + Sync + 'static {
-    /// See [`Domain::name`].
-    fn name(&self) -> &'static str;
-    /// See [`Domain::aliases`].
-    fn aliases(&self) -> &'static [&'static str];
-    /// See [`Domain::keys`].
-    fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError>;
-    /// Build the environment ([`Domain::build`], then [`Domain::hold`]).
-    fn build_any(&self, keys: &toml::Table) -> Result<AnyEnv, KeyError>;
-    /// Rebuild an environment [`AnyEnv::Custom`] saved (bincode of [`Domain::Env`]).
-    fn restore(&self, bytes: &[u8]) -> Result<AnyEnv, String>;
-    /// See [`Domain::paper_settings`].
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table;
-    /// See [`Domain::short_name`].
-    fn short_name(&self, keys: &toml::Table) -> String;
-    /// See [`Domain::tag`].
-    fn tag(&self) -> &'static str;
-    /// See [`Domain::to_tagged`].
-    fn to_tagged(&self, keys: &toml::Table) -> serde_json::Map<String, serde_json::Value>;
-    /// See [`Domain::keys_of_tagged`].
-    fn keys_of_tagged(
-        &self,
-        fields: &serde_json::Map<String, serde_json::Value>,
-    ) -> Result<toml::Table, KeyError>;
-}
-
-impl<D: Domain> DomainEntry for D {
-    fn name(&self) -> &'static str {
-        Domain::name(self)
-    }
-    fn aliases(&self) -> &'static [&'static str] {
-        Domain::aliases(self)
-    }
-    fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
-        Domain::keys(self, given)
-    }
-    fn build_any(&self, keys: &toml::Table) -> Result<AnyEnv, KeyError> {
-        Ok(self.hold(self.build(keys)?))
-    }
-    fn restore(&self, bytes: &[u8]) -> Result<AnyEnv, String> {
-        let env: D::Env = bincode::deserialize(bytes).map_err(|e| e.to_string())?;
-        Ok(self.hold(env))
-    }
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
-        Domain::paper_settings(self, keys)
-    }
-    fn short_name(&self, keys: &toml::Table) -> String {
-        Domain::short_name(self, keys)
-    }
-    fn tag(&self) -> &'static str {
-        Domain::tag(self)
-    }
-    fn to_tagged(&self, keys: &toml::Table) -> serde_json::Map<String, serde_json::Value> {
-        Domain::to_tagged(self, keys)
-    }
-    fn keys_of_tagged(
-        &self,
-        fields: &serde_json::Map<String, serde_json::Value>,
-    ) -> Result<toml::Table, KeyError> {
-        Domain::keys_of_tagged(self, fields)
     }
 }
 

@@ -8,8 +8,85 @@
 
 use std::sync::RwLock;
 
-use super::built_in::BUILT_IN;
-use super::domain::DomainEntry;
+use serde::{Deserialize, Deserializer};
+
+use super::built_in::{built_in_domains, AnyEnv};
+use super::custom_env::{CustomEnv, SavedEnv};
+use super::domain::{Domain, KeyError};
+
+/// Generate [`BUILT_IN`] from the list of built-in domains ([`built_in_domains`]).
+macro_rules! built_in_list {
+    ($($variant:ident($env:ty) = $domain:expr,)+) => {
+        /// The built-in domains, in list order.
+        pub static BUILT_IN: &[&'static dyn DomainEntry] = &[$(&$domain,)+];
+    };
+}
+built_in_domains!(built_in_list);
+
+/// A [`Domain`] with its environment type erased, as the registry and [`super::EnvSpec`] hold
+/// it. Every [`Domain`] is one; there is nothing to implement.
+pub trait DomainEntry: Send + Sync + 'static {
+    /// See [`Domain::name`].
+    fn name(&self) -> &'static str;
+    /// See [`Domain::aliases`].
+    fn aliases(&self) -> &'static [&'static str];
+    /// See [`Domain::keys`].
+    fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError>;
+    /// Build the environment ([`Domain::build`]) as the pipeline holds it ([`AnyEnv::hold`]).
+    fn build_any(&self, keys: &toml::Table) -> Result<AnyEnv, KeyError>;
+    /// Rebuild an environment [`AnyEnv::Custom`] saved (bincode of [`Domain::Env`]).
+    fn restore(&self, bytes: &[u8]) -> Result<AnyEnv, String>;
+    /// See [`Domain::paper_settings`].
+    fn paper_settings(&self, keys: &toml::Table) -> toml::Table;
+    /// See [`Domain::short_name`].
+    fn short_name(&self, keys: &toml::Table) -> String;
+    /// See [`Domain::tag`].
+    fn tag(&self) -> &'static str;
+    /// See [`Domain::to_tagged`].
+    fn to_tagged(&self, keys: &toml::Table) -> serde_json::Map<String, serde_json::Value>;
+    /// See [`Domain::keys_of_tagged`].
+    fn keys_of_tagged(
+        &self,
+        fields: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<toml::Table, KeyError>;
+}
+
+impl<D: Domain> DomainEntry for D {
+    fn name(&self) -> &'static str {
+        Domain::name(self)
+    }
+    fn aliases(&self) -> &'static [&'static str] {
+        Domain::aliases(self)
+    }
+    fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
+        Domain::keys(self, given)
+    }
+    fn build_any(&self, keys: &toml::Table) -> Result<AnyEnv, KeyError> {
+        Ok(AnyEnv::hold(Domain::name(self), self.build(keys)?))
+    }
+    fn restore(&self, bytes: &[u8]) -> Result<AnyEnv, String> {
+        let env: D::Env = bincode::deserialize(bytes).map_err(|e| e.to_string())?;
+        Ok(AnyEnv::hold(Domain::name(self), env))
+    }
+    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
+        Domain::paper_settings(self, keys)
+    }
+    fn short_name(&self, keys: &toml::Table) -> String {
+        Domain::short_name(self, keys)
+    }
+    fn tag(&self) -> &'static str {
+        Domain::tag(self)
+    }
+    fn to_tagged(&self, keys: &toml::Table) -> serde_json::Map<String, serde_json::Value> {
+        Domain::to_tagged(self, keys)
+    }
+    fn keys_of_tagged(
+        &self,
+        fields: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<toml::Table, KeyError> {
+        Domain::keys_of_tagged(self, fields)
+    }
+}
 
 /// Domains registered at run time, after the built-in ones.
 static REGISTERED: RwLock<Vec<&'static dyn DomainEntry>> = RwLock::new(Vec::new());
@@ -109,6 +186,29 @@ pub fn is_built_in(name: &str) -> bool {
     BUILT_IN.iter().any(|d| names_of(*d).any(|n| n == name))
 }
 
+/// A custom environment in a checkpoint names its domain; reading it back asks that domain to
+/// rebuild the environment, so a checkpoint of a domain this binary lacks is refused by name.
+impl<'de> Deserialize<'de> for CustomEnv {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let saved = SavedEnv::deserialize(d)?;
+        let domain = find(&saved.domain).ok_or_else(|| {
+            D::Error::custom(format!(
+                "the saved environment is of domain `{}`, which this binary does not have (it has {})",
+                saved.domain,
+                names_and_tags()
+            ))
+        })?;
+        match domain.restore(&saved.env).map_err(D::Error::custom)? {
+            AnyEnv::Custom(env) => Ok(env),
+            _ => Err(D::Error::custom(format!(
+                "domain `{}` is built in; its environment is not saved as a custom one",
+                saved.domain
+            ))),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -127,7 +227,7 @@ mod tests {
     fn a_built_in_name_cannot_be_registered_again() {
         let bp = find("BP_MA").unwrap();
         // The same object is accepted (idempotent) ...
-        let err = register(super::super::built_in::BUILT_IN[1]);
+        let err = register(BUILT_IN[1]);
         // ... but built-in objects are not in the run-time list, so re-registering one clashes.
         assert_eq!(err, Err(RegistryError::NameTaken("OSD_S_4".into())));
         assert_eq!(bp.name(), "BP_MA");

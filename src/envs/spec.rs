@@ -8,7 +8,8 @@
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::domain::{key_usize, DomainEntry, KeyError, HORIZON_KEY};
+use super::domain::{key_usize, KeyError, HORIZON_KEY};
+use super::registry::DomainEntry;
 use super::{registry, AnyEnv, EnvError};
 
 /// A domain and the values of all its config keys (checked by the domain).

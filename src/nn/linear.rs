@@ -5,7 +5,7 @@ use ndarray::Axis;
 use rand_chacha::ChaCha8Rng;
 
 use super::init::xavier_uniform;
-use super::params::{flat, flat_mut, LinearParams};
+use super::params::{copy_grad, flat, flat_mut, LinearParams};
 use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::{Activation, Tape, Var};
 
@@ -65,23 +65,6 @@ impl LinearVars {
     pub fn grads_into(&self, tape: &Tape, into: &mut LinearParams) {
         copy_grad(tape, self.weight, flat_mut(&mut into.weight));
         copy_grad(tape, self.bias, flat_mut(&mut into.bias));
-    }
-}
-
-/// dst = the gradient of `v` (flattened), or zeros if none reached it.
-pub(crate) fn copy_grad(tape: &Tape, v: Var, dst: &mut [f32]) {
-    match tape.grad(v) {
-        Some(g) => {
-            assert_eq!(
-                g.len(),
-                dst.len(),
-                "gradient size differs from the parameter's"
-            );
-            for (d, &g) in dst.iter_mut().zip(g.iter()) {
-                *d = g;
-            }
-        }
-        None => dst.fill(0.0),
     }
 }
 

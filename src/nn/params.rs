@@ -6,7 +6,6 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::init::{uniform1, uniform2};
-use super::linear::copy_grad;
 use crate::autograd::{Tape, Var};
 
 /// A set of parameter tensors seen as flat slices in a fixed order (Adam steps over them; a
@@ -140,4 +139,21 @@ pub(crate) fn flat<D: ndarray::Dimension>(a: &ndarray::Array<f32, D>) -> &[f32] 
 pub(crate) fn flat_mut<D: ndarray::Dimension>(a: &mut ndarray::Array<f32, D>) -> &mut [f32] {
     a.as_slice_memory_order_mut()
         .expect("owned parameter arrays are contiguous")
+}
+
+/// dst = the gradient of `v` (flattened), or zeros if none reached it.
+pub(crate) fn copy_grad(tape: &Tape, v: Var, dst: &mut [f32]) {
+    match tape.grad(v) {
+        Some(g) => {
+            assert_eq!(
+                g.len(),
+                dst.len(),
+                "gradient size differs from the parameter's"
+            );
+            for (d, &g) in dst.iter_mut().zip(g.iter()) {
+                *d = g;
+            }
+        }
+        None => dst.fill(0.0),
+    }
 }

@@ -3,7 +3,7 @@
 //! name the file (or the directory, when the description is missing) and what was expected.
 
 use super::architecture::WeightsError;
-use super::manifest::{FORMAT, FORMAT_VERSION, POLICY_FILE};
+use super::format::{FORMAT, FORMAT_VERSION, POLICY_FILE};
 use std::path::{Path, PathBuf};
 
 /// Why a policy directory could not be written or read.

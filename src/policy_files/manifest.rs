@@ -3,7 +3,6 @@
 
 use super::architecture::{Architecture, DDRQN, LEAKY_RELU_SLOPE};
 use super::error::PolicyError;
-use super::legacy;
 use super::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
@@ -14,14 +13,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// The description file of every policy directory (a run's `policy/` and an export alike).
-pub const POLICY_FILE: &str = "policy.json";
-/// The `format` tag of [`POLICY_FILE`].
-pub const FORMAT: &str = "macdec-policy";
-/// The newest `format_version` this build reads, and the one it writes. Version 1 was two
-/// formats (a run's `macdec-run-policy` and an export's `manifest.json`); both still load,
-/// converted on read ([`legacy`]).
-pub const FORMAT_VERSION: u32 = 2;
+pub use super::format::{FORMAT, FORMAT_VERSION, POLICY_FILE};
 /// Widest hidden layer a policy file may declare: the limit configs have
 /// (`experiment::limits::MAX_NET_WIDTH`, kept equal by a test), so a hand-edited file cannot
 /// make a reader allocate more than any trained net needs.
@@ -353,57 +345,6 @@ impl Manifest {
         let nets = export_net_files(domain, &architecture, weights)?;
         let agents = AgentLayout::of_domain(domain);
         Manifest::write_new(dir, env, agents, discount, NetRole::Dec, run, &nets)
-    }
-
-    /// The one loader of descriptions: `dir/policy.json` of any version this build reads, or
-    /// `dir/manifest.json` of an export from before format_version 2; older versions are
-    /// converted. Validated (structure and layout; weight files are checked when read, by
-    /// [`Self::read_net`]).
-    pub fn read(dir: &Path) -> Result<Manifest, PolicyError> {
-        let path = match [POLICY_FILE, legacy::MANIFEST_FILE_V1]
-            .iter()
-            .map(|f| dir.join(f))
-            .find(|p| p.exists())
-        {
-            Some(path) => path,
-            None => {
-                return Err(PolicyError::Missing {
-                    dir: dir.to_path_buf(),
-                })
-            }
-        };
-        let bytes = read_regular_file(&path, MAX_DESCRIPTION_BYTES)
-            .map_err(|e| PolicyError::io(&path, e))?;
-        let parse = |message: String| PolicyError::Parse {
-            path: path.clone(),
-            message,
-        };
-        let value: serde_json::Value =
-            serde_json::from_slice(&bytes).map_err(|e| parse(e.to_string()))?;
-        // Format and version first, so a future layout is named as such, not as a parse error.
-        let format = value.get("format").and_then(|v| v.as_str()).unwrap_or("");
-        let version = value
-            .get("format_version")
-            .and_then(|v| v.as_u64())
-            .ok_or_else(|| parse("`format_version` is missing or not a number".into()))?;
-        let manifest = match (format, version) {
-            (FORMAT, v) if v == u64::from(FORMAT_VERSION) => {
-                serde_json::from_value(value).map_err(|e| parse(e.to_string()))?
-            }
-            (FORMAT, 1) => legacy::export_v1(value, &path)?,
-            (legacy::RUN_FORMAT_V1, 1) => legacy::run_v1(value, &path)?,
-            (FORMAT | legacy::RUN_FORMAT_V1, found) => {
-                return Err(PolicyError::Version { path, found })
-            }
-            (found, _) => {
-                return Err(PolicyError::Format {
-                    path,
-                    found: found.to_string(),
-                })
-            }
-        };
-        manifest.validate(&path)?;
-        Ok(manifest)
     }
 
     /// Check the description against itself and its domain: format and version, discount,

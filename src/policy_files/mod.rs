@@ -45,9 +45,11 @@
 
 pub mod architecture;
 pub mod error;
+pub mod format;
 pub mod legacy;
 pub mod manifest;
 pub mod policy_env;
+mod read;
 pub mod run_nets;
 
 pub use architecture::{Architecture, WeightsError};

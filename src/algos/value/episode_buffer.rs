@@ -8,8 +8,8 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::batch::{Batch, Sequence};
 use super::record::{Episode, Layout};
-use super::replay::{Batch, Sequence};
 use super::ReplayError;
 
 /// Episode replay; capacity counts episodes (WTD: 1000).

@@ -11,6 +11,7 @@
 //! gives epsilon and the hysteresis value from the episode count (spec 4.1, 5.6).
 
 pub mod acting;
+pub mod batch;
 pub mod cond_argmax;
 pub mod episode_buffer;
 pub mod evaluate;

@@ -6,8 +6,6 @@
 //! batch's longest episode) are never materialised, because squeezing removes every one of them
 //! (spec 3: all v_i = 0). Their count is kept for information only.
 
-use std::ops::Range;
-
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -16,41 +14,7 @@ use super::record::{Episode, Layout};
 use super::window_buffer::WindowBuffer;
 use super::ReplayError;
 
-/// One sampled sequence: records `start..end` of `episode` in time order.
-///
-/// In the reference's padded form the sequence has `lead_pad` zero records before them and zero
-/// records after them up to [`Batch::padded_len`].
-#[derive(Debug, Clone, Copy)]
-pub struct Sequence<'a> {
-    pub episode: &'a Episode,
-    pub start: usize,
-    pub end: usize,
-    pub lead_pad: usize,
-}
-
-impl Sequence<'_> {
-    /// Number of real (non-padding) records.
-    pub fn len(&self) -> usize {
-        self.end - self.start
-    }
-    /// True if the sequence holds no real record (never produced by the buffers).
-    pub fn is_empty(&self) -> bool {
-        self.end == self.start
-    }
-    /// Indices of the real records inside [`Self::episode`].
-    pub fn records(&self) -> Range<usize> {
-        self.start..self.end
-    }
-}
-
-/// B sampled sequences (with replacement, in draw order) borrowing the buffer's storage.
-#[derive(Debug, Clone)]
-pub struct Batch<'a> {
-    pub sequences: Vec<Sequence<'a>>,
-    /// T of the reference's padded `B x T` batch: trace_len (windows) or the longest sampled
-    /// episode (episodes, spec 3.2).
-    pub padded_len: usize,
-}
+pub use super::batch::{Batch, Sequence};
 
 /// The replay of one training environment: windows (spec 3.1, Box Pushing) or whole episodes
 /// (spec 3.2, `sample_epi`, Warehouse).

@@ -12,8 +12,8 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize, Serializer};
 
+use super::batch::{Batch, Sequence};
 use super::record::{Episode, Layout};
-use super::replay::{Batch, Sequence};
 use super::ReplayError;
 
 /// One window: the window with start index `s` (into the padded cache) of episode `episode_no`.

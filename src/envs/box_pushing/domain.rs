@@ -5,7 +5,7 @@
 
 use super::BoxPushing;
 use crate::envs::domain::{fill_keys, key_table, key_usize, Domain, KeyError, HORIZON_KEY};
-use crate::envs::{AnyEnv, EnvError, EnvSpec};
+use crate::envs::EnvError;
 
 /// Largest grid side a config may ask for (paper: 10 and 30), far below [`super::MAX_GRID`]
 /// so that a run's memory stays bounded (README "Limits and guarantees").
@@ -19,29 +19,12 @@ pub struct BoxPushingDomain;
 
 /// The paper's horizon for a grid: 100 steps below 30 x 30 (Figure 4a's 10 x 10), 200 from
 /// 30 x 30 on (Figure 4b) (spec `algorithms.md` 10.1, 10.2).
-fn paper_horizon(grid: usize) -> usize {
+pub(super) fn paper_horizon(grid: usize) -> usize {
     if grid >= 30 {
         200
     } else {
         100
     }
-}
-
-/// Box Pushing on a `grid` x `grid` grid with `horizon` primitive steps.
-pub fn spec(grid: usize, horizon: usize) -> EnvSpec {
-    EnvSpec::of(
-        &BoxPushingDomain,
-        &key_table([
-            ("grid_dim", (grid as i64).into()),
-            (HORIZON_KEY, (horizon as i64).into()),
-        ]),
-    )
-    .expect("a valid Box Pushing grid and horizon")
-}
-
-/// Box Pushing at the paper's horizon for its grid (see [`paper_horizon`]).
-pub fn paper_spec(grid: usize) -> EnvSpec {
-    spec(grid, paper_horizon(grid))
 }
 
 /// The config key of a parameter [`BoxPushing::check_params`] names.
@@ -167,15 +150,12 @@ impl Domain for BoxPushingDomain {
             &key_table([("grid_dim", grid.into()), (HORIZON_KEY, horizon.into())]),
         )
     }
-
-    fn hold(&self, env: BoxPushing) -> AnyEnv {
-        AnyEnv::BoxPushing(env)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::envs::box_pushing::paper_spec;
 
     #[test]
     fn the_horizon_follows_the_grid_and_keys_are_named() {

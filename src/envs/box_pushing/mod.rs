@@ -16,10 +16,12 @@ mod navigate;
 pub mod observe;
 mod push;
 mod render;
+mod spec;
 pub mod state;
 mod step;
 
-pub use domain::{paper_spec, spec, BoxPushingDomain, DEFAULT_GRID_DIM, MAX_GRID_DIM};
+pub use domain::{BoxPushingDomain, DEFAULT_GRID_DIM, MAX_GRID_DIM};
+pub use spec::{paper_spec, spec};
 
 #[cfg(test)]
 mod properties;

@@ -7,7 +7,7 @@ use super::{Warehouse, WarehouseParams};
 use crate::envs::domain::{
     fill_keys, key_f64, key_table, key_usize, Domain, KeyError, HORIZON_KEY,
 };
-use crate::envs::{AnyEnv, EnvError, EnvSpec};
+use crate::envs::EnvError;
 
 /// The grid side Warehouse runs record: the reference's `--grid_dim` default, which Warehouse
 /// does not read.
@@ -15,24 +15,6 @@ const RECORDED_GRID_DIM: i64 = 10;
 
 /// The Warehouse Tool Delivery domain.
 pub struct WarehouseDomain;
-
-/// Warehouse with `horizon` primitive steps and Turtlebot movement noise std `tb_m_noisy`.
-pub fn spec(horizon: usize, tb_m_noisy: f64) -> EnvSpec {
-    EnvSpec::of(
-        &WarehouseDomain,
-        &key_table([
-            (HORIZON_KEY, (horizon as i64).into()),
-            ("tb_m_noisy", tb_m_noisy.into()),
-        ]),
-    )
-    .expect("a valid Warehouse horizon and noise")
-}
-
-/// Warehouse as in Figure 5: horizon 150, no movement noise (spec 10.3).
-pub fn paper_spec() -> EnvSpec {
-    let p = WarehouseParams::default();
-    spec(p.terminate_step, p.tb_move_noisy)
-}
 
 /// The full parameter set: the keys' horizon and noise, the paper's values for the rest.
 fn params(keys: &toml::Table) -> Result<WarehouseParams, KeyError> {
@@ -161,15 +143,12 @@ impl Domain for WarehouseDomain {
             &key_table([(HORIZON_KEY, horizon.into()), ("tb_m_noisy", noise.into())]),
         )
     }
-
-    fn hold(&self, env: Warehouse) -> AnyEnv {
-        AnyEnv::Warehouse(env)
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::envs::warehouse::{paper_spec, spec};
 
     #[test]
     fn each_bad_parameter_is_named_by_its_config_key() {

@@ -17,6 +17,7 @@ mod observe;
 mod params;
 mod pyround;
 mod render;
+mod spec;
 mod step;
 mod turtlebot;
 
@@ -27,12 +28,13 @@ mod scenarios;
 #[cfg(test)]
 mod testkit;
 
-pub use domain::{paper_spec, spec, WarehouseDomain};
+pub use domain::WarehouseDomain;
 pub use fetch::{Fetch, FetchAction};
 pub use human::Human;
 pub use observe::{FETCH_OBS, TB_OBS};
 pub use params::{WarehouseParams, FETCH_POS, N_TOOLS, TURTLEBOT_STARTS, WAYPOINTS};
 pub use pyround::round2;
+pub use spec::{paper_spec, spec};
 pub use turtlebot::{TbAction, Turtlebot};
 
 use rand_distr::Normal;

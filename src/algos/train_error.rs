@@ -1,0 +1,30 @@
+//! Why a training loop stopped early: what the loop, the environments and a learner can fail with.
+
+use crate::algos::method::Method;
+use crate::algos::value::update::UpdateError;
+use crate::algos::value::ReplayError;
+use crate::envs::EnvError;
+
+/// Why training stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum TrainError {
+    #[error(transparent)]
+    Env(#[from] EnvError),
+    #[error(transparent)]
+    Replay(#[from] ReplayError),
+    #[error(transparent)]
+    Update(#[from] UpdateError),
+    #[error("{method} seed {seed}: non-finite {what} at episode {episode}")]
+    NonFinite {
+        method: Method,
+        seed: u64,
+        what: &'static str,
+        episode: u64,
+    },
+    #[error("{method} asks for {asked} training lanes; runs have random streams for {available}")]
+    TooManyLanes {
+        method: Method,
+        asked: usize,
+        available: usize,
+    },
+}
