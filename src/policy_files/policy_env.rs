@@ -106,7 +106,7 @@ impl CustomEnv {
                 ),
             ));
         }
-        if ["box-pushing", "warehouse", CUSTOM].contains(&self.name.as_str()) {
+        if self.name == CUSTOM || crate::envs::registry::is_built_in(&self.name) {
             return Err((
                 "env.name",
                 format!(
