@@ -102,16 +102,16 @@ pub enum RegistryError {
     BadName(String),
 }
 
-/// Add `domain` to the process's domains. Registering the same domain object again does
-/// nothing; a domain whose name, alias or tag another domain already uses is refused.
+/// Add `domain` to the process's domains. Registering the same domain again does nothing; a
+/// domain whose name, alias or tag another domain already uses is refused.
 pub fn register(domain: &'static dyn DomainEntry) -> Result<(), RegistryError> {
     let mut registered = REGISTERED.write().unwrap_or_else(|e| e.into_inner());
-    if registered.iter().any(|d| {
-        std::ptr::addr_eq(
-            *d as *const dyn DomainEntry,
-            domain as *const dyn DomainEntry,
-        )
-    }) {
+    // The same domain again (same name, aliases and tag; addresses cannot tell, as distinct
+    // unit-struct domains may share one) is already there.
+    let same = |d: &&'static dyn DomainEntry| {
+        d.name() == domain.name() && d.aliases() == domain.aliases() && d.tag() == domain.tag()
+    };
+    if registered.iter().any(same) {
         return Ok(());
     }
     for name in names_of(domain) {
@@ -221,6 +221,48 @@ mod tests {
         assert_eq!(find("warehouse").unwrap().name(), "OSD_S_4");
         assert!(find("Pong").is_none());
         assert_eq!(&names()[..2], ["BP_MA", "OSD_S_4"]);
+    }
+
+    /// Two distinct unit-struct domains (they may share an address) and a name clash.
+    struct TestA;
+    struct TestB;
+    struct TestClash;
+    macro_rules! test_domain {
+        ($t:ident, $name:expr, $aliases:expr) => {
+            impl Domain for $t {
+                type Env = crate::envs::box_pushing::BoxPushing;
+                fn name(&self) -> &'static str {
+                    $name
+                }
+                fn aliases(&self) -> &'static [&'static str] {
+                    $aliases
+                }
+                fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
+                    crate::envs::domain::fill_keys(given, toml::toml! { env_terminate_step = 9 })
+                }
+                fn build(&self, _: &toml::Table) -> Result<Self::Env, KeyError> {
+                    Err(KeyError::new("env_name", "not built in tests"))
+                }
+            }
+        };
+    }
+    test_domain!(TestA, "registry-test-a", &[]);
+    test_domain!(TestB, "registry-test-b", &[]);
+    test_domain!(TestClash, "registry-test-c", &["registry-test-a"]);
+
+    #[test]
+    fn distinct_domains_register_once_each_and_clashes_are_refused() {
+        register(&TestA).unwrap();
+        register(&TestA).unwrap();
+        register(&TestB).unwrap();
+        assert_eq!(find("registry-test-a").unwrap().name(), "registry-test-a");
+        assert_eq!(find("registry-test-b").unwrap().name(), "registry-test-b");
+        assert_eq!(
+            register(&TestClash),
+            Err(RegistryError::NameTaken("registry-test-a".into()))
+        );
+        assert!(find("registry-test-c").is_none());
+        assert!(names().contains(&"registry-test-b"));
     }
 
     #[test]
