@@ -22,6 +22,10 @@ mod qnet;
 pub mod safetensors_io;
 mod update;
 
+/// Widest layer of any net a config or a policy file may ask for (paper: 32 and 64), so neither
+/// can make the process allocate beyond what a net needs (README "Limits and guarantees").
+pub const MAX_NET_WIDTH: usize = 2_048;
+
 pub use adam::{Adam, AdamConfig};
 pub use argmax::argmax;
 pub use gru::{GruState, GRU_TENSOR_NAMES};

@@ -14,10 +14,9 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
 pub use super::format::{FORMAT, FORMAT_VERSION, POLICY_FILE};
-/// Widest hidden layer a policy file may declare: the limit configs have
-/// (`experiment::limits::MAX_NET_WIDTH`, kept equal by a test), so a hand-edited file cannot
-/// make a reader allocate more than any trained net needs.
-pub const MAX_NET_WIDTH: usize = 2_048;
+/// Widest hidden layer a policy file may declare: the limit configs have, so a hand-edited file
+/// cannot make a reader allocate more than any trained net needs.
+pub use crate::nn::MAX_NET_WIDTH;
 
 /// Largest `policy.json` read (one is a few kilobytes, most of it the run's config).
 pub(crate) const MAX_DESCRIPTION_BYTES: u64 = 1 << 20;
@@ -1134,11 +1133,6 @@ mod tests {
         });
         let err = Manifest::read(dir.path()).unwrap_err().to_string();
         assert!(err.contains("leaky_relu_slope"), "{err}");
-    }
-
-    #[test]
-    fn max_net_width_is_the_config_limit() {
-        assert_eq!(MAX_NET_WIDTH, crate::experiment::limits::MAX_NET_WIDTH);
     }
 
     #[test]

@@ -19,8 +19,9 @@ pub const MAX_HORIZON: usize = 100_000;
 pub const MAX_TRACE_LEN: usize = 100_000;
 /// Sequences per batch, `batch_size` (paper: 128 and 16).
 pub const MAX_BATCH_SIZE: usize = 65_536;
-/// Width of any net layer, `*_mlp_layer_size` and `*_rnn_h_size` (paper: 32 and 64).
-pub const MAX_NET_WIDTH: usize = 2_048;
+/// Width of any net layer, `*_mlp_layer_size` and `*_rnn_h_size` (paper: 32 and 64); policy
+/// files are held to it too.
+pub use crate::nn::MAX_NET_WIDTH;
 /// Elements of one batch activation: batch_size x sequence length x widest layer
 /// (2^28 f32 = 1 GiB; paper: about 1.5e5).
 pub const MAX_BATCH_ELEMENTS: u128 = 1 << 28;
