@@ -7,6 +7,7 @@
 
 mod common;
 
+use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
@@ -128,7 +129,20 @@ fn the_custom_domain_trains_plots_exports_evaluates_and_audits() {
     assert!(eval.contains("2 episode(s) of rendezvous"), "{eval}");
     let deploy = ok(run_example(&["deploy", "--policy", p, "--episodes", "1"]));
     assert!(deploy.contains("robot process(es)"), "{deploy}");
-    // Plain macdec serves nothing it cannot simulate, and says which domain is missing.
+    // Plain macdec, which lacks the domain, still serves its agents to robots ...
+    let robot = common::robot_process(&policy, 1, false);
+    let mut stream = std::io::BufReader::new(std::net::TcpStream::connect(&robot.addr).unwrap());
+    stream
+        .get_mut()
+        .write_all(b"{\"type\": \"info\"}\n")
+        .unwrap();
+    let mut info = String::new();
+    stream.read_line(&mut info).unwrap();
+    assert!(
+        info.contains("\"agent\":1") && info.contains("rendezvous"),
+        "{info}"
+    );
+    // ... but runs no episodes of it, and says which domain is missing.
     let err = common::run(&["eval", "--policy", p]);
     assert!(!err.status.success());
     let text = String::from_utf8_lossy(&err.stderr);
