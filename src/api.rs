@@ -120,7 +120,7 @@ impl TrainedPolicy {
         // A built-in domain is recorded as a run's config.toml records it; a custom one by the
         // description's `env` alone.
         let config = match &domain {
-            PolicyEnv::BuiltIn(spec) => serde_json::to_value(RunSettings {
+            PolicyEnv::Known(spec) => serde_json::to_value(RunSettings {
                 env: spec.clone(),
                 config: self.config.clone(),
             }),

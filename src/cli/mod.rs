@@ -863,7 +863,7 @@ fn refuse_policy_dir_as_run(dir: &Path) -> Result<()> {
     let manifest = Manifest::read(dir).with_context(|| format!("reading {}", dir.display()))?;
     manifest
         .env
-        .built_in()
+        .known()
         .with_context(|| format!("rendering {}", dir.display()))?;
     bail!(
         "{} is an exported policy directory, not a run directory: `macdec render --run` takes a \
@@ -971,7 +971,7 @@ impl EpisodeArgs {
             .with_context(|| format!("loading policy {}", self.policy.display()))?;
         manifest
             .env
-            .built_in()
+            .known()
             .with_context(|| format!("running episodes of {}", self.policy.display()))?;
         let seed = self.seed.unwrap_or(manifest.run.seed);
         Ok(EpisodeRun {

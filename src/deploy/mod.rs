@@ -30,7 +30,7 @@ pub use serve::{deadline, line_reader, protocol, robot, server};
 pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};
 pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
 pub use manifest::{Manifest, VerifiedAgent};
-pub use policy_env::{CustomEnv, NotBuiltIn, PolicyEnv};
+pub use policy_env::{CustomEnv, NotInBinary, PolicyEnv};
 pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};
 pub use server::{serve_tcp, spawn_server, Limits, RobotServer};
 

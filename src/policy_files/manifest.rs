@@ -371,7 +371,7 @@ impl Manifest {
             ));
         }
         match &self.env {
-            PolicyEnv::BuiltIn(spec) => self.check_layout_against(spec, path)?,
+            PolicyEnv::Known(spec) => self.check_layout_against(spec, path)?,
             PolicyEnv::Custom(custom) => self.check_custom_layout(custom, path)?,
         }
         let mut seen = std::collections::BTreeSet::new();

@@ -58,7 +58,7 @@ pub use manifest::{
     load_agent, load_all, sha256_hex, weights_file_name, AgentLayout, Manifest, NetEntry, NetFile,
     NetKind, NetRole, RunInfo, VerifiedAgent, FORMAT, FORMAT_VERSION, POLICY_FILE,
 };
-pub use policy_env::{CustomEnv, NotBuiltIn, PolicyEnv};
+pub use policy_env::{CustomEnv, NotInBinary, PolicyEnv};
 pub use run_nets::{
     dec_file_name, read_policy_files, read_qnets, write_policy_files, PolicyNets, CEN_FILE,
     POLICY_DIR,

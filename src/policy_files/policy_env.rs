@@ -1,10 +1,11 @@
-//! Which domain an exported policy is for: one built into this binary ([`EnvSpec`], written
-//! exactly as configs and replay files write it), or a custom domain a library user defined in
-//! their own program (`{"env": "custom", "name": "rendezvous", "horizon": 20}`).
+//! Which domain a policy is for: one this binary knows (built in or registered, an [`EnvSpec`]
+//! written as its tag and keys, exactly as replay files write it), or one it does not (a
+//! library user's, `{"env": "custom", "name": "rendezvous", "horizon": 20}`, or a registered
+//! domain of another binary, read as such).
 //!
-//! A robot needs only its net and the layout in the manifest, so it serves either. Commands that
-//! simulate the domain (`eval`, `deploy`, `domain`, `render`) can build only a built-in one and
-//! refuse a custom one with [`NotBuiltIn`], naming it.
+//! A robot needs only its net and the layout in the policy file, so it serves either. Commands
+//! that simulate the domain (`eval`, `deploy`, `domain`, `render`) can build only a known one and
+//! refuse the other with [`NotInBinary`], naming it.
 
 use crate::envs::{AnyEnv, EnvError, EnvSpec, MacroEnv};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -17,10 +18,10 @@ pub const MAX_NAME_CHARS: usize = 64;
 /// The domain of an exported policy.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PolicyEnv {
-    /// Box Pushing or Warehouse: serialized as the bare [`EnvSpec`], byte for byte as before
-    /// custom domains existed, so every existing policy directory reads unchanged.
-    BuiltIn(EnvSpec),
-    /// A domain defined outside this binary (a [`MacroEnv`] of the library user's).
+    /// A domain this binary has: serialized as the bare [`EnvSpec`] (Box Pushing and Warehouse
+    /// byte for byte as before custom domains existed, so every existing policy reads unchanged).
+    Known(EnvSpec),
+    /// A domain this binary does not have: its name and horizon.
     Custom(CustomEnv),
 }
 
@@ -35,10 +36,10 @@ pub struct CustomEnv {
     pub horizon: usize,
 }
 
-/// A command that must simulate the domain was given a policy of a custom domain.
+/// A command that must simulate the domain was given a policy of a domain this binary lacks.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("the policy's domain `{name}` is not in this binary (it has {}): `macdec robot` serves its agents, but running its episodes needs its simulator: use a binary that registers the domain (`macdec::cli::main_with`, see examples/custom_domain.rs), or drive the robots from your own program (macdec::deploy::run_episodes with your MacroEnv and JsonLink::connect)", crate::envs::registry::names_and_tags())]
-pub struct NotBuiltIn {
+pub struct NotInBinary {
     pub name: String,
 }
 
@@ -51,10 +52,11 @@ impl PolicyEnv {
         })
     }
 
-    /// The domain's name: the built-in `env` tag (`box-pushing`, `warehouse`) or the custom name.
+    /// The domain's name: its `env` tag (`box-pushing`, `warehouse`, `rendezvous`) or the custom
+    /// name.
     pub fn name(&self) -> &str {
         match self {
-            PolicyEnv::BuiltIn(spec) => spec.name(),
+            PolicyEnv::Known(spec) => spec.name(),
             PolicyEnv::Custom(c) => &c.name,
         }
     }
@@ -62,24 +64,24 @@ impl PolicyEnv {
     /// The horizon in primitive steps.
     pub fn horizon(&self) -> usize {
         match self {
-            PolicyEnv::BuiltIn(spec) => spec.horizon(),
+            PolicyEnv::Known(spec) => spec.horizon(),
             PolicyEnv::Custom(c) => c.horizon,
         }
     }
 
-    /// The built-in domain's spec, or [`NotBuiltIn`] naming the custom domain.
-    pub fn built_in(&self) -> Result<EnvSpec, NotBuiltIn> {
+    /// The known domain's spec, or [`NotInBinary`] naming the other.
+    pub fn known(&self) -> Result<EnvSpec, NotInBinary> {
         match self {
-            PolicyEnv::BuiltIn(spec) => Ok(spec.clone()),
-            PolicyEnv::Custom(c) => Err(NotBuiltIn {
+            PolicyEnv::Known(spec) => Ok(spec.clone()),
+            PolicyEnv::Custom(c) => Err(NotInBinary {
                 name: c.name.clone(),
             }),
         }
     }
 
-    /// Build the domain to simulate it: only a built-in one can be.
+    /// Build the domain to simulate it: only a known one can be.
     pub fn build(&self) -> Result<AnyEnv, BuildError> {
-        Ok(self.built_in()?.build()?)
+        Ok(self.known()?.build()?)
     }
 }
 
@@ -87,7 +89,7 @@ impl PolicyEnv {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BuildError {
     #[error(transparent)]
-    NotBuiltIn(#[from] NotBuiltIn),
+    NotInBinary(#[from] NotInBinary),
     #[error(transparent)]
     Env(#[from] EnvError),
 }
@@ -124,13 +126,13 @@ impl CustomEnv {
 
 impl PartialEq<EnvSpec> for PolicyEnv {
     fn eq(&self, other: &EnvSpec) -> bool {
-        matches!(self, PolicyEnv::BuiltIn(spec) if spec == other)
+        matches!(self, PolicyEnv::Known(spec) if spec == other)
     }
 }
 
 impl From<EnvSpec> for PolicyEnv {
     fn from(spec: EnvSpec) -> Self {
-        PolicyEnv::BuiltIn(spec)
+        PolicyEnv::Known(spec)
     }
 }
 
@@ -145,7 +147,7 @@ struct CustomWire<'a> {
 impl Serialize for PolicyEnv {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
-            PolicyEnv::BuiltIn(spec) => spec.serialize(s),
+            PolicyEnv::Known(spec) => spec.serialize(s),
             PolicyEnv::Custom(c) => CustomWire {
                 env: CUSTOM,
                 name: &c.name,
@@ -189,7 +191,7 @@ impl<'de> Deserialize<'de> for PolicyEnv {
             }
         }
         serde_json::from_value(value)
-            .map(PolicyEnv::BuiltIn)
+            .map(PolicyEnv::Known)
             .map_err(|e| {
                 let hint = if e.to_string().contains("unknown domain") {
                     format!(" (or `{CUSTOM}` for a domain defined outside this binary)")
@@ -211,7 +213,7 @@ mod tests {
             crate::envs::box_pushing::paper_spec(10),
             crate::envs::warehouse::spec(150, 0.25),
         ] {
-            let env = PolicyEnv::BuiltIn(spec.clone());
+            let env = PolicyEnv::Known(spec.clone());
             assert_eq!(
                 serde_json::to_string_pretty(&env).unwrap(),
                 serde_json::to_string_pretty(&spec).unwrap()
@@ -270,7 +272,7 @@ mod tests {
                 && err.contains("main_with"),
             "{err}"
         );
-        assert!(PolicyEnv::BuiltIn(crate::envs::warehouse::paper_spec())
+        assert!(PolicyEnv::Known(crate::envs::warehouse::paper_spec())
             .build()
             .is_ok());
     }

@@ -19,7 +19,7 @@ pub enum RolloutError {
     #[error(transparent)]
     Render(#[from] RenderError),
     #[error("{0}: {1}")]
-    NotBuiltIn(String, crate::policy_files::NotBuiltIn),
+    NotInBinary(String, crate::policy_files::NotInBinary),
     #[error("{0}: cannot build the run's environment: {1}")]
     Env(String, crate::envs::EnvError),
     #[error("{0}: the policy files' nets do not fit the domain: {1}")]
@@ -46,8 +46,8 @@ pub fn render_run(
     let spec = run
         .manifest
         .env
-        .built_in()
-        .map_err(|e| RolloutError::NotBuiltIn(run_dir.display().to_string(), e))?;
+        .known()
+        .map_err(|e| RolloutError::NotInBinary(run_dir.display().to_string(), e))?;
     let mut env = spec
         .build()
         .map_err(|e| RolloutError::Env(run_dir.display().to_string(), e))?;
