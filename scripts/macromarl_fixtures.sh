@@ -1,0 +1,23 @@
+#!/bin/bash
+# Regenerates tests/fixtures/macromarl with scripts/macromarl_traces.py (see its doc).
+set -e
+PY=${PY:-python3}; MM=$1; OC=$2; F=tests/fixtures/macromarl; S=scripts/macromarl_traces.py
+BP='"big_box_reward": 300, "small_box_reward": 20, "penalty": -10'
+for g in 6 8 10 12 14; do
+  $PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [$g, $g], $BP}" --plan '[[2, 4], [3, 4]]' --horizon 100 --out $F/bp_ma_${g}_optimum
+  for s in 0 1; do
+    $PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [$g, $g], $BP}" --random-seed $s --horizon 100 --out $F/bp_ma_${g}_random$s
+  done
+done
+P='"grid_dim": [6, 6], '"$BP"', "TB_move_speed": 0.6, "TB_move_noisy": 0.0, "TB_move_cost": 0.0, "fetch_pass_obj_tc": 4, "fetch_look_for_obj_tc": 6, "fetch_manip_noisy": 0.0, "delay_delivery_penalty": 0.0, "obs_human_wait": false'
+$PY $S --macromarl $MM --env OSD-D-v7 --params "{$P, \"n_agent\": 3, \"terminate_step\": 200, \"human_speed_per_step\": [[27,20,20,20],[27,20,20,20]]}" --random-seed 0 --horizon 200 --out $F/osd_d_v7_a_random0
+$PY $S --macromarl $MM --env OSD-D-v7 --params "{$P, \"n_agent\": 3, \"terminate_step\": 200, \"human_speed_per_step\": [[18,15,15,15],[48,18,15,15]]}" --random-seed 1 --horizon 200 --out $F/osd_d_v7_b_random1
+$PY $S --macromarl $MM --env OSD-T-v0 --params "{$P, \"n_agent\": 3, \"terminate_step\": 250, \"human_speed_per_step\": [[40,40,40,40],[40,40,40,40],[40,40,40,40]]}" --random-seed 0 --horizon 250 --out $F/osd_t_v0_c_random0
+$PY $S --macromarl $MM --env OSD-T-v1 --params "{$P, \"n_agent\": 4, \"terminate_step\": 250, \"human_speed_per_step\": [[38,38,38,38],[38,38,38,38],[27,27,27,27]]}" --random-seed 0 --horizon 250 --out $F/osd_t_v1_d_random0
+$PY $S --macromarl $MM --env OSD-F-v0 --params "{$P, \"n_agent\": 4, \"terminate_step\": 300, \"human_speed_per_step\": [[40,40,40,40],[40,40,40,40],[40,40,40,40],[40,40,40,40]]}" --random-seed 0 --horizon 300 --out $F/osd_f_v0_e_random0
+R='{"subtask finished": 10, "correct delivery": 200, "wrong delivery": -5, "step penalty": -0.1}'
+for m in A B C; do
+  $PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"$m\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --random-seed 0 --horizon 200 --out $F/overcooked_$(echo $m | tr A-Z a-z)_n3_random0
+done
+# As published: the scripts never pass n_agent, so Overcooked trains 2 agents.
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false}" --random-seed 1 --horizon 200 --out $F/overcooked_a_n2_random1
