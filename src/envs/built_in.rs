@@ -1,5 +1,5 @@
-//! The domains built into macdec: **the one list** a new built-in domain joins
-//! ([`built_in_domains`]). Each line names the domain's [`AnyEnv`] variant, its environment type
+//! The domains built into macdec: **the one list** a new built-in domain joins (the macro
+//! `built_in_domains`). Each line names the domain's [`AnyEnv`] variant, its environment type
 //! and its [`super::domain::Domain`]; the list becomes [`AnyEnv`] (one variant per domain, plus
 //! [`AnyEnv::Custom`] for a user's own) and its [`MacroEnv`] forwarding here, and the registry's
 //! built-in entries in [`super::registry`].

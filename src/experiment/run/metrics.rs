@@ -144,7 +144,7 @@ pub fn read_text(path: &Path) -> Result<Vec<u8>, MetricsError> {
     }
 }
 
-/// Read a curve written by [`write`] (or its gzip-compressed copy), whatever the family: the
+/// Read a curve written by [`fn@write`] (or its gzip-compressed copy), whatever the family: the
 /// columns between `eval_return` and `wall_seconds` are the family's. A missing leading column,
 /// a cell that is not a number, or a row of the wrong length is an error naming it.
 pub fn read(path: &Path) -> Result<MetricsTable, MetricsError> {
