@@ -395,12 +395,13 @@ fn parse_net_role(text: &str) -> Result<NetRole, String> {
 /// as on the built-in ones.
 ///
 /// ```no_run
+/// # use macdec::envs::domain::KeyError;
 /// # struct MyDomain;
 /// # impl macdec::envs::Domain for MyDomain {
 /// #     type Env = macdec::envs::box_pushing::BoxPushing;
 /// #     fn name(&self) -> &'static str { "mine" }
-/// #     fn keys(&self, g: &toml::Table) -> Result<toml::Table, macdec::envs::domain::KeyError> { unimplemented!() }
-/// #     fn build(&self, k: &toml::Table) -> Result<Self::Env, macdec::envs::domain::KeyError> { unimplemented!() }
+/// #     fn keys(&self, _: &toml::Table) -> Result<toml::Table, KeyError> { todo!() }
+/// #     fn build(&self, _: &toml::Table) -> Result<Self::Env, KeyError> { todo!() }
 /// # }
 /// fn main() -> std::process::ExitCode {
 ///     macdec::cli::main_with(&[&MyDomain])
