@@ -21,6 +21,9 @@ repeats the last one), or drawn uniformly at random for the free agents (--rando
 numpy's RandomState, so a seed gives the same file everywhere); planned and random episodes run
 until the env terminates or --horizon steps.
 
+With --speed SECONDS it writes nothing and prints the reference env's primitive steps per second
+under random macro-actions instead (the Python side of the environment-speed comparison).
+
 Setup (Python 3.11; gym 0.26 runs the reference unchanged):
   python3.11 -m venv venv && venv/bin/pip install numpy gym==0.26.2
   # a checkout of github.com/yuchen-x/MacroMARL at MACROMARL
@@ -44,6 +47,37 @@ def as_ints(values):
     return [int(v) for v in values]
 
 
+def speed(env, args):
+    """Primitive steps per second of `env` under uniformly random macro-actions for the free
+    agents (numpy's RandomState, seed --random-seed or 0), as macdec's `bench envs` measures."""
+    import time
+
+    import numpy as np
+
+    rng = np.random.RandomState(args.random_seed or 0)
+    n_actions = list(env.n_action)
+    steps = episodes = 0
+    start = time.perf_counter()
+    while time.perf_counter() - start < args.speed:
+        env.reset()
+        episodes += 1
+        free = [True] * env.n_agent
+        for _ in range(args.horizon):
+            actions = [int(rng.randint(n)) if free[i] else -1 for i, n in enumerate(n_actions)]
+            _, _, done, info = env.step(actions)
+            steps += 1
+            free = [bool(d) for d in info["mac_done"]]
+            if done:
+                break
+    seconds = time.perf_counter() - start
+    return {
+        "steps": steps,
+        "episodes": episodes,
+        "seconds": seconds,
+        "steps_per_second": steps / seconds,
+    }
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--macromarl", required=True, help="a MacroMARL checkout (its src/ is imported)")
@@ -56,10 +90,18 @@ def main():
     parser.add_argument("--plan", help="JSON list per agent of macro-actions started in order")
     parser.add_argument("--random-seed", type=int, help="draw the free agents' actions at random")
     parser.add_argument("--horizon", type=int, default=100, help="most steps of a random episode")
-    parser.add_argument("--out", required=True, help="output path without extension")
+    parser.add_argument("--out", help="output path without extension")
+    parser.add_argument(
+        "--speed",
+        type=float,
+        help="instead of a trace: step random macro-actions for this many seconds (resetting at "
+        "the end of an episode or --horizon) and print primitive steps per second",
+    )
     args = parser.parse_args()
-    if [args.steps, args.plan, args.random_seed].count(None) != 2:
+    if args.speed is None and [args.steps, args.plan, args.random_seed].count(None) != 2:
         parser.error("give exactly one of --steps, --plan and --random-seed")
+    if args.speed is None and args.out is None:
+        parser.error("give --out (or --speed)")
 
     sys.path.insert(0, os.path.join(args.macromarl, "src"))
     # The env files import IPython (for debugging) but never use it: a stand-in will do.
@@ -117,6 +159,10 @@ def main():
 
     def state_fields():
         return {"state": as_floats(np.asarray(env.get_state()).ravel())} if has_state else {}
+
+    if args.speed is not None:
+        print(json.dumps({"env": args.env, "params": params, **speed(env, args)}))
+        return
 
     lines = []
     obs = env.reset()
