@@ -217,6 +217,36 @@ pub fn key_f64(keys: &toml::Table, key: &str) -> Result<f64, KeyError> {
     }
 }
 
+/// For a domain's own [`Domain::keys_of_tagged`]: refuse a field of its tagged form not in
+/// `known`, naming the field and the known ones.
+pub fn refuse_unknown_fields(
+    fields: &serde_json::Map<String, serde_json::Value>,
+    tag: &str,
+    known: &[&str],
+) -> Result<(), KeyError> {
+    match fields.keys().find(|k| !known.contains(&k.as_str())) {
+        Some(k) => Err(KeyError::new(
+            k,
+            format!("unknown field; {tag} has `{}`", known.join("`, `")),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// For a domain's own [`Domain::keys_of_tagged`]: the required non-negative integer field `key`.
+pub fn tagged_count(
+    fields: &serde_json::Map<String, serde_json::Value>,
+    key: &str,
+) -> Result<i64, KeyError> {
+    match fields.get(key) {
+        Some(v) => v
+            .as_i64()
+            .filter(|n| *n >= 0)
+            .ok_or_else(|| KeyError::new(key, format!("expected a non-negative integer, got {v}"))),
+        None => Err(KeyError::new(key, format!("missing field `{key}`"))),
+    }
+}
+
 /// A key value as JSON (policy and replay files).
 pub fn toml_to_json(v: &toml::Value) -> serde_json::Value {
     serde_json::to_value(v).unwrap_or(serde_json::Value::Null)

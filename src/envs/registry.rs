@@ -157,6 +157,24 @@ pub fn find(name: &str) -> Option<&'static dyn DomainEntry> {
         .find(|d| names_of(*d).any(|n| n == name))
 }
 
+/// A name no known domain answers to, and the names that would have been found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("unknown domain `{name}`: this binary has {known}")]
+pub struct UnknownDomain {
+    pub name: String,
+    /// Every known domain as `name (tag)` ([`names_and_tags`]).
+    pub known: String,
+}
+
+/// The domain answering to `name` ([`find`]), or an error naming it and the known ones: what
+/// every reader of a file that names a domain reports.
+pub fn lookup(name: &str) -> Result<&'static dyn DomainEntry, UnknownDomain> {
+    find(name).ok_or_else(|| UnknownDomain {
+        name: name.to_string(),
+        known: names_and_tags(),
+    })
+}
+
 /// The `env_name` of every known domain, built-in first (for messages listing the choices).
 pub fn names() -> Vec<&'static str> {
     let registered = REGISTERED.read().unwrap_or_else(|e| e.into_inner());
@@ -192,13 +210,8 @@ impl<'de> Deserialize<'de> for CustomEnv {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         use serde::de::Error;
         let saved = SavedEnv::deserialize(d)?;
-        let domain = find(&saved.domain).ok_or_else(|| {
-            D::Error::custom(format!(
-                "the saved environment is of domain `{}`, which this binary does not have (it has {})",
-                saved.domain,
-                names_and_tags()
-            ))
-        })?;
+        let domain = lookup(&saved.domain)
+            .map_err(|e| D::Error::custom(format!("the saved environment's domain: {e}")))?;
         match domain.restore(&saved.env).map_err(D::Error::custom)? {
             AnyEnv::Custom(env) => Ok(env),
             _ => Err(D::Error::custom(format!(

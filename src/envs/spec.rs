@@ -22,8 +22,8 @@ pub struct EnvSpec {
 /// Why a spec could not be made: no such domain, or a bad key.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpecError {
-    #[error("unknown domain `{name}`: this binary has {known}")]
-    UnknownDomain { name: String, known: String },
+    #[error(transparent)]
+    UnknownDomain(#[from] registry::UnknownDomain),
     #[error("{domain}: {source}")]
     Key {
         domain: &'static str,
@@ -36,7 +36,7 @@ impl SpecError {
     /// The config key to blame: `env_name` for an unknown domain, else the bad key.
     pub fn key(&self) -> &str {
         match self {
-            SpecError::UnknownDomain { .. } => "env_name",
+            SpecError::UnknownDomain(_) => "env_name",
             SpecError::Key { source, .. } => &source.key,
         }
     }
@@ -46,25 +46,17 @@ impl EnvSpec {
     /// The domain named `name` (its `env_name`, an alias or its tag) with the keys `given`
     /// (the rest at the domain's defaults).
     pub fn new(name: &str, given: &toml::Table) -> Result<EnvSpec, SpecError> {
-        let domain = registry::find(name).ok_or_else(|| SpecError::UnknownDomain {
-            name: name.to_string(),
-            known: registry::names_and_tags(),
-        })?;
-        Self::of(domain, given)
+        Self::of(registry::lookup(name)?, given)
     }
 
     /// `domain` with the keys `given` (the rest at the domain's defaults).
     pub fn of(domain: &'static dyn DomainEntry, given: &toml::Table) -> Result<EnvSpec, SpecError> {
-        let keys = domain.keys(given).map_err(|source| SpecError::Key {
+        let key_error = |source| SpecError::Key {
             domain: domain.name(),
             source,
-        })?;
-        if let Err(source) = key_usize(&keys, HORIZON_KEY) {
-            return Err(SpecError::Key {
-                domain: domain.name(),
-                source,
-            });
-        }
+        };
+        let keys = domain.keys(given).map_err(key_error)?;
+        key_usize(&keys, HORIZON_KEY).map_err(key_error)?;
         Ok(EnvSpec { domain, keys })
     }
 
@@ -188,12 +180,7 @@ impl<'de> Deserialize<'de> for EnvSpec {
             Some(other) => return Err(D::Error::custom(format!("`env` is not a name: {other}"))),
             None => return Err(D::Error::missing_field("env")),
         };
-        let domain = registry::find(&tag).ok_or_else(|| {
-            D::Error::custom(format!(
-                "unknown domain `{tag}`: this binary has {}",
-                registry::names_and_tags()
-            ))
-        })?;
+        let domain = registry::lookup(&tag).map_err(D::Error::custom)?;
         let keys = domain
             .keys_of_tagged(&object)
             .map_err(|e| D::Error::custom(format!("{tag}: {e}")))?;

@@ -4,7 +4,10 @@
 //! replay files, `{"env": "box-pushing", "grid": 10, "horizon": 100}`.
 
 use super::BoxPushing;
-use crate::envs::domain::{fill_keys, key_table, key_usize, Domain, KeyError, HORIZON_KEY};
+use crate::envs::domain::{
+    fill_keys, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain, KeyError,
+    HORIZON_KEY,
+};
 use crate::envs::EnvError;
 
 /// Largest grid side a config may ask for (paper: 10 and 30), far below [`super::MAX_GRID`]
@@ -54,32 +57,24 @@ impl Domain for BoxPushingDomain {
     /// `tb_m_noisy`, which the reference's command line has for every domain and Box Pushing
     /// runs record as 0: Box Pushing does not read it, so it is always recorded as 0.
     fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
-        let grid = match given.get("grid_dim") {
-            Some(toml::Value::Integer(n)) if *n > 0 && *n as u64 <= MAX_GRID_DIM as u64 => {
-                *n as usize
-            }
-            Some(toml::Value::Integer(n)) if *n > 0 => {
-                return Err(KeyError::new(
-                    "grid_dim",
-                    format!("must be at most {MAX_GRID_DIM}, got {n}"),
-                ))
-            }
-            Some(v) => {
-                return Err(KeyError::new(
-                    "grid_dim",
-                    format!("expected a positive integer, got {v}"),
-                ))
-            }
-            None => DEFAULT_GRID_DIM,
-        };
         let mut keys = fill_keys(
             given,
             key_table([
-                ("grid_dim", (grid as i64).into()),
-                (HORIZON_KEY, (paper_horizon(grid) as i64).into()),
+                ("grid_dim", (DEFAULT_GRID_DIM as i64).into()),
+                (HORIZON_KEY, (paper_horizon(DEFAULT_GRID_DIM) as i64).into()),
                 ("tb_m_noisy", 0.0.into()),
             ]),
         )?;
+        let grid = key_usize(&keys, "grid_dim")?;
+        if grid > MAX_GRID_DIM {
+            return Err(KeyError::new(
+                "grid_dim",
+                format!("must be at most {MAX_GRID_DIM}, got {grid}"),
+            ));
+        }
+        if !given.contains_key(HORIZON_KEY) {
+            keys.insert(HORIZON_KEY.into(), (paper_horizon(grid) as i64).into());
+        }
         keys.insert("tb_m_noisy".into(), toml::Value::Float(0.0));
         BoxPushing::check_params(grid, key_usize(&keys, HORIZON_KEY)?).map_err(key_of)?;
         Ok(keys)
@@ -129,22 +124,9 @@ impl Domain for BoxPushingDomain {
         &self,
         fields: &serde_json::Map<String, serde_json::Value>,
     ) -> Result<toml::Table, KeyError> {
-        if let Some(k) = fields
-            .keys()
-            .find(|k| !["grid", "horizon"].contains(&k.as_str()))
-        {
-            return Err(KeyError::new(
-                k,
-                "unknown field; box-pushing has `grid` and `horizon`",
-            ));
-        }
-        let int = |k: &str| match fields.get(k) {
-            Some(v) => v.as_i64().filter(|n| *n >= 0).ok_or_else(|| {
-                KeyError::new(k, format!("expected a non-negative integer, got {v}"))
-            }),
-            None => Err(KeyError::new(k, format!("missing field `{k}`"))),
-        };
-        let (grid, horizon) = (int("grid")?, int("horizon")?);
+        refuse_unknown_fields(fields, Domain::tag(self), &["grid", "horizon"])?;
+        let grid = tagged_count(fields, "grid")?;
+        let horizon = tagged_count(fields, "horizon")?;
         Domain::keys(
             self,
             &key_table([("grid_dim", grid.into()), (HORIZON_KEY, horizon.into())]),

@@ -5,7 +5,8 @@
 
 use super::{Warehouse, WarehouseParams};
 use crate::envs::domain::{
-    fill_keys, key_f64, key_table, key_usize, Domain, KeyError, HORIZON_KEY,
+    fill_keys, key_f64, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain,
+    KeyError, HORIZON_KEY,
 };
 use crate::envs::EnvError;
 
@@ -114,24 +115,8 @@ impl Domain for WarehouseDomain {
         &self,
         fields: &serde_json::Map<String, serde_json::Value>,
     ) -> Result<toml::Table, KeyError> {
-        if let Some(k) = fields
-            .keys()
-            .find(|k| !["horizon", "tb_m_noisy"].contains(&k.as_str()))
-        {
-            return Err(KeyError::new(
-                k,
-                "unknown field; warehouse has `horizon` and `tb_m_noisy`",
-            ));
-        }
-        let horizon = match fields.get("horizon") {
-            Some(v) => v.as_i64().filter(|n| *n >= 0).ok_or_else(|| {
-                KeyError::new(
-                    "horizon",
-                    format!("expected a non-negative integer, got {v}"),
-                )
-            })?,
-            None => return Err(KeyError::new("horizon", "missing field `horizon`")),
-        };
+        refuse_unknown_fields(fields, Domain::tag(self), &["horizon", "tb_m_noisy"])?;
+        let horizon = tagged_count(fields, "horizon")?;
         let noise = match fields.get("tb_m_noisy") {
             Some(v) => v.as_f64().ok_or_else(|| {
                 KeyError::new("tb_m_noisy", format!("expected a number, got {v}"))

@@ -509,15 +509,8 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
         Some(v) => return Err(bad("env_name", format!("expected a domain name, got {v}"))),
         None => "BP_MA",
     };
-    let domain = crate::envs::registry::find(env_name).ok_or_else(|| {
-        bad(
-            "env_name",
-            format!(
-                "unknown domain {env_name:?}: this binary has {}",
-                crate::envs::registry::names_and_tags()
-            ),
-        )
-    })?;
+    let domain =
+        crate::envs::registry::lookup(env_name).map_err(|e| bad("env_name", e.to_string()))?;
     let env = EnvSpec::from_keys_in(domain, point).map_err(|e| bad(e.key(), e.to_string()))?;
     let defaults = RunSettings::paper(env, method);
     let mut table = toml::Table::try_from(&defaults).expect("RunSettings serializes to a table");

@@ -45,12 +45,7 @@ impl RunSettings {
             Some(other) => return Err(format!("`env_name` is not a name: {other}")),
             None => return Err("missing field `env_name`".into()),
         };
-        let domain = crate::envs::registry::find(&name).ok_or_else(|| {
-            format!(
-                "unknown `env_name` {name:?}: this binary has {}",
-                crate::envs::registry::names_and_tags()
-            )
-        })?;
+        let domain = crate::envs::registry::lookup(&name).map_err(|e| e.to_string())?;
         let env = EnvSpec::from_keys_in(domain, &table).map_err(|e| e.to_string())?;
         for key in env.keys().keys() {
             table.remove(key);
