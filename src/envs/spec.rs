@@ -79,12 +79,6 @@ impl EnvSpec {
         Self::of(domain, &given)
     }
 
-    /// The named domain at its default keys (see [`Self::new`]); panics on an unknown name, so
-    /// only for names known to be built in.
-    pub fn built_in(name: &str) -> EnvSpec {
-        Self::new(name, &toml::Table::new()).expect("a built-in domain at its defaults")
-    }
-
     /// The domain.
     pub fn domain(&self) -> &'static dyn DomainEntry {
         self.domain
@@ -130,13 +124,6 @@ impl EnvSpec {
             toml::Value::Integer(d) => Some(*d as f64),
             _ => None,
         }
-    }
-
-    /// The same domain with `key` set to `value` (checked by the domain).
-    pub fn with(&self, key: &str, value: impl Into<toml::Value>) -> Result<EnvSpec, SpecError> {
-        let mut keys = self.keys.clone();
-        keys.insert(key.to_string(), value.into());
-        Self::of(self.domain, &keys)
     }
 
     /// Build the environment, in its reset state. Errors name the bad key.
