@@ -162,6 +162,8 @@ impl MacroEnv for Rendezvous {
         Ok(StepOutcome {
             reward,
             done: self.done,
+            // The horizon cut counts as terminal, as in the ICRA domains.
+            truncated: false,
         })
     }
 

@@ -106,6 +106,7 @@ impl MacroEnv for Beacon {
         Ok(StepOutcome {
             reward,
             done: self.t >= HORIZON,
+            truncated: false,
         })
     }
     fn obs(&self, agent: usize) -> &[f32] {

@@ -132,4 +132,10 @@ impl MacroEnv for AnyEnv {
     fn draw(&self) -> Option<crate::draw::Picture> {
         dispatch!(self, e => e.draw())
     }
+    fn state_size(&self) -> usize {
+        dispatch!(self, e => e.state_size())
+    }
+    fn write_state(&self, out: &mut [f32]) {
+        dispatch!(self, e => e.write_state(out))
+    }
 }

@@ -139,4 +139,10 @@ impl MacroEnv for CustomEnv {
     fn draw(&self) -> Option<crate::draw::Picture> {
         self.env.draw()
     }
+    fn state_size(&self) -> usize {
+        self.env.state_size()
+    }
+    fn write_state(&self, out: &mut [f32]) {
+        self.env.write_state(out)
+    }
 }

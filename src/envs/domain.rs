@@ -56,7 +56,7 @@ impl KeyError {
 /// #     fn horizon(&self) -> usize { self.horizon }
 /// #     fn reset(&mut self, _: &mut EnvRng) {}
 /// #     fn step(&mut self, _: &[usize], _: &mut EnvRng) -> Result<StepOutcome, EnvError> {
-/// #         Ok(StepOutcome { reward: 0.0, done: true })
+/// #         Ok(StepOutcome::ended(0.0, true))
 /// #     }
 /// #     fn obs(&self, _: usize) -> &[f32] { &[0.0] }
 /// #     fn executed(&self) -> &[usize] { &[0] }

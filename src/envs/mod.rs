@@ -52,8 +52,39 @@ pub enum EnvError {
 pub struct StepOutcome {
     /// The shared team reward of this primitive step (f64 so sums match the reference bit for bit).
     pub reward: f64,
-    /// Episode over: goal reached or horizon hit (spec: the horizon cut is terminal, quirk Q7).
+    /// Episode over: a terminal state or the horizon.
     pub done: bool,
+    /// The episode was cut by the horizon in a state that is not terminal, so a learner should
+    /// bootstrap from it (MacroMARL's runner). Only meaningful with `done`. The ICRA domains
+    /// never set it: their reference treats the horizon cut as terminal (quirk Q7), so each
+    /// domain says which way its reference goes.
+    pub truncated: bool,
+}
+
+impl StepOutcome {
+    /// A step that did not end the episode.
+    pub fn running(reward: f64) -> Self {
+        Self {
+            reward,
+            done: false,
+            truncated: false,
+        }
+    }
+
+    /// A step after which the episode is over: `terminal` (a real terminal state, or a
+    /// horizon the domain's reference treats as one) or else cut by the horizon (truncated).
+    pub fn ended(reward: f64, terminal: bool) -> Self {
+        Self {
+            reward,
+            done: true,
+            truncated: !terminal,
+        }
+    }
+
+    /// The episode ended in a terminal state (not a time-limit cut).
+    pub fn terminal(&self) -> bool {
+        self.done && !self.truncated
+    }
 }
 
 /// What the first record of an episode holds as its "before" observation (quirk Q20).
@@ -105,8 +136,9 @@ pub enum FirstRecordObs {
 /// - **Reward** ([`StepOutcome::reward`]) is one shared team reward per primitive step; the
 ///   learners sum it over a macro-action themselves.
 /// - **Episode end.** [`StepOutcome::done`] is true on the step the episode ends: a terminal
-///   state, or the horizon ([`Self::horizon`] primitive steps, which the domain enforces; the
-///   ICRA learners treat the horizon cut as terminal, quirk Q7). At `done`, every agent's
+///   state, or the horizon ([`Self::horizon`] primitive steps, which the domain enforces). A
+///   horizon cut sets [`StepOutcome::truncated`] where the domain's reference bootstraps from it
+///   (MacroMARL's domains); the ICRA domains treat it as terminal (quirk Q7). At `done`, every agent's
 ///   macro-action counts as ended for its final transition only if `mac_done` says so; an
 ///   unfinished one is dropped by the learners (spec Q6). After `done`, [`Self::step`] is
 ///   [`EnvError::EpisodeOver`] until [`Self::reset`].
@@ -186,6 +218,17 @@ pub trait MacroEnv {
     /// it), drawn with [`crate::draw`]; `None` (the default) when the domain draws none.
     fn draw(&self) -> Option<crate::draw::Picture> {
         None
+    }
+
+    /// Length of the global state vector ([`Self::write_state`]), the input of centralized
+    /// state critics (MacroMARL's `get_state()`); 0 (the default) when the domain has none.
+    fn state_size(&self) -> usize {
+        0
+    }
+    /// Write the current global state into `out`, which must have length [`Self::state_size`]
+    /// (the default writes nothing, for a domain without a state).
+    fn write_state(&self, out: &mut [f32]) {
+        assert!(out.is_empty(), "this domain has no global state");
     }
 
     /// Total joint observation size (sum of the agents' sizes), the centralized nets' input.

@@ -389,6 +389,7 @@ impl MacroEnv for Walk {
         Ok(crate::envs::StepOutcome {
             reward: 1.0,
             done: self.t == 3,
+            truncated: false,
         })
     }
     fn obs(&self, _: usize) -> &[f32] {

@@ -294,7 +294,11 @@ mod tests {
                     self.obs[i] = [(10 * self.k + i) as f32];
                 }
             }
-            Ok(StepOutcome { reward, done })
+            Ok(StepOutcome {
+                reward,
+                done,
+                truncated: false,
+            })
         }
         fn obs(&self, agent: usize) -> &[f32] {
             &self.obs[agent]

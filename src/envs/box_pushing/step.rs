@@ -163,6 +163,7 @@ impl BoxPushing {
         Ok(StepOutcome {
             reward,
             done: self.done,
+            truncated: false,
         })
     }
 }

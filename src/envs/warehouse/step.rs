@@ -83,6 +83,11 @@ impl Warehouse {
         let done = terminal || self.count == self.params.terminate_step;
         self.over = done;
         self.last_reward = r;
-        StepOutcome { reward: r, done }
+        // The horizon cut is terminal, as the ICRA reference treats it (Q7).
+        StepOutcome {
+            reward: r,
+            done,
+            truncated: false,
+        }
     }
 }
