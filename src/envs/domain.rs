@@ -252,7 +252,8 @@ pub fn toml_to_json(v: &toml::Value) -> serde_json::Value {
     serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
 }
 
-/// A JSON value as a key value: numbers, strings, booleans and arrays of them; `None` otherwise.
+/// A JSON value as a key value: numbers, strings, booleans, and arrays and objects of them
+/// (MacroMARL's Overcooked takes a `rewardList` table); `None` for `null` anywhere.
 pub fn json_to_toml(v: &serde_json::Value) -> Option<toml::Value> {
     use serde_json::Value as J;
     Some(match v {
@@ -264,7 +265,12 @@ pub fn json_to_toml(v: &serde_json::Value) -> Option<toml::Value> {
         },
         J::String(s) => toml::Value::String(s.clone()),
         J::Array(a) => toml::Value::Array(a.iter().map(json_to_toml).collect::<Option<_>>()?),
-        J::Null | J::Object(_) => return None,
+        J::Object(m) => toml::Value::Table(
+            m.iter()
+                .map(|(k, v)| Some((k.clone(), json_to_toml(v)?)))
+                .collect::<Option<_>>()?,
+        ),
+        J::Null => return None,
     })
 }
 

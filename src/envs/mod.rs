@@ -15,6 +15,7 @@ pub mod box_pushing;
 pub mod built_in;
 pub mod custom_env;
 pub mod domain;
+pub mod macromarl;
 pub mod registry;
 pub mod replay;
 pub mod spec;

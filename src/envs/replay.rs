@@ -5,6 +5,14 @@
 //! environment is reset, then fed one joint action per primitive step until done or the steps run
 //! out. An agent still busy with its macro-action ignores its entry, which may be -1 as in the
 //! reference's logs; a free agent's entry must be a valid macro-action index.
+//!
+//! The reference form names the domain by its MacroMARL gym id and its keyword arguments:
+//! `{"env": "BP-MA-v0", "params": {"grid_dim": [6, 6], ...}, "steps": [...]}`. The episode is then
+//! as long as `steps` (the runner's horizon is not part of it; a domain whose env itself ends at a
+//! horizon takes it from its params), `done` is the env's own terminal flag, and each line also
+//! has `rewards` (the per-agent list the reference returns) and, for a domain with a global state,
+//! `state` (the reference's `get_state()`), so the output diffs against the reference's trace
+//! (`scripts/macromarl_traces.py`).
 
 use rand::SeedableRng;
 use serde::Serialize;
@@ -21,6 +29,8 @@ pub struct ReplayFile {
     pub spec: EnvSpec,
     /// `steps[k][i]`: agent i's entry at primitive step k+1 (ignored while agent i is busy).
     pub steps: Vec<Vec<i64>>,
+    /// The file named the domain by its reference id and `params` (see the module doc).
+    pub reference_form: bool,
 }
 
 /// Why a replay file was refused. Messages name the step (1-based) and agent at fault.
@@ -36,6 +46,14 @@ pub enum ReplayFileError {
     BadSteps(#[source] serde_json::Error),
     #[error("bad environment description: {0}")]
     BadSpec(#[source] serde_json::Error),
+    #[error("bad environment description: {0}")]
+    BadParams(#[source] super::spec::SpecError),
+    #[error("`params` must be an object of the reference's keyword arguments, got {0}")]
+    ParamsNotAnObject(&'static str),
+    #[error("`params.{0}` holds a null, which is not a parameter value")]
+    NullParam(String),
+    #[error("`env` must be a string naming the domain")]
+    MissingEnv,
     #[error("cannot build the environment: {0}")]
     Build(#[source] EnvError),
     #[error("step {step}: expected {expected} actions (one per agent), got {got}")]
@@ -70,9 +88,51 @@ pub fn parse_replay(text: &str) -> Result<ReplayFile, ReplayFileError> {
     };
     let steps = map.remove("steps").ok_or(ReplayFileError::MissingSteps)?;
     let steps: Vec<Vec<i64>> = serde_json::from_value(steps).map_err(ReplayFileError::BadSteps)?;
+    if let Some(params) = map.remove("params") {
+        let spec = reference_spec(&map, params, steps.len())?;
+        return Ok(ReplayFile {
+            spec,
+            steps,
+            reference_form: true,
+        });
+    }
     let spec: EnvSpec =
         serde_json::from_value(Value::Object(map)).map_err(ReplayFileError::BadSpec)?;
-    Ok(ReplayFile { spec, steps })
+    Ok(ReplayFile {
+        spec,
+        steps,
+        reference_form: false,
+    })
+}
+
+/// The domain of a reference-form file: `env` (the gym id or any name of the domain) with its
+/// `params` as keys, and a horizon no shorter than `steps` unless the params set one.
+fn reference_spec(
+    map: &serde_json::Map<String, Value>,
+    params: Value,
+    n_steps: usize,
+) -> Result<EnvSpec, ReplayFileError> {
+    let Some(Value::String(env)) = map.get("env") else {
+        return Err(ReplayFileError::MissingEnv);
+    };
+    if let Some(other) = map.keys().find(|k| *k != "env") {
+        return Err(ReplayFileError::BadSpec(serde::de::Error::custom(format!(
+            "unknown field `{other}` beside `params` (the reference form has `env`, `params` and `steps`)"
+        ))));
+    }
+    let Value::Object(params) = params else {
+        return Err(ReplayFileError::ParamsNotAnObject(json_kind(&params)));
+    };
+    let mut given = toml::Table::new();
+    for (k, v) in &params {
+        let value =
+            super::domain::json_to_toml(v).ok_or_else(|| ReplayFileError::NullParam(k.clone()))?;
+        given.insert(k.clone(), value);
+    }
+    given
+        .entry(super::domain::HORIZON_KEY)
+        .or_insert_with(|| (n_steps.max(1) as i64).into());
+    EnvSpec::new(env, &given).map_err(ReplayFileError::BadParams)
 }
 
 fn json_kind(v: &Value) -> &'static str {
@@ -96,11 +156,17 @@ pub struct ReplayLine {
     pub obs: Vec<Vec<f32>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reward: Option<f64>,
+    /// The per-agent reward list (reference form only): the team reward for every agent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rewards: Option<Vec<f64>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub done: Option<bool>,
     /// Each agent's macro-action-done flag as 0 or 1.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mac_done: Option<Vec<u8>>,
+    /// The global state (reference form, domains with one only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub state: Option<Vec<f32>>,
 }
 
 /// A replayed line and, when asked for, the ASCII picture of the state after it.
@@ -173,14 +239,23 @@ fn walk(
     let mut rng = EnvRng::seed_from_u64(REPLAY_SEED);
     env.reset(&mut rng);
     let picture = |env: &super::AnyEnv| pictures.then(|| env.render_ascii());
+    let state = |env: &super::AnyEnv| {
+        (file.reference_form && env.state_size() > 0).then(|| {
+            let mut s = vec![0.0; env.state_size()];
+            env.write_state(&mut s);
+            s
+        })
+    };
     on_frame(ReplayFrame {
         line: ReplayLine {
             t: 0,
             executed: None,
             obs: all_obs(&env),
             reward: None,
+            rewards: None,
             done: None,
             mac_done: None,
+            state: state(&env),
         },
         picture: picture(&env),
     })?;
@@ -214,8 +289,14 @@ fn walk(
                 executed: Some(env.executed().to_vec()),
                 obs: all_obs(&env),
                 reward: Some(out.reward),
-                done: Some(out.done),
+                rewards: file.reference_form.then(|| vec![out.reward; n_agents]),
+                done: Some(if file.reference_form {
+                    out.terminal()
+                } else {
+                    out.done
+                }),
                 mac_done: Some(env.mac_done().iter().map(|&d| u8::from(d)).collect()),
+                state: state(&env),
             },
             picture: picture(&env),
         })?;

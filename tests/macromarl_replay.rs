@@ -1,0 +1,100 @@
+//! MacroMARL's domains replay the reference step for step (issue 27).
+//!
+//! Each fixture in `tests/fixtures/macromarl/` is a pair written by `scripts/macromarl_traces.py`
+//! from the reference code itself (`scripts/macromarl_fixtures.sh` regenerates them all): the
+//! actions in the reference form of `macdec replay` (`NAME.actions.json`) and what the reference
+//! printed for them (`NAME.trace.jsonl.gz`). The replay of the actions must give the same lines:
+//! the same number of steps, the same executed macro-actions, `mac_done` and `done` flags, and
+//! the same observations, rewards and states (to f32 precision: the reference computes in f64).
+
+use std::io::Read;
+use std::path::PathBuf;
+
+use macdec::envs::replay::{parse_replay, run_replay};
+use serde_json::Value;
+
+fn fixture(name: &str, ext: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/macromarl")
+        .join(format!("{name}.{ext}"))
+}
+
+/// The reference's trace lines of fixture `name`.
+fn reference_lines(name: &str) -> Vec<Value> {
+    let gz = std::fs::read(fixture(name, "trace.jsonl.gz")).unwrap();
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(&gz[..])
+        .read_to_string(&mut text)
+        .unwrap();
+    text.lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// Whether two numbers agree to f32 precision (relative 1e-6, absolute 1e-6 near zero).
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-6 * (1.0 + a.abs().max(b.abs()))
+}
+
+/// Compare `ours` with the reference's `theirs` field by field; `at` names the place.
+fn assert_same(ours: &Value, theirs: &Value, at: &str) {
+    match (ours, theirs) {
+        (Value::Number(a), Value::Number(b)) => assert!(
+            close(a.as_f64().unwrap(), b.as_f64().unwrap()),
+            "{at}: macdec {a}, reference {b}"
+        ),
+        (Value::Array(a), Value::Array(b)) => {
+            assert_eq!(a.len(), b.len(), "{at}: lengths differ: {ours} vs {theirs}");
+            for (k, (x, y)) in a.iter().zip(b).enumerate() {
+                assert_same(x, y, &format!("{at}[{k}]"));
+            }
+        }
+        (Value::Object(a), Value::Object(b)) => {
+            let mut ka: Vec<&String> = a.keys().collect();
+            let mut kb: Vec<&String> = b.keys().collect();
+            ka.sort();
+            kb.sort();
+            assert_eq!(ka, kb, "{at}: fields differ");
+            for k in ka {
+                assert_same(&a[k], &b[k], &format!("{at}.{k}"));
+            }
+        }
+        _ => assert_eq!(ours, theirs, "{at}"),
+    }
+}
+
+/// Replay fixture `name` and compare every line with the reference's.
+fn replays_like_the_reference(name: &str) {
+    let text = std::fs::read_to_string(fixture(name, "actions.json")).unwrap();
+    let file = parse_replay(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let replay = run_replay(&file, false).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let theirs = reference_lines(name);
+    assert_eq!(
+        replay.frames.len(),
+        theirs.len(),
+        "{name}: macdec ran {} steps, the reference {}",
+        replay.frames.len() - 1,
+        theirs.len() - 1
+    );
+    for (frame, their) in replay.frames.iter().zip(&theirs) {
+        let ours = serde_json::to_value(&frame.line).unwrap();
+        assert_same(&ours, their, &format!("{name} t={}", frame.line.t));
+    }
+}
+
+fn all(names: &[&str]) {
+    for name in names {
+        replays_like_the_reference(name);
+    }
+}
+
+#[test]
+fn bp_ma_v0_replays_the_reference() {
+    let mut names = Vec::new();
+    for grid in [6, 8, 10, 12, 14] {
+        names.push(format!("bp_ma_{grid}_optimum"));
+        names.push(format!("bp_ma_{grid}_random0"));
+        names.push(format!("bp_ma_{grid}_random1"));
+    }
+    all(&names.iter().map(String::as_str).collect::<Vec<_>>());
+}
