@@ -9,6 +9,10 @@ for g in 6 8 10 12 14; do
     $PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [$g, $g], $BP}" --random-seed $s --horizon 100 --out $F/bp_ma_${g}_random$s
   done
 done
+# Longer random episodes (penalties, misses) on 6x6 and 4x4, and a horizon cut on 10x10 at step 25.
+$PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [6, 6], $BP}" --random-seed 10 --horizon 100 --out $F/bp_ma_6_random10
+$PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [4, 4], $BP}" --random-seed 3 --horizon 100 --out $F/bp_ma_4_random3
+$PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [10, 10], $BP}" --random-seed 4 --horizon 25 --out $F/bp_ma_10_cut25_random4
 P='"grid_dim": [6, 6], '"$BP"', "TB_move_speed": 0.6, "TB_move_noisy": 0.0, "TB_move_cost": 0.0, "fetch_pass_obj_tc": 4, "fetch_look_for_obj_tc": 6, "fetch_manip_noisy": 0.0, "delay_delivery_penalty": 0.0, "obs_human_wait": false'
 $PY $S --macromarl $MM --env OSD-D-v7 --params "{$P, \"n_agent\": 3, \"terminate_step\": 200, \"human_speed_per_step\": [[27,20,20,20],[27,20,20,20]]}" --random-seed 0 --horizon 200 --out $F/osd_d_v7_a_random0
 $PY $S --macromarl $MM --env OSD-D-v7 --params "{$P, \"n_agent\": 3, \"terminate_step\": 200, \"human_speed_per_step\": [[18,15,15,15],[48,18,15,15]]}" --random-seed 1 --horizon 200 --out $F/osd_d_v7_b_random1

@@ -96,5 +96,14 @@ fn bp_ma_v0_replays_the_reference() {
         names.push(format!("bp_ma_{grid}_random0"));
         names.push(format!("bp_ma_{grid}_random1"));
     }
+    // Longer episodes with penalties on 6 x 6 and 4 x 4, and a horizon cut that is no terminal.
+    names.extend(
+        [
+            "bp_ma_6_random10",
+            "bp_ma_4_random3",
+            "bp_ma_10_cut25_random4",
+        ]
+        .map(String::from),
+    );
     all(&names.iter().map(String::as_str).collect::<Vec<_>>());
 }

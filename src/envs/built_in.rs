@@ -13,11 +13,12 @@ use super::custom_env::{CustomEnv, ErasedEnv};
 use super::{EnvError, EnvRng, FirstRecordObs, MacroEnv, StepOutcome};
 
 /// The list of built-in domains, handed to the macro `$then` (which generates what the list
-/// decides).
+/// decides). Domains that share an environment type share its variant: `Variant(Env) = Domain;
+/// OtherDomain,`.
 macro_rules! built_in_domains {
     ($then:ident) => {
         $then! {
-            BoxPushing(crate::envs::box_pushing::BoxPushing) = crate::envs::box_pushing::BoxPushingDomain,
+            BoxPushing(crate::envs::box_pushing::BoxPushing) = crate::envs::box_pushing::BoxPushingDomain; crate::envs::bp_ma_v0::BpMaV0Domain,
             Warehouse(crate::envs::warehouse::Warehouse) = crate::envs::warehouse::WarehouseDomain,
         }
     };
@@ -26,7 +27,7 @@ pub(crate) use built_in_domains;
 
 /// Generate [`AnyEnv`], [`AnyEnv::hold`] and the forwarding macro from the list.
 macro_rules! any_env {
-    ($($variant:ident($env:ty) = $domain:expr,)+) => {
+    ($($variant:ident($env:ty) = $domain:expr $(; $more:expr)*,)+) => {
         /// Any built environment: a built-in domain's, by `match` (no dynamic dispatch on the hot
         /// path, `Clone`, and a checkpoint's bincode names the variant), or a user's own behind
         /// [`AnyEnv::Custom`].

@@ -16,9 +16,9 @@ use super::domain::{Domain, KeyError};
 
 /// Generate [`BUILT_IN`] from the list of built-in domains ([`built_in_domains`]).
 macro_rules! built_in_list {
-    ($($variant:ident($env:ty) = $domain:expr,)+) => {
+    ($($variant:ident($env:ty) = $domain:expr $(; $more:expr)*,)+) => {
         /// The built-in domains, in list order.
-        pub static BUILT_IN: &[&'static dyn DomainEntry] = &[$(&$domain,)+];
+        pub static BUILT_IN: &[&'static dyn DomainEntry] = &[$(&$domain, $(&$more,)*)+];
     };
 }
 built_in_domains!(built_in_list);
@@ -222,8 +222,13 @@ mod tests {
         assert_eq!(find("box-pushing").unwrap().name(), "BP_MA");
         assert_eq!(find("OSD_S_4").unwrap().name(), "OSD_S_4");
         assert_eq!(find("warehouse").unwrap().name(), "OSD_S_4");
+        assert_eq!(find("BP-MA-v0").unwrap().name(), "BP-MA-v0");
         assert!(find("Pong").is_none());
-        assert!(names_and_tags().starts_with("BP_MA (box-pushing), OSD_S_4 (warehouse)"));
+        let all = names_and_tags();
+        assert!(
+            all.starts_with("BP_MA (box-pushing), BP-MA-v0, OSD_S_4 (warehouse)"),
+            "{all}"
+        );
     }
 
     /// Two distinct unit-struct domains (they may share an address) and a name clash.
@@ -272,7 +277,8 @@ mod tests {
     fn a_built_in_name_cannot_be_registered_again() {
         let bp = find("BP_MA").unwrap();
         // The same object is accepted (idempotent) ...
-        let err = register(BUILT_IN[1]);
+        let wtd = *BUILT_IN.iter().find(|d| d.name() == "OSD_S_4").unwrap();
+        let err = register(wtd);
         // ... but built-in objects are not in the run-time list, so re-registering one clashes.
         assert_eq!(err, Err(RegistryError::NameTaken("OSD_S_4".into())));
         assert_eq!(bp.name(), "BP_MA");

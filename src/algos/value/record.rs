@@ -280,7 +280,7 @@ impl Episode {
     pub fn joint_obs_size(&self) -> usize {
         self.joint_obs_size
     }
-    /// Whether the last record ends the episode (what a buffer expects of a finished episode).
+    /// Whether the last record is terminal (false for an episode the horizon truncated).
     pub fn is_finished(&self) -> bool {
         self.done.last().copied().unwrap_or(false)
     }

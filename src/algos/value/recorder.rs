@@ -92,17 +92,19 @@ impl Recorder {
         result
     }
 
-    /// Record one primitive step: `executed` [N], `next_joint_obs` [D], the team `reward`, the
-    /// episode-over flag and v [N]. Returns the finished episode when `done` (and then expects
-    /// [`Self::begin`] before the next step).
+    /// Record one primitive step: `executed` [N], `next_joint_obs` [D], the step's `outcome`
+    /// (team reward, episode over, truncated) and v [N]. The record's `done` is the terminal
+    /// flag the targets mask with: true at a terminal step, false at a horizon cut the domain
+    /// truncates (MacroMARL's domains), so the target bootstraps there. Returns the finished
+    /// episode when the episode is over (and then expects [`Self::begin`] before the next step).
     pub fn record(
         &mut self,
         executed: &[usize],
         next_joint_obs: &[f32],
-        reward: f64,
-        done: bool,
+        outcome: StepOutcome,
         valid: &[bool],
     ) -> Result<Option<Episode>, ReplayError> {
+        let reward = outcome.reward;
         if !self.started {
             return Err(ReplayError::EpisodeNotStarted);
         }
@@ -159,12 +161,12 @@ impl Recorder {
             acc_id: &self.acc_id_f32,
             acc_joint: self.acc_joint as f32,
             next_obs: next_joint_obs,
-            done,
+            done: outcome.terminal(),
             valid,
         })?;
         self.last_obs.copy_from_slice(next_joint_obs);
 
-        if done {
+        if outcome.done {
             self.started = false;
             let fresh = self.fresh_episode();
             Ok(Some(std::mem::replace(&mut self.episode, fresh)))
@@ -183,13 +185,7 @@ impl Recorder {
         self.check_env(env)?;
         let mut obs = std::mem::take(&mut self.next_obs);
         env.write_joint_obs(&mut obs);
-        let result = self.record(
-            env.executed(),
-            &obs,
-            outcome.reward,
-            outcome.done,
-            env.mac_done(),
-        );
+        let result = self.record(env.executed(), &obs, outcome, env.mac_done());
         self.next_obs = obs;
         result
     }
@@ -410,7 +406,12 @@ mod tests {
         }
         // stepping on without begin is refused
         assert_eq!(
-            rec.record(&[0, 0], &[0.0, 0.0], 1.0, false, &[true, true]),
+            rec.record(
+                &[0, 0],
+                &[0.0, 0.0],
+                StepOutcome::running(1.0),
+                &[true, true]
+            ),
             Err(ReplayError::EpisodeNotStarted)
         );
         env.reset(&mut rng);
@@ -426,16 +427,33 @@ mod tests {
     }
 
     #[test]
+    fn a_truncated_end_finishes_the_episode_without_a_terminal_record() {
+        let layout = Layout::new(&[1, 1], &[2, 2]).unwrap();
+        let mut rec = Recorder::new(&layout, FirstRecordObs::Reset, 4);
+        let step = |rec: &mut Recorder, outcome| {
+            rec.record(&[0, 0], &[0.0, 0.0], outcome, &[true, true])
+                .unwrap()
+        };
+        rec.begin(&[0.0, 0.0]).unwrap();
+        assert!(step(&mut rec, StepOutcome::running(1.0)).is_none());
+        let cut = step(&mut rec, StepOutcome::ended(1.0, false)).unwrap();
+        assert_eq!((cut.len(), cut.done(1)), (2, false));
+        rec.begin(&[0.0, 0.0]).unwrap();
+        let terminal = step(&mut rec, StepOutcome::ended(1.0, true)).unwrap();
+        assert!(terminal.done(0));
+    }
+
+    #[test]
     fn record_refuses_wrong_widths() {
         let layout = Layout::new(&[1, 1], &[2, 2]).unwrap();
         let mut rec = Recorder::new(&layout, FirstRecordObs::Reset, 4);
         assert!(rec.begin(&[0.0]).is_err());
         rec.begin(&[0.0, 0.0]).unwrap();
         assert!(rec
-            .record(&[0, 0], &[0.0, 0.0], 1.0, false, &[true])
+            .record(&[0, 0], &[0.0, 0.0], StepOutcome::running(1.0), &[true])
             .is_err());
         assert!(rec
-            .record(&[0], &[0.0, 0.0], 1.0, false, &[true, true])
+            .record(&[0], &[0.0, 0.0], StepOutcome::running(1.0), &[true, true])
             .is_err());
     }
 }

@@ -3,7 +3,7 @@
 //! paper's settings for it (spec `algorithms.md` 10.1, 10.2) and its tagged form in policy and
 //! replay files, `{"env": "box-pushing", "grid": 10, "horizon": 100}`.
 
-use super::BoxPushing;
+use super::{BoxPushing, Rules};
 use crate::envs::domain::{
     fill_keys, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain, KeyError,
     HORIZON_KEY,
@@ -76,7 +76,8 @@ impl Domain for BoxPushingDomain {
             keys.insert(HORIZON_KEY.into(), (paper_horizon(grid) as i64).into());
         }
         keys.insert("tb_m_noisy".into(), toml::Value::Float(0.0));
-        BoxPushing::check_params(grid, key_usize(&keys, HORIZON_KEY)?).map_err(key_of)?;
+        BoxPushing::check_params(grid, key_usize(&keys, HORIZON_KEY)?, &Rules::ICRA)
+            .map_err(key_of)?;
         Ok(keys)
     }
 

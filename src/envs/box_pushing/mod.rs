@@ -16,11 +16,13 @@ mod navigate;
 pub mod observe;
 mod push;
 mod render;
+pub mod rules;
 mod spec;
 pub mod state;
 mod step;
 
 pub use domain::{BoxPushingDomain, DEFAULT_GRID_DIM, MAX_GRID_DIM};
+pub use rules::Rules;
 pub use spec::{paper_spec, spec};
 
 #[cfg(test)]
@@ -37,8 +39,13 @@ use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
 /// Number of robots.
 pub const N_AGENTS: usize = 2;
 
-/// Smallest supported grid side: the spec's general layout formulas need N >= 8 (spec 2).
-pub const MIN_GRID: usize = 8;
+/// Smallest grid side of the ICRA paper's Box Pushing: the spec's general layout formulas need
+/// N >= 8 (spec 2). MacroMARL's rules go down to 4 ([`Rules::min_grid`]).
+pub const MIN_GRID: usize = Rules::ICRA.min_grid;
+
+/// Length of the global state ([`MacroEnv::write_state`]): per robot x, y and a one-hot heading,
+/// per box x, y (MacroMARL's `get_state()`).
+pub const STATE_SIZE: usize = N_AGENTS * 6 + 3 * 2;
 
 /// Largest supported grid side, so every coordinate (even a robot lifted above the grid by the Q2
 /// joint push) fits in `i32` with room to spare.
@@ -65,6 +72,7 @@ pub struct DeliveryStats {
 pub struct BoxPushing {
     layout: GridLayout,
     horizon: usize,
+    rules: Rules,
     robots: [Robot; N_AGENTS],
     boxes: Boxes,
     /// The joint big-box push latch (spec 4 step 3, 5.4): once on, it stays on until reset.
@@ -79,12 +87,14 @@ pub struct BoxPushing {
 }
 
 impl BoxPushing {
-    /// Check `grid` and `horizon` as [`Self::new`] does, without building (config validation).
-    pub fn check_params(grid: usize, horizon: usize) -> Result<(), EnvError> {
-        if grid < MIN_GRID {
+    /// Check `grid` and `horizon` as [`Self::with_rules`] does, without building (config
+    /// validation).
+    pub fn check_params(grid: usize, horizon: usize, rules: &Rules) -> Result<(), EnvError> {
+        let min = rules.min_grid;
+        if grid < min {
             return Err(EnvError::InvalidParameter {
                 name: "grid",
-                reason: format!("must be at least {MIN_GRID} (spec section 2 layout), got {grid}"),
+                reason: format!("must be at least {min} (spec section 2 layout), got {grid}"),
             });
         }
         if !grid.is_multiple_of(2) {
@@ -110,20 +120,27 @@ impl BoxPushing {
         Ok(())
     }
 
-    /// An N x N Box Pushing environment with an episode horizon in primitive steps (paper: 10 with
-    /// 100, 30 with 200).
-    ///
-    /// `grid` must be even and at least 8: the spec's layout formulas need N >= 8 (spec 2) and an
-    /// odd N puts the big box and its waypoints off the cell centres, where they can never be
-    /// reached or seen (quirk Q9). `horizon` must be at least 1.
+    /// The ICRA paper's N x N Box Pushing with an episode horizon in primitive steps (paper: 10
+    /// with 100, 30 with 200): [`Self::with_rules`] with [`Rules::ICRA`].
     pub fn new(grid: usize, horizon: usize) -> Result<Self, EnvError> {
-        Self::check_params(grid, horizon)?;
+        Self::with_rules(grid, horizon, Rules::ICRA)
+    }
+
+    /// An N x N Box Pushing environment under `rules`, with an episode horizon in primitive steps.
+    ///
+    /// `grid` must be even and at least `rules.min_grid`: the spec's layout formulas need N >= 8
+    /// (spec 2; MacroMARL adds fixed 4 x 4 and 6 x 6 layouts) and an odd N puts the big box and
+    /// its waypoints off the cell centres, where they can never be reached or seen (quirk Q9).
+    /// `horizon` must be at least 1.
+    pub fn with_rules(grid: usize, horizon: usize, rules: Rules) -> Result<Self, EnvError> {
+        Self::check_params(grid, horizon, &rules)?;
         let layout = GridLayout::new(grid as i32);
         Ok(Self {
             robots: start_robots(&layout),
             boxes: start_boxes(&layout),
             layout,
             horizon,
+            rules,
             joint_push: false,
             t: 0,
             done: false,
@@ -132,6 +149,11 @@ impl BoxPushing {
             mac_done: [true; N_AGENTS],
             stats: DeliveryStats::default(),
         })
+    }
+
+    /// The rules this environment plays by.
+    pub fn rules(&self) -> &Rules {
+        &self.rules
     }
 
     /// Grid side N.
@@ -270,18 +292,74 @@ impl MacroEnv for BoxPushing {
         render::render(self)
     }
 
-    /// Known for the paper's two settings at gamma 0.98 (10x10 horizon 100, 30x30 horizon 200).
+    /// Known at gamma 0.98 for the ICRA paper's two settings (10x10 horizon 100, 30x30 horizon
+    /// 200) and for MacroMARL's published rewards on grids 6 to 14 (spec `macromarl.md` 3.1), where
+    /// the best plan is the scripted one: each robot to its big-box waypoint, then the joint push.
     fn optimal_return(&self, discount: f64) -> Option<f64> {
-        match (self.grid(), self.horizon) {
-            (10, 100) if discount == 0.98 => Some(BP10_OPTIMAL),
-            (30, 200) if discount == 0.98 => Some(BP30_OPTIMAL),
-            _ => None,
+        if discount != 0.98 {
+            return None;
         }
+        if self.rules == Rules::ICRA {
+            return match (self.grid(), self.horizon) {
+                (10, 100) => Some(BP10_OPTIMAL),
+                (30, 200) => Some(BP30_OPTIMAL),
+                _ => None,
+            };
+        }
+        let published = Rules {
+            penalty: self.rules.penalty,
+            ..Rules::MACROMARL
+        };
+        (self.rules == published && matches!(self.grid(), 6 | 8 | 10 | 12 | 14))
+            .then(|| self.big_box_plan_return(discount))
+            .flatten()
     }
 
+    fn state_size(&self) -> usize {
+        STATE_SIZE
+    }
+
+    /// Robots (x, y, one-hot heading), then boxes 0, 1, big (x, y), each coordinate the cell
+    /// centre over the grid side (the big box's centre is between its two cells), as the
+    /// reference's `get_state()`.
+    fn write_state(&self, out: &mut [f32]) {
+        assert_eq!(
+            out.len(),
+            STATE_SIZE,
+            "Box Pushing's state has {STATE_SIZE} values"
+        );
+        let n = self.grid() as f64;
+        let centre = |c: i32| ((c as f64 + 0.5) / n) as f32;
+        let mut at = 0;
+        for robot in &self.robots {
+            out[at] = centre(robot.cell.col);
+            out[at + 1] = centre(robot.cell.row);
+            out[at + 2..at + 6].fill(0.0);
+            out[at + 2 + robot.heading.index()] = 1.0;
+            at += 6;
+        }
+        for cell in self.boxes.small {
+            out[at] = centre(cell.col);
+            out[at + 1] = centre(cell.row);
+            at += 2;
+        }
+        out[at] = ((self.boxes.big_left.col as f64 + 1.0) / n) as f32;
+        out[at + 1] = centre(self.boxes.big_left.row);
+    }
+
+    /// "Box Pushing 10x10, horizon 100"; rewards other than the ICRA paper's are named.
     fn describe(&self) -> String {
+        let rewards = if self.rules == Rules::ICRA {
+            String::new()
+        } else {
+            let r = &self.rules;
+            format!(
+                ", rewards {}/{}/{}",
+                r.big_box_reward, r.small_box_reward, r.penalty
+            )
+        };
         format!(
-            "Box Pushing {0}x{0}, horizon {1}",
+            "Box Pushing {0}x{0}{rewards}, horizon {1}",
             self.grid(),
             self.horizon
         )
@@ -289,6 +367,31 @@ impl MacroEnv for BoxPushing {
 
     fn draw(&self) -> Option<crate::draw::Picture> {
         Some(draw::draw(self))
+    }
+}
+
+impl BoxPushing {
+    /// The discounted return of the scripted big-box plan from reset (robot 0 to W2, robot 1 to
+    /// W3, then both push), if it delivers within the horizon.
+    fn big_box_plan_return(&self, discount: f64) -> Option<f64> {
+        let mut env = self.clone();
+        env.reset_state();
+        let (mut ret, mut weight) = (0.0, 1.0);
+        let mut plans = [[2, 4], [3, 4]];
+        loop {
+            let actions = [plans[0][0], plans[1][0]];
+            let out = env.step_primitive(&actions).ok()?;
+            ret += weight * out.reward;
+            weight *= discount;
+            if out.done {
+                return (env.boxes.big_left.row == env.layout.goal_row()).then_some(ret);
+            }
+            for (plan, &done) in plans.iter_mut().zip(&env.mac_done) {
+                if done {
+                    plan[0] = plan[1];
+                }
+            }
+        }
     }
 }
 

@@ -3,9 +3,6 @@
 use super::geometry::Heading;
 use super::state::{Boxes, Robot};
 
-/// Penalty of a Push that hits a wall edge, the big box, or a small box sideways (spec 7).
-pub const HIT_PENALTY: f64 = -5.0;
-
 /// Whether the robot stands on a boundary cell facing out of an `n` x `n` grid: facing north in
 /// row n-1, east in column n-1, south in row 0 or west in column 0 (spec 5.2 (a), (c)). Exact
 /// equality as in the reference: a robot lifted above the grid by Q2 is not "on the edge".
@@ -20,16 +17,17 @@ pub fn facing_out_from_edge(robot: &Robot, n: i32) -> bool {
     }
 }
 
-/// One primitive step of Push by one robot on an `n` x `n` grid with goal row `n - 1`. Returns the
-/// robot's penalty, summed from 0.0 in box order as the reference does (0.0 or -5.0; -10.0 would
-/// need a robot standing inside a box).
+/// One primitive step of Push by one robot on an `n` x `n` grid with goal row `n - 1`, where a hit
+/// costs `hit` ([`super::Rules::penalty`]: -5 in the ICRA paper, spec 7). Returns the robot's penalty, summed from 0.0
+/// in box order as the reference does (0.0 or one `hit`; two would need a robot standing inside
+/// a box).
 #[inline]
-pub fn push_step(robot: &mut Robot, boxes: &mut Boxes, n: i32) -> f64 {
+pub fn push_step(robot: &mut Robot, boxes: &mut Boxes, n: i32, hit: f64) -> f64 {
     let mut penalty = 0.0;
     // (a) Facing out from an edge: -5, finished, no movement (quirk Q5).
     if facing_out_from_edge(robot, n) {
         robot.finished = true;
-        return penalty + HIT_PENALTY;
+        return penalty + hit;
     }
     // (b) Step forward, then test the boxes in the order small 0, small 1, big, each against the
     // robot's cell at that moment (a bounce moves the robot back before the next test).
@@ -49,7 +47,7 @@ pub fn push_step(robot: &mut Robot, boxes: &mut Boxes, n: i32) -> f64 {
             // The big box alone, or a small box sideways or downwards (quirk Q11).
             robot.cell = robot.cell.step_back(robot.heading);
             robot.finished = true;
-            penalty += HIT_PENALTY;
+            penalty += hit;
         }
     }
     // (c) Reaching the last cell before the wall ends the Push without a penalty.
@@ -63,6 +61,7 @@ pub fn push_step(robot: &mut Robot, boxes: &mut Boxes, n: i32) -> f64 {
 mod tests {
     use super::super::geometry::Cell;
     use super::super::layout::GridLayout;
+    use super::super::Rules;
     use super::*;
 
     fn setup(cell: Cell, heading: Heading) -> (Robot, Boxes) {
@@ -81,7 +80,7 @@ mod tests {
     #[test]
     fn facing_out_from_an_edge_costs_five_and_does_not_move() {
         let (mut r, mut b) = setup(Cell::new(1, 0), Heading::South);
-        assert_eq!(push_step(&mut r, &mut b, 10), -5.0);
+        assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), -5.0);
         assert!(r.finished);
         assert_eq!(r.cell, Cell::new(1, 0));
     }
@@ -89,7 +88,7 @@ mod tests {
     #[test]
     fn walking_into_the_last_cell_finishes_without_penalty() {
         let (mut r, mut b) = setup(Cell::new(1, 1), Heading::South);
-        assert_eq!(push_step(&mut r, &mut b, 10), 0.0);
+        assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), 0.0);
         assert!(r.finished);
         assert_eq!(r.cell, Cell::new(1, 0));
     }
@@ -97,7 +96,7 @@ mod tests {
     #[test]
     fn free_space_push_keeps_running() {
         let (mut r, mut b) = setup(Cell::new(1, 1), Heading::East);
-        assert_eq!(push_step(&mut r, &mut b, 10), 0.0);
+        assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), 0.0);
         assert!(!r.finished);
         assert_eq!(r.cell, Cell::new(2, 1));
     }
@@ -105,7 +104,7 @@ mod tests {
     #[test]
     fn big_box_alone_bounces_with_penalty() {
         let (mut r, mut b) = setup(Cell::new(5, 4), Heading::North);
-        assert_eq!(push_step(&mut r, &mut b, 10), -5.0);
+        assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), -5.0);
         assert!(r.finished);
         assert_eq!(r.cell, Cell::new(5, 4));
         assert_eq!(b.big_left, Cell::new(4, 5));
@@ -115,7 +114,7 @@ mod tests {
     fn small_box_sideways_bounces_with_penalty() {
         // Quirk Q11: from (0,5) facing east into small box 0 at (1,5).
         let (mut r, mut b) = setup(Cell::new(0, 5), Heading::East);
-        assert_eq!(push_step(&mut r, &mut b, 10), -5.0);
+        assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), -5.0);
         assert_eq!(r.cell, Cell::new(0, 5));
         assert_eq!(b.small[0], Cell::new(1, 5));
     }
@@ -124,11 +123,11 @@ mod tests {
     fn small_box_north_moves_with_the_robot_until_the_goal_row() {
         let (mut r, mut b) = setup(Cell::new(1, 4), Heading::North);
         for row in 6..9 {
-            assert_eq!(push_step(&mut r, &mut b, 10), 0.0);
+            assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), 0.0);
             assert_eq!(b.small[0], Cell::new(1, row));
             assert!(!r.finished);
         }
-        assert_eq!(push_step(&mut r, &mut b, 10), 0.0);
+        assert_eq!(push_step(&mut r, &mut b, 10, Rules::ICRA.penalty), 0.0);
         assert_eq!(b.small[0], Cell::new(1, 9));
         assert_eq!(r.cell, Cell::new(1, 8));
         assert!(r.finished);

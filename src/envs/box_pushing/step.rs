@@ -12,20 +12,22 @@ use crate::envs::{EnvError, StepOutcome};
 
 /// The time penalty every step starts from (spec 7).
 pub const STEP_REWARD: f64 = -0.1;
-/// Bonus when a small box enters the goal row (spec 7).
-pub const SMALL_BOX_BONUS: f64 = 10.0;
-/// Bonus when the big box enters the goal row (spec 7).
-pub const BIG_BOX_BONUS: f64 = 100.0;
 
 /// One primitive step of macro-action `m` for one robot (spec 5). Returns its penalty.
 #[inline]
-fn execute(robot: &mut Robot, m: MacroAction, boxes: &mut Boxes, layout: &GridLayout) -> f64 {
+fn execute(
+    robot: &mut Robot,
+    m: MacroAction,
+    boxes: &mut Boxes,
+    layout: &GridLayout,
+    hit: f64,
+) -> f64 {
     match m {
         MacroAction::MoveTo(k) => {
             move_step(robot, k, layout.waypoints[k as usize], boxes);
             0.0
         }
-        MacroAction::Push => push_step(robot, boxes, layout.n),
+        MacroAction::Push => push_step(robot, boxes, layout.n, hit),
         MacroAction::TurnLeft => {
             robot.heading = robot.heading.left();
             robot.finished = true;
@@ -104,7 +106,7 @@ impl BoxPushing {
                 let robot = &mut self.robots[agent];
                 robot.current = Some(m);
                 robot.finished = false;
-                let penalty = execute(robot, m, &mut self.boxes, &self.layout);
+                let penalty = execute(robot, m, &mut self.boxes, &self.layout, self.rules.penalty);
                 self.executed[agent] = m.index();
                 self.mac_done[agent] = robot.finished;
                 reward += penalty;
@@ -134,13 +136,13 @@ impl BoxPushing {
         for row in [self.boxes.small[0].row, self.boxes.small[1].row] {
             if row == goal {
                 terminal = true;
-                bonus += SMALL_BOX_BONUS;
+                bonus += self.rules.small_box_reward;
                 small_delivered += 1;
             }
         }
         if self.boxes.big_left.row == goal {
             terminal = true;
-            bonus += BIG_BOX_BONUS;
+            bonus += self.rules.big_box_reward;
             self.stats.big_box += 1;
         }
         match small_delivered {
@@ -158,12 +160,13 @@ impl BoxPushing {
             }
         }
 
-        // 8. The horizon cut is folded into done (Q1).
+        // 8. The horizon cut is folded into done (Q1); it is terminal under the ICRA rules (Q7)
+        // and a truncation under MacroMARL's, whose runner bootstraps from it.
         self.done = terminal || self.t >= self.horizon;
         Ok(StepOutcome {
             reward,
             done: self.done,
-            truncated: false,
+            truncated: self.done && !terminal && !self.rules.horizon_is_terminal,
         })
     }
 }

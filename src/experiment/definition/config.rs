@@ -427,15 +427,58 @@ fn looks_numeric(word: &str) -> bool {
             .all(|c| c.is_ascii_digit() || "._eE+-".contains(c))
 }
 
+/// How deeply lists nest in `v`: 0 for a plain value, 1 for a list of plain values, ...
+fn list_depth(v: &toml::Value) -> usize {
+    match v {
+        toml::Value::Array(items) => 1 + items.first().map_or(0, list_depth),
+        _ => 0,
+    }
+}
+
+/// For each key whose value is itself a list in a domain `table` names (`env_name`, Box
+/// Pushing when absent; every name of a swept `env_name`), the depth of that list: such a
+/// key's value is one value at that depth and a sweep one level deeper
+/// (`human_speed_per_step = [[18, 18, 18, 18], [18, 18, 18, 18]]` is one setting).
+fn list_valued_keys(table: &toml::Table) -> std::collections::HashMap<String, usize> {
+    let names: Vec<&str> = match table.get("env_name") {
+        Some(toml::Value::String(name)) => vec![name.as_str()],
+        Some(toml::Value::Array(items)) => items.iter().filter_map(|v| v.as_str()).collect(),
+        _ => vec!["BP_MA"],
+    };
+    let mut depths = std::collections::HashMap::new();
+    for name in names {
+        let Ok(domain) = crate::envs::registry::lookup(name) else {
+            continue; // resolve names the bad env_name
+        };
+        for (key, default) in domain.keys(&toml::Table::new()).unwrap_or_default() {
+            let depth = list_depth(&default);
+            if depth > 0 {
+                let d = depths.entry(key).or_insert(0);
+                *d = depth.max(*d);
+            }
+        }
+    }
+    depths
+}
+
 /// Expand list-valued keys into the grid of their combinations (keys sorted by
 /// name, so variant names are stable). Each point is named by its swept keys. An empty list and
-/// a grid beyond [`limits::MAX_RUNS`] points are refused before anything is expanded.
+/// a grid beyond [`limits::MAX_RUNS`] points are refused before anything is expanded. A key
+/// whose value is a list by nature ([`list_valued_keys`]) is swept only by a list of such lists.
 fn expand_grid(
     path: &Path,
     table: &toml::Table,
 ) -> Result<Vec<(String, toml::Table)>, ConfigError> {
+    let list_valued = list_valued_keys(table);
+    let is_sweep = |key: &String, value: &toml::Value| {
+        matches!(value, toml::Value::Array(_))
+            && list_depth(value) > list_valued.get(key).copied().unwrap_or(0)
+    };
     let mut size: u128 = 1;
     for (key, value) in table {
+        if !is_sweep(key, value) {
+            continue;
+        }
         if let toml::Value::Array(items) = value {
             if items.is_empty() {
                 return Err(ConfigError::BadValue {
@@ -459,11 +502,11 @@ fn expand_grid(
     let mut keys: Vec<(&String, &toml::Value)> = table.iter().collect();
     keys.sort_by_key(|(k, _)| *k);
     for (key, value) in keys {
+        let swept = is_sweep(key, value);
         let choices: Vec<toml::Value> = match value {
-            toml::Value::Array(items) => items.clone(),
+            toml::Value::Array(items) if swept => items.clone(),
             other => vec![other.clone()],
         };
-        let swept = matches!(value, toml::Value::Array(_));
         let mut next = Vec::with_capacity(points.len() * choices.len());
         for (name, point) in &points {
             for choice in &choices {
@@ -487,9 +530,15 @@ fn expand_grid(
     Ok(points)
 }
 
+/// A swept value as it appears in variant names: a list's items joined by `-` (lists of lists
+/// by `+`), so `grid_dim = [[6, 6], [8, 8]]` names its points `grid_dim=6-6` and `grid_dim=8-8`.
 fn value_label(v: &toml::Value) -> String {
     match v {
         toml::Value::String(s) => s.clone(),
+        toml::Value::Array(items) => {
+            let sep = if list_depth(v) > 1 { "+" } else { "-" };
+            items.iter().map(value_label).collect::<Vec<_>>().join(sep)
+        }
         other => other.to_string(),
     }
 }
@@ -516,6 +565,14 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
     let mut table = toml::Table::try_from(&defaults).expect("RunSettings serializes to a table");
     for (key, value) in point {
         if !table.contains_key(key) {
+            // A key the domain accepts and drops (MacroMARL's script passes every BP/OSD
+            // keyword argument to every such environment) is not an error.
+            if domain
+                .keys(&toml::Table::from_iter([(key.clone(), value.clone())]))
+                .is_ok()
+            {
+                continue;
+            }
             return Err(ConfigError::UnknownKey {
                 path: p(),
                 key: key.clone(),
@@ -839,6 +896,42 @@ mod tests {
             ..Default::default()
         };
         assert!(Experiment::parse("", Path::new("t.toml"), "t", &o).is_err());
+    }
+
+    #[test]
+    fn a_list_valued_key_is_one_value_and_its_list_of_lists_a_sweep() {
+        let variants = |text: &str| -> Vec<(String, String)> {
+            parse(text, &[])
+                .unwrap()
+                .runs()
+                .unwrap()
+                .into_iter()
+                .map(|r| (r.variant, r.env.short_name()))
+                .collect()
+        };
+        let head = "methods = [\"our1\"]\n[params]\nenv_name = \"BP-MA-v0\"\n";
+        assert_eq!(
+            variants(&format!("{head}grid_dim = [6, 6]")),
+            [(String::new(), "bpma6".to_string())]
+        );
+        assert_eq!(
+            variants(&format!("{head}grid_dim = [[6, 6], [8, 8]]")),
+            [
+                ("grid_dim=6-6".to_string(), "bpma6".to_string()),
+                ("grid_dim=8-8".to_string(), "bpma8".to_string())
+            ]
+        );
+        // Box Pushing's grid_dim is a number, so a list of numbers sweeps it.
+        let icra = "methods = [\"our1\"]\n[params]\ngrid_dim = [8, 10]";
+        assert_eq!(variants(icra).len(), 2);
+        // A key MacroMARL's script passes to every BP/OSD env is accepted and not recorded.
+        let e = parse(&format!("{head}TB_move_speed = 0.6"), &[]).unwrap();
+        assert!(!e.runs().unwrap()[0]
+            .env
+            .keys()
+            .contains_key("TB_move_speed"));
+        let err = parse(&format!("{head}grid_size = 6"), &[]).unwrap_err();
+        assert!(err.to_string().contains("unknown key `grid_size`"), "{err}");
     }
 
     #[test]
