@@ -1,5 +1,8 @@
 #!/bin/bash
-# Regenerates tests/fixtures/macromarl with scripts/macromarl_traces.py (see its doc).
+# Regenerates tests/fixtures/macromarl with scripts/macromarl_traces.py (see its doc):
+#   PY=venv/bin/python TORCH_PY=torchvenv/bin/python scripts/macromarl_fixtures.sh MACROMARL OVERCOOKED
+# The greedy episodes of the authors' trained actors (*_actors) need torch in TORCH_PY's venv
+# (pip install torch numpy gym==0.26.2); without TORCH_PY they are left as they are.
 set -e
 PY=${PY:-python3}; MM=$1; OC=$2; F=tests/fixtures/macromarl; S=scripts/macromarl_traces.py
 BP='"big_box_reward": 300, "small_box_reward": 20, "penalty": -10'
@@ -25,3 +28,17 @@ for m in A B C; do
 done
 # As published: the scripts never pass n_agent, so Overcooked trains 2 agents.
 $PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false}" --random-seed 1 --horizon 200 --out $F/overcooked_a_n2_random1
+# The authors' trained actors (visualization/policy_nns), greedy with each GRU state carried
+# across its agent's decisions, under the published settings of each block (Warehouse: Turtlebot
+# speed 0.8, delay penalty -20), so their episodes replay here step for step.
+if [ -n "$TORCH_PY" ]; then
+  N=$MM/visualization/policy_nns
+  $TORCH_PY $S --macromarl $MM --env BP-MA-v0 --params "{\"grid_dim\": [14, 14], $BP}" --actors $N/BP_MA/14x14 --horizon 100 --gamma 0.98 --out $F/bp_ma_14_actors
+  W='"grid_dim": [6, 6], '"$BP"', "TB_move_speed": 0.8, "TB_move_noisy": 0.0, "TB_move_cost": 0.0, "fetch_pass_obj_tc": 4, "fetch_look_for_obj_tc": 6, "fetch_manip_noisy": 0.0, "delay_delivery_penalty": -20.0, "obs_human_wait": false'
+  $TORCH_PY $S --macromarl $MM --env OSD-T-v0 --params "{$W, \"n_agent\": 3, \"terminate_step\": 250, \"human_speed_per_step\": [[40,40,40,40],[40,40,40,40],[40,40,40,40]]}" --actors $N/OSD_T/40 --horizon 250 --out $F/osd_t_v0_c_actors
+  $TORCH_PY $S --macromarl $MM --env OSD-T-v1 --params "{$W, \"n_agent\": 4, \"terminate_step\": 250, \"human_speed_per_step\": [[38,38,38,38],[38,38,38,38],[27,27,27,27]]}" --actors $N/OSD_T/4R383827 --horizon 250 --out $F/osd_t_v1_d_actors
+  $TORCH_PY $S --macromarl $MM --env OSD-F-v0 --params "{$W, \"n_agent\": 4, \"terminate_step\": 300, \"human_speed_per_step\": [[40,40,40,40],[40,40,40,40],[40,40,40,40],[40,40,40,40]]}" --actors $N/OSD_F/v040 --horizon 300 --out $F/osd_f_v0_e_actors
+  for m in A B; do
+    $TORCH_PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"$m\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --actors $N/Overcooked/map$m --horizon 200 --gamma 0.99 --out $F/overcooked_$(echo $m | tr A-Z a-z)_n3_actors
+  done
+fi

@@ -18,8 +18,12 @@ two files:
 The actions are given (--steps FILE, a JSON list of joint actions), or planned per agent (--plan
 '[[2, 4], [3, 4]]': agent i starts its list's macro-actions in order whenever it is free and
 repeats the last one), or drawn uniformly at random for the free agents (--random-seed S,
-numpy's RandomState, so a seed gives the same file everywhere); planned and random episodes run
-until the env terminates or --horizon steps.
+numpy's RandomState, so a seed gives the same file everywhere), or chosen by trained actors
+(--actors DIR: MacroMARL's `agent_state_dict*.pt` files, in agent order by file name; each free
+agent takes the argmax of its actor on its observation, its GRU state carried across its own
+decisions, as the reference's controller acts; needs torch); planned, random and actor episodes
+run until the env terminates or --horizon steps. With --actors, --gamma G also prints the
+episode's return discounted per primitive step.
 
 With --speed SECONDS it writes nothing and prints the reference env's primitive steps per second
 under random macro-actions instead (the Python side of the environment-speed comparison).
@@ -78,6 +82,56 @@ def speed(env, args):
     }
 
 
+def actor_policy(directory):
+    """The trained actors in `directory` (agent_state_dict*.pt in file-name order) as a function
+    from (free flags, observations) to joint actions, greedy, each GRU state carried across its
+    agent's own decisions. The module is MacroMARL's Actor (fc1, fc2, GRU, fc3, fc4,
+    log_softmax), rebuilt here with the sizes the state_dict implies."""
+    import glob
+
+    import torch
+    import torch.nn.functional as F
+
+    class Actor(torch.nn.Module):
+        def __init__(self, sd):
+            super().__init__()
+            m0, obs = sd["fc1.weight"].shape
+            hidden = sd["gru.weight_hh_l0"].shape[1]
+            m1 = sd["fc3.weight"].shape[0]
+            actions = sd["fc4.weight"].shape[0]
+            self.fc1 = torch.nn.Linear(obs, m0)
+            self.fc2 = torch.nn.Linear(m0, m0)
+            self.gru = torch.nn.GRU(m0, hidden, num_layers=1, batch_first=True)
+            self.fc3 = torch.nn.Linear(hidden, m1)
+            self.fc4 = torch.nn.Linear(m1, actions)
+            self.load_state_dict(sd)
+
+        def forward(self, x, h):
+            x = F.leaky_relu(self.fc1(x))
+            x = F.leaky_relu(self.fc2(x))
+            x, h = self.gru(x, h)
+            x = F.leaky_relu(self.fc3(x))
+            return F.log_softmax(self.fc4(x), dim=-1), h
+
+    files = sorted(glob.glob(os.path.join(directory, "*.pt")))
+    actors = [Actor(torch.load(f, map_location="cpu")) for f in files]
+    hidden = [None] * len(actors)
+
+    def act(free, obs):
+        actions = []
+        with torch.no_grad():
+            for i, actor in enumerate(actors):
+                if not free[i]:
+                    actions.append(-1)
+                    continue
+                x = torch.as_tensor(obs[i], dtype=torch.float32).view(1, 1, -1)
+                logp, hidden[i] = actor(x, hidden[i])
+                actions.append(int(logp.view(-1).argmax()))
+        return actions
+
+    return act
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--macromarl", required=True, help="a MacroMARL checkout (its src/ is imported)")
@@ -89,6 +143,8 @@ def main():
     parser.add_argument("--steps", help="JSON file: a list of joint actions (-1 for busy agents)")
     parser.add_argument("--plan", help="JSON list per agent of macro-actions started in order")
     parser.add_argument("--random-seed", type=int, help="draw the free agents' actions at random")
+    parser.add_argument("--actors", help="directory of trained agent_state_dict*.pt files")
+    parser.add_argument("--gamma", type=float, default=1.0, help="discount of the printed return")
     parser.add_argument("--horizon", type=int, default=100, help="most steps of a random episode")
     parser.add_argument("--out", help="output path without extension")
     parser.add_argument(
@@ -98,8 +154,8 @@ def main():
         "the end of an episode or --horizon) and print primitive steps per second",
     )
     args = parser.parse_args()
-    if args.speed is None and [args.steps, args.plan, args.random_seed].count(None) != 2:
-        parser.error("give exactly one of --steps, --plan and --random-seed")
+    if args.speed is None and [args.steps, args.plan, args.random_seed, args.actors].count(None) != 3:
+        parser.error("give exactly one of --steps, --plan, --random-seed and --actors")
     if args.speed is None and args.out is None:
         parser.error("give --out (or --speed)")
 
@@ -145,7 +201,12 @@ def main():
 
             names = {}
             stand_in = types.ModuleType("pygame")
-            stand_in.__getattr__ = lambda name: names.setdefault(name, Stand(name))
+            def stand(name):
+                if name.startswith("__"):  # module protocol (torch's inspect asks for __file__)
+                    raise AttributeError(name)
+                return names.setdefault(name, Stand(name))
+
+            stand_in.__getattr__ = stand
             sys.modules["pygame"] = stand_in
         import gym_macro_overcooked  # noqa: F401  (registers the gym ids)
         from gym_macro_overcooked.macActEnvWrapper import MacEnvWrapper
@@ -180,6 +241,8 @@ def main():
             given = json.load(f)
     rng = np.random.RandomState(args.random_seed if args.random_seed is not None else 0)
     plan = json.loads(args.plan) if args.plan else None
+    actors = actor_policy(args.actors) if args.actors else None
+    last_obs = obs
     started = [0] * env.n_agent
     free = [True] * env.n_agent
     steps = []
@@ -192,7 +255,9 @@ def main():
         else:
             if t == args.horizon:
                 break
-            if plan is not None:
+            if actors is not None:
+                actions = actors(free, last_obs)
+            elif plan is not None:
                 actions = []
                 for i in range(env.n_agent):
                     if free[i]:
@@ -206,6 +271,7 @@ def main():
                 ]
         steps.append(actions)
         obs, rewards, done, info = env.step(actions)
+        last_obs = obs
         t += 1
         mac_done = as_ints(info["mac_done"])
         lines.append(
@@ -231,7 +297,11 @@ def main():
     with open(args.out + ".trace.jsonl.gz", "wb") as raw:
         with gzip.GzipFile(filename="", mode="wb", compresslevel=9, fileobj=raw, mtime=0) as f:
             f.write(text.encode())
-    print(f"{args.out}: {len(steps)} steps, return {sum(l.get('reward', 0.0) for l in lines):.4f}")
+    discounted = sum(args.gamma ** (l["t"] - 1) * l["reward"] for l in lines[1:])
+    print(
+        f"{args.out}: {len(steps)} steps, return {sum(l.get('reward', 0.0) for l in lines):.4f}"
+        f", discounted by {args.gamma}: {discounted:.4f}"
+    )
 
 
 if __name__ == "__main__":

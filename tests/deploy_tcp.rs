@@ -10,7 +10,7 @@ use macdec::deploy::link::{JsonLink, LocalLink};
 use macdec::deploy::local_eval::eval_policy;
 use macdec::deploy::manifest::{load_all, Manifest, VerifiedAgent};
 use macdec::deploy::mock::{mock_manifest, mock_policies, MockPolicy};
-use macdec::deploy::qnet_policy::{load_net, qnet_factory};
+use macdec::deploy::net_policy::{load_net, net_factory};
 use macdec::deploy::remote::run_with_robots_at;
 use macdec::deploy::robot::RobotSpec;
 use macdec::deploy::server::{spawn_server, Limits, RobotServer};
@@ -20,7 +20,7 @@ use macdec::envs::{EnvRng, EnvSpec, MacroEnv};
 mod common;
 
 use common::{mock_robot_server, synthetic_agent_weights, test_run, write_synthetic_policy};
-use macdec::nn::QNet;
+use macdec::nn::{ActingNet, QNet};
 use rand::SeedableRng;
 use std::net::{SocketAddr, TcpListener};
 use std::sync::Arc;
@@ -205,7 +205,7 @@ fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
     let arch = Architecture::ddrqn(16, 8);
     let weights = synthetic_agent_weights(&env, &arch);
     let manifest = Manifest::build(env_spec, 0.95, arch, test_run(0), &weights).unwrap();
-    let nets: Vec<QNet> = (0..env.n_agents())
+    let nets: Vec<ActingNet> = (0..env.n_agents())
         .map(|i| {
             let verified = VerifiedAgent {
                 index: i,
@@ -216,7 +216,7 @@ fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
         .collect();
     let servers: Vec<_> = (0..env.n_agents())
         .map(|i| {
-            let factory = qnet_factory(nets[i].clone());
+            let factory = net_factory(nets[i].clone());
             let spec = Arc::new(RobotSpec::new(&manifest, i).unwrap());
             let listener = TcpListener::bind("127.0.0.1:0").unwrap();
             spawn_server(listener, factory, spec, Limits::default()).unwrap()
@@ -239,7 +239,7 @@ fn tcp_deployment_of_qnets_equals_greedy_evaluation() {
     )
     .unwrap();
 
-    let refs: Vec<&QNet> = nets.iter().collect();
+    let refs: Vec<&QNet> = nets.iter().map(|n| n.as_q().unwrap()).collect();
     let mut eval_rng = EnvRng::seed_from_u64(4);
     let mut distinct_actions = std::collections::BTreeSet::new();
     for trace in &deployed {
@@ -291,7 +291,7 @@ fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
 
     let nets: Vec<QNet> = verified
         .iter()
-        .map(|v| load_net(&manifest, v).unwrap())
+        .map(|v| load_net(&manifest, v).unwrap().as_q().unwrap().clone())
         .collect();
     let refs: Vec<&QNet> = nets.iter().collect();
     let mut rng = EnvRng::seed_from_u64(9);

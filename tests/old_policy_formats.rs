@@ -6,7 +6,7 @@
 //! observations from a zero state, computed by that build.
 
 use macdec::deploy::export::export_run;
-use macdec::deploy::qnet_policy::load_net;
+use macdec::deploy::net_policy::load_net;
 use macdec::nn::QNet;
 use macdec::policy_files::{
     load_all, read_policy_files, read_qnets, Manifest, NetKind, NetRole, PolicyEnv, FORMAT_VERSION,
@@ -96,7 +96,7 @@ fn version_1_exports_load_for_robots_with_the_same_nets() {
         assert_eq!(manifest.nets[1].file, "agent-1.safetensors");
         assert_eq!(manifest.agents[0].obs_names.len(), 5);
         for v in &verified {
-            let net = load_net(&manifest, v).unwrap();
+            let net = load_net(&manifest, v).unwrap().as_q().unwrap().clone();
             assert_eq!(
                 net,
                 run_nets[v.index],
@@ -115,7 +115,10 @@ fn version_1_exports_load_for_robots_with_the_same_nets() {
     let run_policy = fixtures().join("run/policy");
     let (manifest, verified) = load_all(&run_policy).unwrap();
     for v in &verified {
-        assert_eq!(load_net(&manifest, v).unwrap(), run_nets[v.index]);
+        assert_eq!(
+            load_net(&manifest, v).unwrap().as_q(),
+            Some(&run_nets[v.index])
+        );
     }
 }
 

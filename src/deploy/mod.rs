@@ -5,7 +5,7 @@
 //! seeing only its own macro-observations ([`driver`], [`link`], [`processes`]).
 //!
 //! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
-//! recurrent Q-net, [`qnet_policy::QNetPolicy`], or [`mock::MockPolicy`] in tests and behind the
+//! net, [`net_policy::NetPolicy`] over a Q-net or an actor, or [`mock::MockPolicy`] in tests and behind the
 //! CLI's hidden `--mock` flag). [`remote`] drives robots that already run elsewhere (`macdec
 //! domain`, the ROS bridge of issue 14). Only [`export`] reads a run directory, and only its
 //! policy files ([`crate::policy_files`]), never its checkpoint; deploy imports nothing
@@ -24,7 +24,9 @@ pub mod policy;
 pub mod serve;
 
 pub use drive::{driver, link, local_eval, processes, remote};
-pub use policy::{architecture, export, import, manifest, mock, policy_env, qnet_policy};
+pub use policy::{
+    architecture, export, import, import_actors, manifest, mock, net_policy, policy_env,
+};
 pub use serve::{deadline, line_reader, protocol, robot, server};
 
 pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};

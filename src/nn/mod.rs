@@ -6,13 +6,16 @@
 //! - [`GruParams`]: a one-layer GRU as PyTorch's `nn.GRU` (gate order, init, state_dict
 //!   names), run on a tape over packed sequences (`Tape::gru_packed`) or one step at a time
 //!   with a [`GruState`] (acting).
+//! - [`GruActor`]: MacroMARL's actor fc1 -> fc2 -> GRU -> fc3 -> fc4 -> log_softmax, for acting.
 //! - [`Adam`]: PyTorch's Adam (spec 2.4); [`Updater::td_step`]: one full TD gradient step.
 //! - `safetensors_io`: weight files with PyTorch's state_dict names.
 
+mod acting_net;
 mod adam;
 pub mod argmax;
 pub mod demo;
 mod gru;
+mod gru_actor;
 pub mod init;
 mod linear;
 pub mod loss;
@@ -26,9 +29,11 @@ mod update;
 /// can make the process allocate beyond what a net needs (README "Limits and guarantees").
 pub const MAX_NET_WIDTH: usize = 2_048;
 
+pub use acting_net::{ActingNet, ActingState};
 pub use adam::{Adam, AdamConfig};
 pub use argmax::argmax;
 pub use gru::{GruState, GRU_TENSOR_NAMES};
+pub use gru_actor::{GruActor, GruActorConfig, GruActorState, GRU_ACTOR_TENSOR_NAMES};
 pub use linear::LinearVars;
 pub use lstm::LstmState;
 pub use params::{GruParams, LinearParams, LstmParams, Params};

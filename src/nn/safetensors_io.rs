@@ -62,7 +62,7 @@ pub fn to_safetensors_bytes(params: &QNetParams) -> Vec<u8> {
 
 /// Named f32 tensors as safetensors bytes, with PyTorch's `{"format": "pt"}` metadata: the one
 /// writer behind every net's file.
-fn named_to_safetensors_bytes(named: &[(&'static str, ArrayViewD<'_, f32>)]) -> Vec<u8> {
+pub(crate) fn named_to_safetensors_bytes(named: &[(&'static str, ArrayViewD<'_, f32>)]) -> Vec<u8> {
     let data: Vec<(&str, Vec<usize>, Vec<u8>)> = named
         .iter()
         .map(|(name, a)| {
@@ -77,6 +77,87 @@ fn named_to_safetensors_bytes(named: &[(&'static str, ArrayViewD<'_, f32>)]) -> 
     });
     let meta = Some(HashMap::from([("format".to_string(), "pt".to_string())]));
     safetensors::serialize(views, &meta).expect("serializing in-memory f32 tensors cannot fail")
+}
+
+/// The shape of tensor `name` in a file's bytes (to read a net's sizes before the full check).
+pub fn tensor_shape(
+    bytes: &[u8],
+    origin: &Path,
+    name: &'static str,
+) -> Result<Vec<usize>, WeightsError> {
+    let st = SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Format {
+        path: origin.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    let view = st.tensor(name).map_err(|_| WeightsError::Missing {
+        path: origin.to_path_buf(),
+        name,
+        expected: vec![],
+    })?;
+    Ok(view.shape().to_vec())
+}
+
+/// The values of exactly the tensors `expected` (name and shape, in order) from a file's bytes,
+/// like PyTorch's strict `load_state_dict`: each present, F32 and of its shape, and nothing else
+/// in the file. `what` names the net in errors ("GRU actor"); `origin` labels them.
+pub fn read_exact(
+    bytes: &[u8],
+    origin: &Path,
+    what: &'static str,
+    expected: &[(&'static str, Vec<usize>)],
+) -> Result<Vec<Vec<f32>>, WeightsError> {
+    let path = origin.to_path_buf();
+    let st = SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Format {
+        path: path.clone(),
+        reason: e.to_string(),
+    })?;
+    let mut names: Vec<String> = st.names().into_iter().cloned().collect();
+    names.sort();
+    if let Some(name) = names
+        .into_iter()
+        .find(|n| !expected.iter().any(|(e, _)| e == n))
+    {
+        return Err(WeightsError::Unexpected {
+            path,
+            name,
+            what,
+            expected: expected
+                .iter()
+                .map(|(e, _)| *e)
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
+    let mut out = Vec::with_capacity(expected.len());
+    for (name, shape) in expected {
+        let view = st.tensor(name).map_err(|_| WeightsError::Missing {
+            path: path.clone(),
+            name,
+            expected: shape.clone(),
+        })?;
+        if view.dtype() != Dtype::F32 {
+            return Err(WeightsError::Dtype {
+                path,
+                name: name.to_string(),
+                found: format!("{:?}", view.dtype()),
+            });
+        }
+        if view.shape() != shape.as_slice() {
+            return Err(WeightsError::Shape {
+                path,
+                name: name.to_string(),
+                found: view.shape().to_vec(),
+                expected: shape.clone(),
+            });
+        }
+        out.push(
+            view.data()
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect(),
+        );
+    }
+    Ok(out)
 }
 
 /// Parse a file's bytes into parameters of size `cfg`. `origin` only labels errors.

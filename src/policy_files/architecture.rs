@@ -10,14 +10,21 @@
 //! ```
 
 use crate::nn::safetensors_io::{from_safetensors_bytes, WeightsError as NnWeightsError};
-use crate::nn::{QNet, QNetConfig, TENSOR_NAMES};
+use crate::nn::{
+    ActingNet, GruActor, GruActorConfig, QNet, QNetConfig, GRU_ACTOR_TENSOR_NAMES, TENSOR_NAMES,
+};
 use safetensors::Dtype;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The one architecture exported so far: the reference's `DDRQN` (fc1, fc2, one LSTM layer, fc3,
-/// fc4), whose sizes are the run's `dec_mlp_layer_size` (M) and `dec_rnn_h_size` (H).
+/// The ICRA reference's `DDRQN` (fc1, fc2, one LSTM layer, fc3, fc4), whose sizes are the run's
+/// `dec_mlp_layer_size` (M) and `dec_rnn_h_size` (H).
 pub const DDRQN: &str = "ddrqn";
+
+/// MacroMARL's actor ([`GruActor`]: fc1, fc2, one GRU layer, fc3, fc4, log_softmax), whose sizes
+/// are `a_mlp_layer_size = [m0, m1]` (`mlp_layer_size`, `mlp_out_size`) and `a_rnn_layer_size`
+/// (`rnn_h_size`).
+pub const GRU_ACTOR: &str = "macromarl-gru-actor";
 
 /// Negative slope of every leaky ReLU (PyTorch's `F.leaky_relu` default, used by the reference).
 pub const LEAKY_RELU_SLOPE: f32 = 0.01;
@@ -27,12 +34,16 @@ pub const LEAKY_RELU_SLOPE: f32 = 0.01;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Architecture {
-    /// Which module: [`DDRQN`].
+    /// Which module: [`DDRQN`] or [`GRU_ACTOR`].
     pub kind: String,
-    /// M: width of fc1 and fc3.
+    /// M: width of fc1 and fc3 (DDRQN); m0: width of fc1 and fc2 (GRU actor).
     pub mlp_layer_size: usize,
-    /// H: width of fc2 and of the LSTM's input and hidden state.
+    /// H: width of fc2 and of the LSTM's input and hidden state (DDRQN); the GRU's hidden size
+    /// (GRU actor).
     pub rnn_h_size: usize,
+    /// m1: width of fc3 (GRU actor only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mlp_out_size: Option<usize>,
     /// Negative slope of the leaky ReLUs ([`LEAKY_RELU_SLOPE`]).
     pub leaky_relu_slope: f32,
 }
@@ -44,7 +55,32 @@ impl Architecture {
             kind: DDRQN.to_string(),
             mlp_layer_size,
             rnn_h_size,
+            mlp_out_size: None,
             leaky_relu_slope: LEAKY_RELU_SLOPE,
+        }
+    }
+
+    /// MacroMARL's actor with `a_mlp_layer_size = [m0, m1]` and GRU hidden size H.
+    pub fn gru_actor(mlp: [usize; 2], rnn_h_size: usize) -> Self {
+        Architecture {
+            kind: GRU_ACTOR.to_string(),
+            mlp_layer_size: mlp[0],
+            rnn_h_size,
+            mlp_out_size: Some(mlp[1]),
+            leaky_relu_slope: LEAKY_RELU_SLOPE,
+        }
+    }
+
+    /// The actor sizes of one agent's net (GRU actor).
+    pub fn actor_config(&self, obs_len: usize, n_actions: usize) -> GruActorConfig {
+        GruActorConfig {
+            input: obs_len,
+            mlp: [
+                self.mlp_layer_size,
+                self.mlp_out_size.unwrap_or(self.mlp_layer_size),
+            ],
+            hidden: self.rnn_h_size,
+            output: n_actions,
         }
     }
 
@@ -62,6 +98,12 @@ impl Architecture {
     /// (`nn.Linear.weight` is `[out, in]`; the LSTM stacks its four gates i, f, g, o in `4H` rows):
     /// nn's one table of the Q-net's tensors ([`crate::nn::TENSORS`]).
     pub fn tensors(&self, obs_len: usize, n_actions: usize) -> Vec<(&'static str, Vec<usize>)> {
+        if self.kind == GRU_ACTOR {
+            return GRU_ACTOR_TENSOR_NAMES
+                .into_iter()
+                .zip(self.actor_config(obs_len, n_actions).tensor_shapes())
+                .collect();
+        }
         TENSOR_NAMES
             .into_iter()
             .zip(self.qnet_config(obs_len, n_actions).tensor_shapes())
@@ -77,7 +119,27 @@ impl Architecture {
         obs_len: usize,
         n_actions: usize,
     ) -> Result<(), WeightsError> {
-        self.qnet(bytes, obs_len, n_actions).map(|_| ())
+        self.acting_net(bytes, obs_len, n_actions).map(|_| ())
+    }
+
+    /// The net a safetensors file holds, checked as [`Self::check_weights`] describes.
+    pub fn acting_net(
+        &self,
+        bytes: &[u8],
+        obs_len: usize,
+        n_actions: usize,
+    ) -> Result<ActingNet, WeightsError> {
+        match self.kind.as_str() {
+            DDRQN => self.qnet(bytes, obs_len, n_actions).map(ActingNet::Q),
+            GRU_ACTOR => GruActor::from_safetensors_bytes_sized(
+                bytes,
+                self.actor_config(obs_len, n_actions),
+                Path::new(""),
+            )
+            .map(ActingNet::Actor)
+            .map_err(weights_error),
+            other => Err(WeightsError::UnknownKind(other.to_string())),
+        }
     }
 
     /// The Q-net a safetensors file holds, checked as [`Self::check_weights`] describes.
@@ -91,35 +153,38 @@ impl Architecture {
             return Err(WeightsError::UnknownKind(self.kind.clone()));
         }
         let cfg = self.qnet_config(obs_len, n_actions);
-        match from_safetensors_bytes(bytes, cfg, Path::new("")) {
-            Ok(params) => Ok(QNet { params }),
-            Err(e) => Err(match e {
-                NnWeightsError::Io { source, .. } => WeightsError::Unreadable(source.to_string()),
-                NnWeightsError::Format { reason, .. } => WeightsError::Unreadable(reason),
-                NnWeightsError::Missing { name, .. } => WeightsError::Missing(name.to_string()),
-                NnWeightsError::Unexpected { name, .. } => WeightsError::Unexpected(name),
-                NnWeightsError::Dtype { name, found, .. } => {
-                    WeightsError::Dtype { name, dtype: found }
-                }
-                NnWeightsError::Shape {
-                    name,
-                    found,
-                    expected,
-                    ..
-                } => WeightsError::Shape {
-                    name,
-                    expected,
-                    got: found,
-                },
-            }),
-        }
+        from_safetensors_bytes(bytes, cfg, Path::new(""))
+            .map(|params| QNet { params })
+            .map_err(weights_error)
+    }
+}
+
+/// nn's weight-file error as the policy format reports it (the file's path is added by the
+/// caller).
+fn weights_error(e: NnWeightsError) -> WeightsError {
+    match e {
+        NnWeightsError::Io { source, .. } => WeightsError::Unreadable(source.to_string()),
+        NnWeightsError::Format { reason, .. } => WeightsError::Unreadable(reason),
+        NnWeightsError::Missing { name, .. } => WeightsError::Missing(name.to_string()),
+        NnWeightsError::Unexpected { name, .. } => WeightsError::Unexpected(name),
+        NnWeightsError::Dtype { name, found, .. } => WeightsError::Dtype { name, dtype: found },
+        NnWeightsError::Shape {
+            name,
+            found,
+            expected,
+            ..
+        } => WeightsError::Shape {
+            name,
+            expected,
+            got: found,
+        },
     }
 }
 
 /// Why a weight file does not fit the manifest's architecture.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WeightsError {
-    #[error("unknown architecture `{0}` (this version knows `ddrqn`)")]
+    #[error("unknown architecture `{0}` (this version knows `ddrqn` and `macromarl-gru-actor`)")]
     UnknownKind(String),
     #[error("not a safetensors file: {0}")]
     Unreadable(String),

@@ -1,14 +1,14 @@
 //! `policy.json`, the description of a policy directory, and the one writer and loader of the
 //! directory (see the module doc of [`crate::policy_files`] for the JSON shape).
 
-use super::architecture::{Architecture, DDRQN, LEAKY_RELU_SLOPE};
+use super::architecture::{Architecture, DDRQN, GRU_ACTOR, LEAKY_RELU_SLOPE};
 use super::error::PolicyError;
 use super::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::read_regular_file;
 use crate::nn::safetensors_io::to_safetensors_bytes;
-use crate::nn::{QNet, QNetConfig};
+use crate::nn::{ActingNet, QNet, QNetConfig};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -23,13 +23,27 @@ pub(crate) const MAX_DESCRIPTION_BYTES: u64 = 1 << 20;
 /// Room for a weight file's JSON header beyond its tensor data.
 const MAX_SAFETENSORS_HEADER_BYTES: u64 = 1 << 16;
 
-/// What a net computes. Only Q-nets exist today; an actor-critic policy (MacroMARL: per-agent
-/// actors, centralized critics) adds its kinds here and writes the same entries.
+/// What a net computes: Q-values (the ICRA methods) or a policy's log-probabilities (MacroMARL's
+/// actors); a critic would be another kind with the same entries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NetKind {
     /// Q-values, one per macro-action (per joint macro-action for a centralized net).
     Q,
+    /// A policy's log-probabilities, one per macro-action (per joint macro-action for a
+    /// centralized actor): MacroMARL's actors.
+    Actor,
+}
+
+impl NetKind {
+    /// What a net of `architecture` computes: an actor for [`GRU_ACTOR`], else Q-values.
+    pub fn of_architecture(architecture: &Architecture) -> NetKind {
+        if architecture.kind == GRU_ACTOR {
+            NetKind::Actor
+        } else {
+            NetKind::Q
+        }
+    }
 }
 
 /// Whose input a net reads.
@@ -433,8 +447,21 @@ impl Manifest {
             }
             let (input, output) = self.q_net_sizes(net.role, net.agent);
             let sizes = match net.kind {
-                NetKind::Q => Some((input, output)),
+                NetKind::Q | NetKind::Actor => Some((input, output)),
             };
+            let expected_kind = match net.kind {
+                NetKind::Q => DDRQN,
+                NetKind::Actor => GRU_ACTOR,
+            };
+            if net.architecture.kind != expected_kind {
+                return Err(invalid(
+                    key("architecture.kind"),
+                    format!(
+                        "a {:?} net is a `{expected_kind}`, not a `{}`",
+                        net.kind, net.architecture.kind
+                    ),
+                ));
+            }
             if let Some((input, output)) = sizes {
                 if (Some(net.input), Some(net.output)) != (input, output) {
                     return Err(invalid(
@@ -641,7 +668,11 @@ impl Manifest {
         }
         self.nets
             .iter()
-            .position(|n| n.kind == NetKind::Q && n.role == NetRole::Dec && n.agent == Some(agent))
+            .position(|n| {
+                matches!(n.kind, NetKind::Q | NetKind::Actor)
+                    && n.role == NetRole::Dec
+                    && n.agent == Some(agent)
+            })
             .ok_or_else(|| PolicyError::NoAgentNet {
                 path: PathBuf::from(POLICY_FILE),
                 agent,
@@ -659,10 +690,17 @@ impl Manifest {
         })
     }
 
-    /// Agent `verified.index`'s Q-net from its verified bytes.
-    pub fn agent_qnet(&self, verified: &VerifiedAgent) -> Result<QNet, PolicyError> {
+    /// Agent `verified.index`'s net (a Q-net or an actor) from its verified bytes.
+    pub fn agent_acting_net(&self, verified: &VerifiedAgent) -> Result<ActingNet, PolicyError> {
         let index = self.agent_net(verified.index)?;
-        self.qnet_from_bytes(Path::new(""), index, &verified.weights)
+        let entry = &self.nets[index];
+        entry
+            .architecture
+            .acting_net(&verified.weights, entry.input, entry.output)
+            .map_err(|source| PolicyError::Weights {
+                path: PathBuf::from(&entry.file),
+                source,
+            })
     }
 
     /// The names of agent `agent`'s macro-actions. Panics if `agent` is out of range (the
@@ -672,7 +710,8 @@ impl Manifest {
     }
 }
 
-/// Agent i's decentralized Q-net file of an export from its weights `weights[i]`.
+/// Agent i's decentralized net file of an export from its weights `weights[i]` (a Q-net or an
+/// actor, as the architecture says).
 fn export_net_files(
     domain: &impl MacroEnv,
     architecture: &Architecture,
@@ -693,7 +732,7 @@ fn export_net_files(
         .iter()
         .enumerate()
         .map(|(agent, bytes)| NetFile {
-            kind: NetKind::Q,
+            kind: NetKind::of_architecture(architecture),
             role: NetRole::Dec,
             agent: Some(agent),
             file: weights_file_name(agent),
@@ -708,14 +747,21 @@ fn export_net_files(
 /// The architecture is one this build runs, with widths a config could have asked for.
 fn check_architecture(arch: &Architecture, i: usize, path: &Path) -> Result<(), PolicyError> {
     let key = |field: &str| format!("nets[{i}].architecture.{field}");
-    if arch.kind != DDRQN {
+    if arch.kind != DDRQN && arch.kind != GRU_ACTOR {
         return Err(PolicyError::invalid(
             path,
             key("kind"),
             format!(
-                "unknown architecture `{}` (this build knows `{DDRQN}`)",
+                "unknown architecture `{}` (this build knows `{DDRQN}` and `{GRU_ACTOR}`)",
                 arch.kind
             ),
+        ));
+    }
+    if arch.kind == DDRQN && arch.mlp_out_size.is_some() {
+        return Err(PolicyError::invalid(
+            path,
+            key("mlp_out_size"),
+            format!("is for `{GRU_ACTOR}`; a `{DDRQN}` has fc3 as wide as fc1"),
         ));
     }
     if arch.leaky_relu_slope != LEAKY_RELU_SLOPE {
@@ -731,6 +777,10 @@ fn check_architecture(arch: &Architecture, i: usize, path: &Path) -> Result<(), 
     for (field, value) in [
         ("mlp_layer_size", arch.mlp_layer_size),
         ("rnn_h_size", arch.rnn_h_size),
+        (
+            "mlp_out_size",
+            arch.mlp_out_size.unwrap_or(arch.mlp_layer_size),
+        ),
     ] {
         if value == 0 || value > MAX_NET_WIDTH {
             return Err(PolicyError::invalid(

@@ -1,11 +1,11 @@
 //! `macdec eval` (issue 12): greedy episodes of a policy directory in this process. The same
 //! driver loop as `macdec deploy` ([`run_episodes_with`]) with each robot replaced by an
-//! in-process link to the same Q-net ([`LocalLink`] over [`QNetPolicy`]), so for the same policy
+//! in-process link to the same Q-net ([`LocalLink`] over [`NetPolicy`]), so for the same policy
 //! and seed it gives exactly deploy's episodes, without starting a process or opening a socket.
 
 use crate::deploy::driver::{run_episodes_with, DeployError, EpisodeTrace};
 use crate::deploy::link::LocalLink;
-use crate::deploy::qnet_policy::{load_net, QNetPolicy};
+use crate::deploy::net_policy::{load_net, NetPolicy};
 use crate::envs::EnvRng;
 use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};
 use std::sync::Arc;
@@ -14,12 +14,12 @@ use std::sync::Arc;
 pub fn local_links(
     manifest: &Manifest,
     verified: &[VerifiedAgent],
-) -> Result<Vec<LocalLink<QNetPolicy>>, PolicyError> {
+) -> Result<Vec<LocalLink<NetPolicy>>, PolicyError> {
     verified
         .iter()
         .map(|v| {
             let net = load_net(manifest, v)?;
-            Ok(LocalLink::new(QNetPolicy::new(Arc::new(net))))
+            Ok(LocalLink::new(NetPolicy::new(Arc::new(net))))
         })
         .collect()
 }

@@ -94,6 +94,15 @@ pub enum ImportError {
         first_m: usize,
         first_h: usize,
     },
+    #[error("{path}: widths {mlp:?} and hidden size {hidden}, but {first} has {first_mlp:?} and {first_hidden}; all agents of a policy share one architecture")]
+    ActorMismatch {
+        path: PathBuf,
+        mlp: [usize; 2],
+        hidden: usize,
+        first: PathBuf,
+        first_mlp: [usize; 2],
+        first_hidden: usize,
+    },
     #[error("the {env} domain has {expected} agents, {got} state_dict files were given (one per agent, in agent order)")]
     AgentCount {
         env: &'static str,

@@ -1,26 +1,28 @@
-//! The real policy behind a robot: one exported agent's recurrent Q-net and its LSTM state,
-//! stepped with the same no-tape acting forward greedy evaluation uses (`QNet::act_step`).
+//! The real policy behind a robot: one agent's net (a recurrent Q-net or a MacroMARL actor,
+//! [`ActingNet`]) and its recurrent state, stepped with the same no-tape acting forward greedy
+//! evaluation uses. The scores it answers with are the net's (Q-values or log-probabilities);
+//! either way the highest is the greedy macro-action.
 
 use crate::deploy::server::PolicyFactory;
 use crate::deploy::AgentPolicy;
-use crate::nn::{LstmState, QNet};
+use crate::nn::{ActingNet, ActingState};
 use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};
 use std::sync::Arc;
 
-/// A Q-net shared between connections, with this connection's hidden state.
-pub struct QNetPolicy {
-    net: Arc<QNet>,
-    state: LstmState,
+/// A net shared between connections, with this connection's hidden state.
+pub struct NetPolicy {
+    net: Arc<ActingNet>,
+    state: ActingState,
     /// Where a step is computed; it becomes the state only if everything came out finite.
-    candidate: LstmState,
+    candidate: ActingState,
 }
 
-impl QNetPolicy {
+impl NetPolicy {
     /// The net with a zero hidden state.
-    pub fn new(net: Arc<QNet>) -> Self {
+    pub fn new(net: Arc<ActingNet>) -> Self {
         let state = net.zero_state();
         let candidate = net.zero_state();
-        QNetPolicy {
+        NetPolicy {
             net,
             state,
             candidate,
@@ -28,43 +30,43 @@ impl QNetPolicy {
     }
 }
 
-impl AgentPolicy for QNetPolicy {
+impl AgentPolicy for NetPolicy {
     fn obs_len(&self) -> usize {
-        self.net.config().input
+        self.net.obs_len()
     }
     fn n_actions(&self) -> usize {
-        self.net.config().output
+        self.net.n_actions()
     }
     fn reset(&mut self) {
         self.state.reset();
     }
     fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
-        // A huge but finite observation can overflow the LSTM: keep the old state then, so one
-        // bad message does not break the rest of the session.
+        // A huge but finite observation can overflow the recurrent layer: keep the old state
+        // then, so one bad message does not break the rest of the session.
         self.candidate.copy_from(&self.state);
         q.copy_from_slice(self.net.act_step(obs, &mut self.candidate));
-        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
-        if finite(q) && finite(self.candidate.h()) && finite(self.candidate.c()) {
+        if q.iter().all(|x| x.is_finite()) && self.candidate.is_finite() {
             std::mem::swap(&mut self.state, &mut self.candidate);
         }
     }
 }
 
 /// Build agent `verified.index`'s net from its verified weight bytes, sized by its net entry.
-pub fn load_net(manifest: &Manifest, verified: &VerifiedAgent) -> Result<QNet, PolicyError> {
-    manifest.agent_qnet(verified)
+pub fn load_net(manifest: &Manifest, verified: &VerifiedAgent) -> Result<ActingNet, PolicyError> {
+    manifest.agent_acting_net(verified)
 }
 
 /// A factory giving each connection the same net with a fresh zero state.
-pub fn qnet_factory(net: QNet) -> PolicyFactory {
+pub fn net_factory(net: ActingNet) -> PolicyFactory {
     let net = Arc::new(net);
-    Arc::new(move || Box::new(QNetPolicy::new(net.clone())) as Box<dyn AgentPolicy>)
+    Arc::new(move || Box::new(NetPolicy::new(net.clone())) as Box<dyn AgentPolicy>)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::nn::safetensors_io::to_safetensors_bytes;
+    use crate::nn::QNet;
     use crate::nn::QNetConfig;
     use crate::policy_files::architecture::Architecture;
     use crate::policy_files::{load_agent, RunInfo};
@@ -113,7 +115,7 @@ mod tests {
         )
         .unwrap();
         let (manifest, verified) = load_agent(dir.path(), 2).unwrap();
-        let mut policy = QNetPolicy::new(Arc::new(load_net(&manifest, &verified).unwrap()));
+        let mut policy = NetPolicy::new(Arc::new(load_net(&manifest, &verified).unwrap()));
         assert_eq!((policy.obs_len(), policy.n_actions()), (4, 6));
         let mut state = nets[2].zero_state();
         let mut q = vec![0.0; 6];
@@ -137,15 +139,15 @@ mod tests {
             hidden: 6,
             output: 4,
         };
-        let net = Arc::new(QNet::new(cfg, &mut rng));
+        let net = Arc::new(ActingNet::Q(QNet::new(cfg, &mut rng)));
         let (a, b) = ([0.5, -1.0, 0.0, 1.0, 0.25], [1.0, 0.0, 1.0, 0.0, -0.5]);
         let mut q = [0.0; 4];
-        let mut reference = QNetPolicy::new(net.clone());
+        let mut reference = NetPolicy::new(net.clone());
         reference.q_values(&a, &mut q);
         reference.q_values(&b, &mut q);
         let expected = q;
 
-        let mut policy = QNetPolicy::new(net);
+        let mut policy = NetPolicy::new(net);
         policy.q_values(&a, &mut q);
         policy.q_values(&[3.4e38; 5], &mut q);
         assert!(

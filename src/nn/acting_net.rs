@@ -1,0 +1,105 @@
+//! The net a decentralized agent acts with, whichever family trained it: the ICRA methods'
+//! recurrent Q-net ([`QNet`], scores = Q-values) or MacroMARL's actor ([`GruActor`], scores =
+//! log-probabilities). Both are stepped one macro-observation at a time with a carried recurrent
+//! state, and the greedy macro-action is the highest score, so evaluation, robots and deploy run
+//! either without knowing which.
+
+use super::gru_actor::{GruActor, GruActorState};
+use super::lstm::LstmState;
+use super::qnet::QNet;
+
+/// A decentralized agent's net.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ActingNet {
+    /// Q-values (the ICRA methods' DDRQN).
+    Q(QNet),
+    /// Log-probabilities (MacroMARL's actors).
+    Actor(GruActor),
+}
+
+/// The recurrent state an [`ActingNet`] carries between an agent's decisions.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ActingState {
+    Lstm(LstmState),
+    Gru(GruActorState),
+}
+
+impl ActingNet {
+    /// Length of the observation it reads.
+    pub fn obs_len(&self) -> usize {
+        match self {
+            ActingNet::Q(q) => q.config().input,
+            ActingNet::Actor(a) => a.config().input,
+        }
+    }
+
+    /// Number of macro-actions it scores.
+    pub fn n_actions(&self) -> usize {
+        match self {
+            ActingNet::Q(q) => q.config().output,
+            ActingNet::Actor(a) => a.config().output,
+        }
+    }
+
+    /// The Q-net, if it is one.
+    pub fn as_q(&self) -> Option<&QNet> {
+        match self {
+            ActingNet::Q(q) => Some(q),
+            ActingNet::Actor(_) => None,
+        }
+    }
+
+    /// What its scores are, for messages: "Q-values" or "log-probabilities".
+    pub fn scores(&self) -> &'static str {
+        match self {
+            ActingNet::Q(_) => "Q-values",
+            ActingNet::Actor(_) => "log-probabilities",
+        }
+    }
+
+    /// The zero state of an episode's start.
+    pub fn zero_state(&self) -> ActingState {
+        match self {
+            ActingNet::Q(q) => ActingState::Lstm(q.zero_state()),
+            ActingNet::Actor(a) => ActingState::Gru(a.zero_state()),
+        }
+    }
+
+    /// One decision: the scores of every macro-action for `x`, advancing `state`. Panics if x or
+    /// the state do not belong to this net.
+    pub fn act_step<'s>(&self, x: &[f32], state: &'s mut ActingState) -> &'s [f32] {
+        match (self, state) {
+            (ActingNet::Q(q), ActingState::Lstm(s)) => q.act_step(x, s),
+            (ActingNet::Actor(a), ActingState::Gru(s)) => a.act_step(x, s),
+            _ => panic!("act_step: the state belongs to another kind of net"),
+        }
+    }
+}
+
+impl ActingState {
+    /// Back to the zero state.
+    pub fn reset(&mut self) {
+        match self {
+            ActingState::Lstm(s) => s.reset(),
+            ActingState::Gru(s) => s.reset(),
+        }
+    }
+
+    /// Copy `other` into `self` (same net). Panics if they belong to different kinds of net.
+    pub fn copy_from(&mut self, other: &ActingState) {
+        match (self, other) {
+            (ActingState::Lstm(a), ActingState::Lstm(b)) => a.copy_from(b),
+            (ActingState::Gru(a), ActingState::Gru(b)) => a.copy_from(b),
+            _ => panic!("copy_from: states of different kinds of net"),
+        }
+    }
+
+    /// Whether every value of the recurrent state is finite.
+    pub fn is_finite(&self) -> bool {
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        match self {
+            ActingState::Lstm(s) => finite(s.h()) && finite(s.c()),
+            ActingState::Gru(s) => finite(s.h()),
+        }
+    }
+}

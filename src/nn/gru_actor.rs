@@ -1,0 +1,381 @@
+//! MacroMARL's recurrent actor (spec `macromarl.md` 2.4, `cores/pg_based/mac_iac/models.py:
+//! Actor`), for acting: the authors' trained actors run here, greedy or sampled.
+//!
+//! ```text
+//! obs -> fc1 (in -> m0) -> leaky_relu(0.01) -> fc2 (m0 -> m0) -> leaky_relu -> GRU (m0 -> H)
+//!     -> fc3 (H -> m1) -> leaky_relu -> fc4 (m1 -> actions) -> log_softmax
+//! ```
+//!
+//! Unlike the ICRA Q-net, fc2 keeps width m0 and the recurrent layer is a GRU. The weight file is
+//! the module's `state_dict` under its own names (`fc1.weight`, ..., `gru.weight_ih_l0`, ...), so
+//! `scripts/torch_to_safetensors.py` converts the shipped `agent_state_dict*.pt` files as they
+//! are. The eps-mixture the reference applies while training is not part of acting
+//! (`test_mode`), so it is not here.
+
+use std::path::Path;
+
+use ndarray::ArrayViewD;
+
+use super::gru::GruState;
+use super::params::{GruParams, LinearParams};
+use super::safetensors_io::{read_exact, tensor_shape, WeightsError};
+use crate::autograd::Activation;
+
+/// The actor's tensors, in its `state_dict` order.
+pub const GRU_ACTOR_TENSOR_NAMES: [&str; 12] = [
+    "fc1.weight",
+    "fc1.bias",
+    "fc2.weight",
+    "fc2.bias",
+    "gru.weight_ih_l0",
+    "gru.weight_hh_l0",
+    "gru.bias_ih_l0",
+    "gru.bias_hh_l0",
+    "fc3.weight",
+    "fc3.bias",
+    "fc4.weight",
+    "fc4.bias",
+];
+
+/// The actor's sizes: its input, the MLP widths m0 (fc1, fc2) and m1 (fc3), the GRU's hidden
+/// size H and the number of macro-actions (MacroMARL's `a_mlp_layer_size = [m0, m1]` and
+/// `a_rnn_layer_size = H`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GruActorConfig {
+    pub input: usize,
+    pub mlp: [usize; 2],
+    pub hidden: usize,
+    pub output: usize,
+}
+
+impl GruActorConfig {
+    /// Each tensor's PyTorch shape, in [`GRU_ACTOR_TENSOR_NAMES`] order.
+    pub fn tensor_shapes(&self) -> [Vec<usize>; 12] {
+        let ([m0, m1], h) = (self.mlp, self.hidden);
+        [
+            vec![m0, self.input],
+            vec![m0],
+            vec![m0, m0],
+            vec![m0],
+            vec![3 * h, m0],
+            vec![3 * h, h],
+            vec![3 * h],
+            vec![3 * h],
+            vec![m1, h],
+            vec![m1],
+            vec![self.output, m1],
+            vec![self.output],
+        ]
+    }
+}
+
+/// The actor's parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GruActor {
+    fc1: LinearParams,
+    fc2: LinearParams,
+    gru: GruParams,
+    fc3: LinearParams,
+    fc4: LinearParams,
+}
+
+/// One agent's recurrent state while acting, with the scratch the forward writes into (acting
+/// never allocates after the first step).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GruActorState {
+    gru: GruState,
+    a1: Vec<f32>,
+    a2: Vec<f32>,
+    a3: Vec<f32>,
+    out: Vec<f32>,
+}
+
+impl GruActorState {
+    /// Back to the zero state, as at the start of an episode.
+    pub fn reset(&mut self) {
+        self.gru.reset();
+    }
+
+    /// The GRU's hidden state h: [H].
+    pub fn h(&self) -> &[f32] {
+        self.gru.h()
+    }
+
+    /// Copy `other` (same sizes) into `self`.
+    pub fn copy_from(&mut self, other: &GruActorState) {
+        self.clone_from(other);
+    }
+}
+
+const LEAKY: Activation = Activation::LEAKY_001;
+
+impl GruActor {
+    /// The sizes.
+    pub fn config(&self) -> GruActorConfig {
+        GruActorConfig {
+            input: self.fc1.input(),
+            mlp: [self.fc1.output(), self.fc3.output()],
+            hidden: self.gru.hidden(),
+            output: self.fc4.output(),
+        }
+    }
+
+    /// Every tensor with its `state_dict` name, in [`GRU_ACTOR_TENSOR_NAMES`] order.
+    pub fn named(&self) -> [(&'static str, ArrayViewD<'_, f32>); 12] {
+        let n = GRU_ACTOR_TENSOR_NAMES;
+        [
+            (n[0], self.fc1.weight.view().into_dyn()),
+            (n[1], self.fc1.bias.view().into_dyn()),
+            (n[2], self.fc2.weight.view().into_dyn()),
+            (n[3], self.fc2.bias.view().into_dyn()),
+            (n[4], self.gru.weight_ih.view().into_dyn()),
+            (n[5], self.gru.weight_hh.view().into_dyn()),
+            (n[6], self.gru.bias_ih.view().into_dyn()),
+            (n[7], self.gru.bias_hh.view().into_dyn()),
+            (n[8], self.fc3.weight.view().into_dyn()),
+            (n[9], self.fc3.bias.view().into_dyn()),
+            (n[10], self.fc4.weight.view().into_dyn()),
+            (n[11], self.fc4.bias.view().into_dyn()),
+        ]
+    }
+
+    /// The actor a safetensors file holds, its sizes read from `fc1.weight` [m0, in],
+    /// `gru.weight_hh_l0` [3H, H], `fc3.weight` [m1, H] and `fc4.weight` [actions, m1]: exactly
+    /// the twelve tensors, F32, of consistent shapes. `origin` labels errors.
+    pub fn from_safetensors_bytes(bytes: &[u8], origin: &Path) -> Result<GruActor, WeightsError> {
+        let [fc1, hh, fc3, fc4] = ["fc1.weight", "gru.weight_hh_l0", "fc3.weight", "fc4.weight"]
+            .map(|name| tensor_shape(bytes, origin, name));
+        let (fc1, hh, fc3, fc4) = (fc1?, hh?, fc3?, fc4?);
+        let dim = |s: &[usize], k: usize| s.get(k).copied().unwrap_or(0);
+        let cfg = GruActorConfig {
+            input: dim(&fc1, 1),
+            mlp: [dim(&fc1, 0), dim(&fc3, 0)],
+            hidden: dim(&hh, 1),
+            output: dim(&fc4, 0),
+        };
+        Self::from_safetensors_bytes_sized(bytes, cfg, origin)
+    }
+
+    /// [`Self::from_safetensors_bytes`] for known sizes `cfg`: every shape must match them.
+    pub fn from_safetensors_bytes_sized(
+        bytes: &[u8],
+        cfg: GruActorConfig,
+        origin: &Path,
+    ) -> Result<GruActor, WeightsError> {
+        let expected: Vec<(&'static str, Vec<usize>)> = GRU_ACTOR_TENSOR_NAMES
+            .into_iter()
+            .zip(cfg.tensor_shapes())
+            .collect();
+        let mut t = read_exact(bytes, origin, "GRU actor", &expected)?.into_iter();
+        let ([m0, m1], h) = (cfg.mlp, cfg.hidden);
+        let fc1 = take_linear(&mut t, cfg.input, m0);
+        let fc2 = take_linear(&mut t, m0, m0);
+        let mut gru = GruParams::zeros(m0, h);
+        for slot in [
+            gru.weight_ih.as_slice_mut(),
+            gru.weight_hh.as_slice_mut(),
+            gru.bias_ih.as_slice_mut(),
+            gru.bias_hh.as_slice_mut(),
+        ] {
+            slot.expect("fresh array")
+                .copy_from_slice(&t.next().expect("twelve tensors"));
+        }
+        let fc3 = take_linear(&mut t, h, m1);
+        let fc4 = take_linear(&mut t, m1, cfg.output);
+        Ok(GruActor {
+            fc1,
+            fc2,
+            gru,
+            fc3,
+            fc4,
+        })
+    }
+
+    /// A zero recurrent state sized for this actor.
+    pub fn zero_state(&self) -> GruActorState {
+        let cfg = self.config();
+        GruActorState {
+            gru: GruState::zeros(cfg.hidden),
+            a1: vec![0.0; cfg.mlp[0]],
+            a2: vec![0.0; cfg.mlp[0]],
+            a3: vec![0.0; cfg.mlp[1]],
+            out: vec![0.0; cfg.output],
+        }
+    }
+
+    /// One acting step: the log-probabilities of the macro-actions for input x given the
+    /// carried state, which advances (the reference's `test_mode` forward with its hidden state
+    /// kept between the agent's decisions). Panics if x or the state do not match the sizes.
+    pub fn act_step<'s>(&self, x: &[f32], state: &'s mut GruActorState) -> &'s [f32] {
+        assert_eq!(x.len(), self.fc1.input(), "act_step: input length");
+        self.fc1.forward_row(x, LEAKY, &mut state.a1);
+        self.fc2.forward_row(&state.a1, LEAKY, &mut state.a2);
+        self.gru.step(&state.a2, &mut state.gru);
+        self.fc3.forward_row(state.gru.h(), LEAKY, &mut state.a3);
+        self.fc4
+            .forward_row(&state.a3, Activation::Identity, &mut state.out);
+        log_softmax_in_place(&mut state.out);
+        &state.out
+    }
+
+    /// The GRU's parameters.
+    pub fn gru(&self) -> &GruParams {
+        &self.gru
+    }
+}
+
+/// The next two tensors (weight, bias) of `t` as a layer from `input` to `output` features;
+/// their shapes were checked by [`read_exact`].
+fn take_linear(
+    t: &mut impl Iterator<Item = Vec<f32>>,
+    input: usize,
+    output: usize,
+) -> LinearParams {
+    let mut p = LinearParams::zeros(input, output);
+    for slot in [p.weight.as_slice_mut(), p.bias.as_slice_mut()] {
+        slot.expect("fresh array")
+            .copy_from_slice(&t.next().expect("a weight and a bias"));
+    }
+    p
+}
+
+/// x <- x - max - log(sum(exp(x - max))), as `torch.log_softmax` computes it.
+fn log_softmax_in_place(x: &mut [f32]) {
+    let max = x.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    let sum: f32 = x.iter().map(|v| (v - max).exp()).sum();
+    let lse = sum.ln();
+    for v in x.iter_mut() {
+        *v = *v - max - lse;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nn::safetensors_io::named_to_safetensors_bytes;
+
+    /// An actor whose every element is a small deterministic function of its name and index.
+    fn actor(cfg: GruActorConfig) -> Vec<u8> {
+        let data: Vec<(&'static str, Vec<usize>, Vec<f32>)> = GRU_ACTOR_TENSOR_NAMES
+            .into_iter()
+            .zip(cfg.tensor_shapes())
+            .enumerate()
+            .map(|(k, (name, shape))| {
+                let n: usize = shape.iter().product();
+                let values = (0..n)
+                    .map(|i| (((i * 7 + k * 13) % 17) as f32 - 8.0) / 40.0)
+                    .collect();
+                (name, shape, values)
+            })
+            .collect();
+        let arrays: Vec<(&'static str, ndarray::ArrayD<f32>)> = data
+            .into_iter()
+            .map(|(n, s, v)| (n, ndarray::ArrayD::from_shape_vec(s, v).unwrap()))
+            .collect();
+        let views: Vec<(&'static str, ArrayViewD<'_, f32>)> =
+            arrays.iter().map(|(n, a)| (*n, a.view())).collect();
+        named_to_safetensors_bytes(&views)
+    }
+
+    const CFG: GruActorConfig = GruActorConfig {
+        input: 5,
+        mlp: [6, 4],
+        hidden: 3,
+        output: 8,
+    };
+
+    #[test]
+    fn sizes_come_from_the_file_and_bytes_round_trip() {
+        let bytes = actor(CFG);
+        let a = GruActor::from_safetensors_bytes(&bytes, Path::new("a")).unwrap();
+        assert_eq!(a.config(), CFG);
+        assert_eq!(named_to_safetensors_bytes(&a.named()), bytes);
+    }
+
+    #[test]
+    fn a_step_is_the_layers_composed_and_a_distribution() {
+        let a = GruActor::from_safetensors_bytes(&actor(CFG), Path::new("a")).unwrap();
+        let mut s = a.zero_state();
+        let x = [0.0, 1.0, 0.0, 0.5, -1.0];
+        let first = a.act_step(&x, &mut s).to_vec();
+        let total: f32 = first.iter().map(|v| v.exp()).sum();
+        assert!((total - 1.0).abs() < 1e-5, "{total}");
+        // The same layers by hand, with the bare GRU's own step.
+        let mut a1 = vec![0.0; 6];
+        let mut a2 = vec![0.0; 6];
+        a.fc1.forward_row(&x, LEAKY, &mut a1);
+        a.fc2.forward_row(&a1, LEAKY, &mut a2);
+        let mut g = GruState::zeros(3);
+        a.gru().step(&a2, &mut g);
+        assert_eq!(s.h(), g.h());
+        // The state carries: a second step from it differs from a step from zero.
+        let second = a.act_step(&x, &mut s).to_vec();
+        let mut fresh = a.zero_state();
+        assert_eq!(a.act_step(&x, &mut fresh), first.as_slice());
+        assert_ne!(second, first);
+        s.reset();
+        assert_eq!(a.act_step(&x, &mut s), first.as_slice());
+    }
+
+    #[test]
+    fn matches_pytorch_step_by_step_with_the_state_carried() {
+        // tests/fixtures/gru_actor_torch.{json,safetensors}, written by
+        // scripts/gru_actor_fixture_from_torch.py from a PyTorch module of the actor's shape.
+        let want: serde_json::Value =
+            serde_json::from_str(include_str!("../../tests/fixtures/gru_actor_torch.json"))
+                .unwrap();
+        let bytes = include_bytes!("../../tests/fixtures/gru_actor_torch.safetensors");
+        let a = GruActor::from_safetensors_bytes(bytes, Path::new("fixture")).unwrap();
+        assert_eq!(
+            a.config(),
+            GruActorConfig {
+                input: 5,
+                mlp: [6, 4],
+                hidden: 3,
+                output: 8
+            }
+        );
+        let floats = |v: &serde_json::Value| -> Vec<f32> {
+            v.as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap() as f32)
+                .collect()
+        };
+        let mut s = a.zero_state();
+        let steps = want["steps"].as_array().unwrap();
+        for (obs, step) in want["obs"].as_array().unwrap().iter().zip(steps) {
+            let got = a.act_step(&floats(obs), &mut s).to_vec();
+            for (g, w) in got.iter().zip(floats(&step["log_probs"])) {
+                assert!(
+                    (g - w).abs() < 1e-5,
+                    "log-probs {got:?} vs {:?}",
+                    step["log_probs"]
+                );
+            }
+            for (g, w) in s.h().iter().zip(floats(&step["h"])) {
+                assert!((g - w).abs() < 1e-5, "h {:?} vs {:?}", s.h(), step["h"]);
+            }
+        }
+        assert_eq!(steps.len(), 5);
+    }
+
+    #[test]
+    fn inconsistent_or_foreign_files_name_the_tensor() {
+        let bytes = actor(CFG);
+        let other = GruActorConfig { output: 7, ..CFG };
+        let err =
+            GruActor::from_safetensors_bytes_sized(&bytes, other, Path::new("a")).unwrap_err();
+        assert!(err.to_string().contains("fc4.weight"), "{err}");
+        let q = crate::nn::safetensors_io::to_safetensors_bytes(&crate::nn::QNetParams::zeros(
+            crate::nn::QNetConfig {
+                input: 5,
+                mlp: 4,
+                hidden: 3,
+                output: 8,
+            },
+        ));
+        let err = GruActor::from_safetensors_bytes(&q, Path::new("q")).unwrap_err();
+        assert!(err.to_string().contains("gru.weight_hh_l0"), "{err}");
+    }
+}
