@@ -10,9 +10,9 @@ mod common;
 use common::{run, stdout_lines, weight};
 use macdec::deploy::architecture::{synthetic_weights, Architecture};
 use macdec::deploy::manifest::load_all;
-use macdec::policy_files::NetKind;
 use macdec::deploy::EpisodeTrace;
 use macdec::envs::{EnvSpec, MacroEnv};
+use macdec::policy_files::NetKind;
 use std::path::{Path, PathBuf};
 
 /// One actor file per agent of `env` with widths `mlp` and hidden size `hidden`.

@@ -70,7 +70,7 @@ pub fn bench_env(name: &str, spec: EnvSpec, min_steps: u64) -> Result<EnvBench, 
     })
 }
 
-/// The environments `macdec bench envs` measures, at the paper's settings.
+/// The environments `macdec bench envs` measures, at the papers' settings.
 pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
     vec![
         (
@@ -84,6 +84,18 @@ pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
         (
             "warehouse (horizon 150)",
             crate::envs::warehouse::spec(150, 0.0),
+        ),
+        (
+            "BP-MA-v0 6x6 (runner horizon 100)",
+            crate::envs::bp_ma_v0::spec(6, 100),
+        ),
+        (
+            "BP-MA-v0 10x10 (runner horizon 100)",
+            crate::envs::bp_ma_v0::spec(10, 100),
+        ),
+        (
+            "BP-MA-v0 14x14 (runner horizon 100)",
+            crate::envs::bp_ma_v0::spec(14, 100),
         ),
     ]
 }

@@ -436,3 +436,32 @@ fn a_custom_domain_that_draws_renders_through_any_env() {
     }
     assert_eq!(frames[3].team_return, 3.0);
 }
+
+#[test]
+fn every_built_in_domain_draws_a_random_episode_into_a_gif() {
+    // Each built-in domain at its default keys: a random episode records, encodes and decodes
+    // frame for frame.
+    for domain in crate::envs::registry::BUILT_IN {
+        let spec = crate::envs::EnvSpec::of(*domain, &toml::Table::new()).unwrap();
+        let mut env = spec.build().unwrap();
+        let mut rng = EnvRng::seed_from_u64(3);
+        let mut pick = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let n_actions = env.n_actions().to_vec();
+        let frames = record_episode(&mut env, &mut rng, |_: &AnyEnv, actions: &mut [usize]| {
+            for (a, &n) in actions.iter_mut().zip(&n_actions) {
+                *a = pick.gen_range(0..n);
+            }
+        });
+        let frames = frames.unwrap_or_else(|e| panic!("{}: {e}", domain.name()));
+        assert!(frames.len() > 1, "{}", domain.name());
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("episode.gif");
+        write_gif(&frames, &path, 100).unwrap();
+        assert_eq!(
+            decode(&path).screens.len(),
+            frames.len(),
+            "{}",
+            domain.name()
+        );
+    }
+}
