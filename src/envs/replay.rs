@@ -393,6 +393,44 @@ mod tests {
     }
 
     #[test]
+    fn the_reference_form_prints_what_the_reference_returns() {
+        let text = r#"{"env": "BP-MA-v0", "params": {"grid_dim": [6, 6], "TB_move_speed": 0.6},
+            "steps": [[2, 3], [-1, -1], [-1, -1], [-1, -1], [4, 4], [-1, -1], [7, 7]]}"#;
+        let file = parse_replay(text).unwrap();
+        assert!(file.reference_form);
+        // The runner's horizon is the file's length, so only the env's own terminal ends it.
+        assert_eq!(file.spec.horizon(), 7);
+        let replay = run_replay(&file, false).unwrap();
+        assert_eq!((replay.frames.len(), replay.unused_steps), (7, 1));
+        let first = &replay.frames[0].line;
+        assert_eq!(first.state.as_ref().map(Vec::len), Some(18));
+        let last = &replay.frames[6].line;
+        assert_eq!(last.rewards, Some(vec![299.9, 299.9]));
+        assert_eq!(last.done, Some(true));
+        // A horizon cut is not the env's terminal: done stays false on the last line.
+        let cut = r#"{"env": "BP-MA-v0", "params": {}, "steps": [[7, 7], [7, 7]]}"#;
+        let replay = run_replay(&parse_replay(cut).unwrap(), false).unwrap();
+        assert_eq!(replay.frames[2].line.done, Some(false));
+        // The ICRA form keeps its lines: no rewards, no state.
+        let icra = run_replay(&parse_replay(&bp10("[[7, 7]]")).unwrap(), false).unwrap();
+        assert!(icra.frames[1].line.rewards.is_none() && icra.frames[1].line.state.is_none());
+    }
+
+    #[test]
+    fn bad_reference_forms_name_the_problem() {
+        let e = error_of(r#"{"env": "BP-MA-v0", "params": [1], "steps": []}"#);
+        assert!(e.contains("`params` must be an object"), "{e}");
+        let e = error_of(r#"{"env": "BP-MA-v0", "params": {"penalty": null}, "steps": []}"#);
+        assert!(e.contains("`params.penalty` holds a null"), "{e}");
+        let e = error_of(r#"{"env": "BP-MA-v0", "grid": 6, "params": {}, "steps": []}"#);
+        assert!(e.contains("unknown field `grid`"), "{e}");
+        let e = error_of(r#"{"params": {}, "steps": []}"#);
+        assert!(e.contains("`env` must be a string"), "{e}");
+        let e = error_of(r#"{"env": "BP-MA-v0", "params": {"colour": 1}, "steps": []}"#);
+        assert!(e.contains("`colour`: not a key of this domain"), "{e}");
+    }
+
+    #[test]
     fn busy_agents_may_hold_any_integer() {
         let file = parse_replay(&bp10("[[2, 7], [-1, 7], [99, 7]]")).unwrap();
         let replay = run_replay(&file, false).unwrap();
