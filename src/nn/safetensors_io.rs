@@ -168,52 +168,13 @@ pub fn from_safetensors_bytes(
     cfg: QNetConfig,
     origin: &Path,
 ) -> Result<QNetParams, WeightsError> {
-    let path = origin.to_path_buf();
-    let st = SafeTensors::deserialize(bytes).map_err(|e| WeightsError::Format {
-        path: path.clone(),
-        reason: e.to_string(),
-    })?;
-    let mut names: Vec<String> = st.names().into_iter().cloned().collect();
-    names.sort();
-    for name in &names {
-        if !TENSOR_NAMES.contains(&name.as_str()) {
-            return Err(WeightsError::Unexpected {
-                path,
-                name: name.clone(),
-                what: "Q-net",
-                expected: TENSOR_NAMES.join(", "),
-            });
-        }
-    }
+    let expected: Vec<(&'static str, Vec<usize>)> =
+        TENSOR_NAMES.into_iter().zip(cfg.tensor_shapes()).collect();
+    let values = read_exact(bytes, origin, "Q-net", &expected)?;
     let mut params = QNetParams::zeros(cfg);
-    let shapes = cfg.tensor_shapes();
-    let mut slots = params.slices_mut();
-    for ((name, expected), slot) in TENSOR_NAMES.iter().zip(shapes).zip(slots.iter_mut()) {
-        let view = st.tensor(name).map_err(|_| WeightsError::Missing {
-            path: path.clone(),
-            name,
-            expected: expected.clone(),
-        })?;
-        if view.dtype() != Dtype::F32 {
-            return Err(WeightsError::Dtype {
-                path,
-                name: name.to_string(),
-                found: format!("{:?}", view.dtype()),
-            });
-        }
-        if view.shape() != expected.as_slice() {
-            return Err(WeightsError::Shape {
-                path,
-                name: name.to_string(),
-                found: view.shape().to_vec(),
-                expected,
-            });
-        }
-        for (d, b) in slot.iter_mut().zip(view.data().chunks_exact(4)) {
-            *d = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-        }
+    for (slot, v) in params.slices_mut().into_iter().zip(values) {
+        slot.copy_from_slice(&v);
     }
-    drop(slots);
     Ok(params)
 }
 

@@ -7,7 +7,7 @@
 //! The reference names the LSTM `lstm` in `MA_dec_cen_hddrqn` (MacDec-MADDRQN, Our-1/Our-2) and
 //! `rnn` in `MA_hddrqn` (Dec-HDDRQN); both are accepted.
 
-use crate::envs::{EnvSpec, MacroEnv};
+use crate::envs::{AnyEnv, EnvSpec, MacroEnv};
 use crate::nn::safetensors_io::{from_safetensors_bytes, to_safetensors_bytes};
 use crate::nn::QNetConfig;
 use crate::policy_files::architecture::Architecture;
@@ -339,9 +339,8 @@ struct Source {
     tensor_names: Naming,
 }
 
-/// Import one state_dict per agent into the policy directory `out` (see the module doc). The
-/// manifest's run section says `imported` and lists each source file with its SHA-256.
-pub fn import_policy(request: &ImportRequest, out: &Path) -> Result<Manifest, ImportError> {
+/// The request's domain, built, with one file per agent (else [`ImportError::AgentCount`]).
+pub fn request_domain(request: &ImportRequest) -> Result<AnyEnv, ImportError> {
     let env = request
         .env
         .build()
@@ -353,6 +352,25 @@ pub fn import_policy(request: &ImportRequest, out: &Path) -> Result<Manifest, Im
             got: request.agents.len(),
         });
     }
+    Ok(env)
+}
+
+/// The run section of an imported policy: `imported`, with `config` saying where from.
+pub fn imported_run(config: serde_json::Value) -> RunInfo {
+    RunInfo {
+        experiment: IMPORTED.to_string(),
+        method: IMPORTED.to_string(),
+        variant: String::new(),
+        seed: 0,
+        episodes_trained: 0,
+        config,
+    }
+}
+
+/// Import one state_dict per agent into the policy directory `out` (see the module doc). The
+/// manifest's run section says `imported` and lists each source file with its SHA-256.
+pub fn import_policy(request: &ImportRequest, out: &Path) -> Result<Manifest, ImportError> {
+    let env = request_domain(request)?;
     let mut checked: Vec<CheckedStateDict> = Vec::with_capacity(request.agents.len());
     let mut sources = Vec::with_capacity(request.agents.len());
     for (agent, path) in request.agents.iter().enumerate() {
@@ -379,17 +397,10 @@ pub fn import_policy(request: &ImportRequest, out: &Path) -> Result<Manifest, Im
         checked.push(one);
     }
     let (m, h) = (checked[0].mlp, checked[0].hidden);
-    let run = RunInfo {
-        experiment: IMPORTED.to_string(),
-        method: IMPORTED.to_string(),
-        variant: String::new(),
-        seed: 0,
-        episodes_trained: 0,
-        config: serde_json::json!({
-            "imported_from": "PyTorch DDRQN state_dicts (reference code)",
-            "files": sources,
-        }),
-    };
+    let run = imported_run(serde_json::json!({
+        "imported_from": "PyTorch DDRQN state_dicts (reference code)",
+        "files": sources,
+    }));
     let weights: Vec<Vec<u8>> = checked.into_iter().map(|c| c.canonical).collect();
     Ok(Manifest::write_policy(
         out,

@@ -5,11 +5,13 @@
 //! and output sizes the domain agent's and the same widths as agent 0's; the directory is written
 //! by [`Manifest::write_policy`] as for any other policy, its nets of kind `actor`.
 
-use super::import::{read_bounded, ImportError, ImportRequest, IMPORTED, MAX_STATE_DICT_BYTES};
+use super::import::{
+    imported_run, read_bounded, request_domain, ImportError, ImportRequest, MAX_STATE_DICT_BYTES,
+};
 use crate::envs::MacroEnv;
 use crate::nn::{GruActor, GruActorConfig};
 use crate::policy_files::architecture::Architecture;
-use crate::policy_files::{sha256_hex, Manifest, RunInfo};
+use crate::policy_files::{sha256_hex, Manifest};
 use serde::Serialize;
 use std::path::Path;
 
@@ -86,17 +88,7 @@ pub fn check_actor(
 
 /// Import one actor file per agent into the policy directory `out` (see the module doc).
 pub fn import_actors(request: &ImportRequest, out: &Path) -> Result<Manifest, ImportError> {
-    let env = request
-        .env
-        .build()
-        .map_err(|e| ImportError::Env(e.to_string()))?;
-    if request.agents.len() != env.n_agents() {
-        return Err(ImportError::AgentCount {
-            env: request.env.name(),
-            expected: env.n_agents(),
-            got: request.agents.len(),
-        });
-    }
+    let env = request_domain(request)?;
     let mut weights = Vec::with_capacity(request.agents.len());
     let mut sources = Vec::with_capacity(request.agents.len());
     let mut first: Option<GruActorConfig> = None;
@@ -124,17 +116,10 @@ pub fn import_actors(request: &ImportRequest, out: &Path) -> Result<Manifest, Im
         weights.push(bytes);
     }
     let cfg = first.expect("a domain has at least one agent");
-    let run = RunInfo {
-        experiment: IMPORTED.to_string(),
-        method: IMPORTED.to_string(),
-        variant: String::new(),
-        seed: 0,
-        episodes_trained: 0,
-        config: serde_json::json!({
-            "imported_from": "MacroMARL actor state_dicts (reference code)",
-            "files": sources,
-        }),
-    };
+    let run = imported_run(serde_json::json!({
+        "imported_from": "MacroMARL actor state_dicts (reference code)",
+        "files": sources,
+    }));
     Ok(Manifest::write_policy(
         out,
         request.env.clone(),

@@ -30,8 +30,8 @@ pub(super) fn paper_horizon(grid: usize) -> usize {
     }
 }
 
-/// The config key of a parameter [`BoxPushing::check_params`] names.
-fn key_of(e: EnvError) -> KeyError {
+/// The config key of a parameter [`BoxPushing::check_params`] names (`grid_dim`, the horizon).
+pub(crate) fn key_of(e: EnvError) -> KeyError {
     match e {
         EnvError::InvalidParameter {
             name: "grid",

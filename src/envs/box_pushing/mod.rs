@@ -8,7 +8,7 @@
 //! [`actions`] (3), `step` (4), `navigate` (5.1), `push` (5.2), [`observe`] (6), `render`.
 
 pub mod actions;
-mod domain;
+pub(crate) mod domain;
 pub mod draw;
 pub mod geometry;
 pub mod layout;

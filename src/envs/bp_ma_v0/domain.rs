@@ -2,12 +2,12 @@
 //! reference's keyword arguments as keys (`grid_dim`, `big_box_reward`, `small_box_reward`,
 //! `penalty`, `n_agent`), plus the runner's horizon `env_terminate_step`.
 
+use crate::envs::box_pushing::domain::key_of;
 use crate::envs::box_pushing::{BoxPushing, Rules, MAX_GRID_DIM};
 use crate::envs::domain::{
     fill_keys, key_f64, key_table, key_usize, Domain, KeyError, HORIZON_KEY,
 };
 use crate::envs::macromarl::without_ignored_kwargs;
-use crate::envs::EnvError;
 
 /// The `BP-MA-v0` domain.
 pub struct BpMaV0Domain;
@@ -61,18 +61,6 @@ fn rules(keys: &toml::Table) -> Result<Rules, KeyError> {
         penalty: key_f64(keys, "penalty")?,
         ..Rules::MACROMARL
     })
-}
-
-/// The config key of a parameter [`BoxPushing::check_params`] names.
-fn key_of(e: EnvError) -> KeyError {
-    match e {
-        EnvError::InvalidParameter {
-            name: "grid",
-            reason,
-        } => KeyError::new("grid_dim", reason),
-        EnvError::InvalidParameter { reason, .. } => KeyError::new(HORIZON_KEY, reason),
-        other => KeyError::new("env_name", other.to_string()),
-    }
 }
 
 impl Domain for BpMaV0Domain {
