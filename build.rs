@@ -25,7 +25,11 @@ fn main() {
     }
     let commit = match git(&["rev-parse", "HEAD"]) {
         Some(hash) if !hash.is_empty() => {
+            // --no-optional-locks: a plain `git status` refreshes and rewrites .git/index (on a
+            // fresh clone, always), which this script watches, so the next build would rerun it
+            // and recompile the crate for nothing.
             let dirty = git(&[
+                "--no-optional-locks",
                 "status",
                 "--porcelain",
                 "--untracked-files=no",
