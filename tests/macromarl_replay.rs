@@ -107,3 +107,23 @@ fn bp_ma_v0_replays_the_reference() {
     );
     all(&names.iter().map(String::as_str).collect::<Vec<_>>());
 }
+
+#[test]
+fn osd_d_v7_replays_the_reference() {
+    all(&["osd_d_v7_a_random0", "osd_d_v7_b_random1"]);
+}
+
+#[test]
+fn osd_t_v0_replays_the_reference() {
+    all(&["osd_t_v0_c_random0"]);
+}
+
+#[test]
+fn osd_t_v1_replays_the_reference() {
+    all(&["osd_t_v1_d_random0"]);
+}
+
+#[test]
+fn osd_f_v0_replays_the_reference() {
+    all(&["osd_f_v0_e_random0"]);
+}
