@@ -110,20 +110,30 @@ fn bp_ma_v0_replays_the_reference() {
 
 #[test]
 fn osd_d_v7_replays_the_reference() {
-    all(&["osd_d_v7_a_random0", "osd_d_v7_b_random1"]);
+    all(&[
+        "osd_d_v7_a_random0",
+        "osd_d_v7_b_random1",
+        "osd_d_v7_a_scripted",
+        "osd_d_v7_b_scripted",
+        "osd_d_v7_costs_random2",
+    ]);
 }
 
 #[test]
 fn osd_t_v0_replays_the_reference() {
-    all(&["osd_t_v0_c_random0"]);
+    all(&["osd_t_v0_c_random0", "osd_t_v0_c_scripted"]);
 }
 
 #[test]
 fn osd_t_v1_replays_the_reference() {
-    all(&["osd_t_v1_d_random0"]);
+    all(&[
+        "osd_t_v1_d_random0",
+        "osd_t_v1_d_scripted",
+        "osd_t_v1_costs_random1",
+    ]);
 }
 
 #[test]
 fn osd_f_v0_replays_the_reference() {
-    all(&["osd_f_v0_e_random0"]);
+    all(&["osd_f_v0_e_random0", "osd_f_v0_e_scripted"]);
 }

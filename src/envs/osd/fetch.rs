@@ -117,7 +117,10 @@ impl Fetch {
                 Self::t_cost(a, p) - 1.0
             };
             self.done = a == FetchAction::Wait;
-            if let FetchAction::Pass(k) = a {
+            // Reference quirk: the start-of-pass test exists for Pass_Obj_T0 and _T1 only
+            // (`AgentFetch_v5.step` has no branch for action 3), so a pass to Turtlebot 2
+            // succeeds if it waits at the table when the pass *ends*, wherever it was before.
+            if let FetchAction::Pass(k @ 0..=1) = a {
                 self.serving = true;
                 if !tbs[k].waiting_at_table(layout) {
                     self.serving_failed = true;

@@ -92,6 +92,20 @@ impl Layout {
             self.tables[tb]
         }
     }
+    /// Where the reference keeps Turtlebot `tb`'s observation to hand out while it is busy
+    /// (its slot of `old_observations`). Reference bug, kept: in `osd_ma_double_room.py` the
+    /// human-wait loop `for idx, human in enumerate(self.humans)` reuses the Turtlebot loop's
+    /// `idx`, so with `obs_human_wait` every finished Turtlebot's observation is stored in slot
+    /// `n_humans - 1` (Turtlebot 1's): a busy Turtlebot 1 then shows the observation Turtlebot 0
+    /// last got, and a busy Turtlebot 0 its reset observation. A Turtlebot's observation at the
+    /// step its macro-action ends, the one a policy acts on, is always its own.
+    pub fn held_obs_slot(&self, tb: usize, obs_human_wait: bool) -> usize {
+        if obs_human_wait && self.human_wait_obs == HumanWaitObs::EveryHuman {
+            self.n_humans() - 1
+        } else {
+            tb
+        }
+    }
     /// Length of a Turtlebot's observation, without and with the human-wait bits.
     pub fn tb_obs_size(&self, obs_human_wait: bool) -> usize {
         let n = self.n_humans();

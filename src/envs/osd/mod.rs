@@ -66,8 +66,11 @@ pub struct Osd<const V: usize> {
     over: bool,
     executed: Vec<usize>,
     mac_done: Vec<bool>,
-    /// Each agent's held observation (Turtlebots, then the Fetch).
+    /// Each agent's observation as the last step returned it (Turtlebots, then the Fetch).
     obs: Vec<Vec<f32>>,
+    /// The Turtlebots' observations kept for busy steps (the reference's `old_observations`;
+    /// see [`Layout::held_obs_slot`]).
+    held: Vec<Vec<f32>>,
     obs_sizes: Vec<usize>,
     n_actions: Vec<usize>,
     /// Reward of the last step (for pictures only).
@@ -103,6 +106,7 @@ impl<const V: usize> Osd<V> {
             executed: vec![0; n_tb + 1],
             mac_done: vec![true; n_tb + 1],
             obs: obs_sizes.iter().map(|&n| vec![0.0; n]).collect(),
+            held: obs_sizes[..n_tb].iter().map(|&n| vec![0.0; n]).collect(),
             obs_sizes,
             n_actions,
             last_reward: 0.0,
@@ -156,8 +160,9 @@ impl<const V: usize> Osd<V> {
         self.mac_done.fill(true);
         self.last_reward = 0.0;
         let n_tb = self.tbs.len();
-        for o in &mut self.obs[..n_tb] {
+        for (o, h) in self.obs[..n_tb].iter_mut().zip(&mut self.held) {
             observe::write_tb_reset_obs(layout, o);
+            h.copy_from_slice(o);
         }
         self.obs[n_tb].fill(0.0);
     }
@@ -219,6 +224,10 @@ impl<const V: usize> Osd<V> {
         for (i, tb) in self.tbs.iter().enumerate() {
             if tb.done {
                 observe::write_tb_obs(layout, p, tb, &self.fetch, &self.humans, &mut self.obs[i]);
+                let slot = layout.held_obs_slot(i, p.obs_human_wait);
+                self.held[slot].copy_from_slice(&self.obs[i]);
+            } else {
+                self.obs[i].copy_from_slice(&self.held[i]);
             }
         }
         if self.fetch.done {
