@@ -131,7 +131,7 @@ fn draw_humans<const V: usize>(c: &mut Canvas, env: &Osd<V>) {
     for (human, &area) in env.humans().iter().zip(layout.work_areas) {
         let (lo, hi) = room_of(area);
         let top = area[1] >= 2.5;
-        let (hx, hy) = to_px([area[0] + 0.5, if top { 3.9 } else { 1.1 }]);
+        let (hx, hy) = to_px([area[0] + 0.35, if top { 3.9 } else { 1.1 }]);
         c.fill_circle(hx, hy - 16.0, 6.5, Colour::Human);
         c.fill_rect(hx as i64 - 6, hy as i64 - 9, 13, 22, Colour::Human);
         // Work steps: done dark, current green while its time runs, red while waiting.
@@ -171,7 +171,8 @@ fn draw_turtlebots<const V: usize>(c: &mut Canvas, env: &Osd<V>) {
     for (i, tb) in env.turtlebots().iter().enumerate() {
         let (x, y) = to_px(tb.pos);
         c.ringed_circle(x, y, r, 1.5, Colour::Dark, tb_colour(i));
-        centred_text(c, x, y, &i.to_string(), Colour::White);
+        let text = if i < 2 { Colour::White } else { Colour::Dark };
+        centred_text(c, x, y, &i.to_string(), text);
         let mut slot = 0.0;
         for (k, &count) in tb.basket.iter().enumerate() {
             if count > 0.0 {

@@ -159,7 +159,8 @@ mod tests {
     fn bad_values_are_refused_by_name() {
         let ok = OsdParams::published(&LAYOUTS[D7]);
         ok.validate(&LAYOUTS[D7]).unwrap();
-        let cases: [(fn(&mut OsdParams), &str); 8] = [
+        type Spoil = fn(&mut OsdParams);
+        let cases: [(Spoil, &str); 8] = [
             (|p| p.horizon = 0, "env_terminate_step"),
             (
                 |p| p.human_speeds.pop().map(|_| ()).unwrap(),

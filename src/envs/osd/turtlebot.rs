@@ -136,6 +136,6 @@ mod tests {
         assert_eq!(numpy_round2(0.015), 0.02);
         assert_eq!(numpy_round2(0.025), 0.02);
         assert_eq!(numpy_round2(0.005), 0.0);
-        assert_eq!(numpy_round2(1.414_213_562_373_095_1), 1.41);
+        assert_eq!(numpy_round2(std::f64::consts::SQRT_2), 1.41);
     }
 }
