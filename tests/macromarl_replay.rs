@@ -121,7 +121,12 @@ fn osd_d_v7_replays_the_reference() {
 
 #[test]
 fn osd_t_v0_replays_the_reference() {
-    all(&["osd_t_v0_c_random0", "osd_t_v0_c_scripted"]);
+    // *_actors: the greedy episode of the authors' trained actors (C 801 in 99 steps).
+    all(&[
+        "osd_t_v0_c_random0",
+        "osd_t_v0_c_scripted",
+        "osd_t_v0_c_actors",
+    ]);
 }
 
 #[test]
@@ -130,10 +135,15 @@ fn osd_t_v1_replays_the_reference() {
         "osd_t_v1_d_random0",
         "osd_t_v1_d_scripted",
         "osd_t_v1_costs_random1",
+        "osd_t_v1_d_actors",
     ]);
 }
 
 #[test]
 fn osd_f_v0_replays_the_reference() {
-    all(&["osd_f_v0_e_random0", "osd_f_v0_e_scripted"]);
+    all(&[
+        "osd_f_v0_e_random0",
+        "osd_f_v0_e_scripted",
+        "osd_f_v0_e_actors",
+    ]);
 }
