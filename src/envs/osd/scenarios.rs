@@ -422,3 +422,25 @@ const SCRIPTED_PARAMS: [&str; 5] = [
     r#"{"TB_move_speed": 0.8, "delay_delivery_penalty": -20.0, "human_speed_per_step": [[38,38,38,38],[38,38,38,38],[27,27,27,27]]}"#,
     r#"{"TB_move_speed": 0.8, "delay_delivery_penalty": -20.0, "obs_human_wait": true, "terminate_step": 300, "human_speed_per_step": [[40,40,40,40],[40,40,40,40],[40,40,40,40],[40,40,40,40]]}"#,
 ];
+
+#[test]
+fn observation_names_match_the_observation_sizes() {
+    fn check<const V: usize>() {
+        for wait in [false, true] {
+            let p = OsdParams {
+                obs_human_wait: wait,
+                ..OsdParams::published(Osd::<V>::layout())
+            };
+            let env = Osd::<V>::new(p).unwrap();
+            for agent in 0..env.n_agents() {
+                assert_eq!(env.obs_names(agent).len(), env.obs_sizes()[agent]);
+                assert_eq!(env.obs(agent).len(), env.obs_sizes()[agent]);
+                assert_eq!(env.action_names(agent).len(), env.n_actions()[agent]);
+            }
+        }
+    }
+    check::<D7>();
+    check::<T0>();
+    check::<T1>();
+    check::<F0>();
+}
