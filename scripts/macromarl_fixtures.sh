@@ -42,3 +42,16 @@ if [ -n "$TORCH_PY" ]; then
     $TORCH_PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"$m\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --actors $N/Overcooked/map$m --horizon 200 --gamma 0.99 --out $F/overcooked_$(echo $m | tr A-Z a-z)_n3_actors
   done
 fi
+# Warehouse at the published settings (tb_m_speed 0.8, d_pen -20). The *_scripted steps are macdec's
+# scripted team that serves every human (OSD_STEPS_DIR=DIR cargo test --release --lib
+# write_scripted_steps -- --ignored writes them); here they are read back from the fixtures.
+WP='"TB_move_speed": 0.8, "delay_delivery_penalty": -20.0'
+steps() { $PY -c 'import json, sys; print(json.dumps(json.load(open(sys.argv[1]))["steps"]))' $F/$1.actions.json > /tmp/$1.steps.json; echo /tmp/$1.steps.json; }
+$PY $S --macromarl $MM --env OSD-D-v7 --params "{$WP, \"human_speed_per_step\": [[27,20,20,20],[27,20,20,20]]}" --steps $(steps osd_d_v7_a_scripted) --out $F/osd_d_v7_a_scripted
+$PY $S --macromarl $MM --env OSD-D-v7 --params "{$WP, \"obs_human_wait\": true, \"human_speed_per_step\": [[18,15,15,15],[48,18,15,15]]}" --steps $(steps osd_d_v7_b_scripted) --out $F/osd_d_v7_b_scripted
+$PY $S --macromarl $MM --env OSD-T-v0 --params "{$WP, \"obs_human_wait\": true, \"human_speed_per_step\": [[40,40,40,40],[40,40,40,40],[40,40,40,40]]}" --steps $(steps osd_t_v0_c_scripted) --out $F/osd_t_v0_c_scripted
+$PY $S --macromarl $MM --env OSD-T-v1 --params "{$WP, \"human_speed_per_step\": [[38,38,38,38],[38,38,38,38],[27,27,27,27]]}" --steps $(steps osd_t_v1_d_scripted) --out $F/osd_t_v1_d_scripted
+$PY $S --macromarl $MM --env OSD-F-v0 --params "{$WP, \"obs_human_wait\": true, \"terminate_step\": 300, \"human_speed_per_step\": [[40,40,40,40],[40,40,40,40],[40,40,40,40],[40,40,40,40]]}" --steps $(steps osd_f_v0_e_scripted) --out $F/osd_f_v0_e_scripted
+C="$WP"', "TB_move_cost": -0.5, "fetch_drop_obj_penalty": -5.0, "obs_human_wait": true'
+$PY $S --macromarl $MM --env OSD-D-v7 --params "{$C, \"human_speed_per_step\": [[18,15,15,15],[48,18,15,15]]}" --random-seed 2 --horizon 200 --out $F/osd_d_v7_costs_random2
+$PY $S --macromarl $MM --env OSD-T-v1 --params "{$C, \"human_speed_per_step\": [[8,8,8,8],[38,38,38,38],[27,27,27,27]]}" --random-seed 1 --horizon 250 --out $F/osd_t_v1_costs_random1

@@ -107,3 +107,43 @@ fn bp_ma_v0_replays_the_reference() {
     );
     all(&names.iter().map(String::as_str).collect::<Vec<_>>());
 }
+
+#[test]
+fn osd_d_v7_replays_the_reference() {
+    all(&[
+        "osd_d_v7_a_random0",
+        "osd_d_v7_b_random1",
+        "osd_d_v7_a_scripted",
+        "osd_d_v7_b_scripted",
+        "osd_d_v7_costs_random2",
+    ]);
+}
+
+#[test]
+fn osd_t_v0_replays_the_reference() {
+    // *_actors: the greedy episode of the authors' trained actors (C 801 in 99 steps).
+    all(&[
+        "osd_t_v0_c_random0",
+        "osd_t_v0_c_scripted",
+        "osd_t_v0_c_actors",
+    ]);
+}
+
+#[test]
+fn osd_t_v1_replays_the_reference() {
+    all(&[
+        "osd_t_v1_d_random0",
+        "osd_t_v1_d_scripted",
+        "osd_t_v1_costs_random1",
+        "osd_t_v1_d_actors",
+    ]);
+}
+
+#[test]
+fn osd_f_v0_replays_the_reference() {
+    all(&[
+        "osd_f_v0_e_random0",
+        "osd_f_v0_e_scripted",
+        "osd_f_v0_e_actors",
+    ]);
+}

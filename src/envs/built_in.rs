@@ -20,6 +20,10 @@ macro_rules! built_in_domains {
         $then! {
             BoxPushing(crate::envs::box_pushing::BoxPushing) = crate::envs::box_pushing::BoxPushingDomain; crate::envs::bp_ma_v0::BpMaV0Domain,
             Warehouse(crate::envs::warehouse::Warehouse) = crate::envs::warehouse::WarehouseDomain,
+            OsdD7(crate::envs::osd::OsdD7) = crate::envs::osd::OSD_D_V7,
+            OsdT0(crate::envs::osd::OsdT0) = crate::envs::osd::OSD_T_V0,
+            OsdT1(crate::envs::osd::OsdT1) = crate::envs::osd::OSD_T_V1,
+            OsdF0(crate::envs::osd::OsdF0) = crate::envs::osd::OSD_F_V0,
         }
     };
 }

@@ -17,6 +17,7 @@ pub mod built_in;
 pub mod custom_env;
 pub mod domain;
 pub mod macromarl;
+pub mod osd;
 pub mod registry;
 pub mod replay;
 pub mod spec;

@@ -1,0 +1,76 @@
+//! MacroMARL's Warehouse domains step without allocating, checked as `envs_no_alloc.rs` checks
+//! the ICRA domains (a counting allocator on the test thread, random macro-actions, resets
+//! included), with the published settings and with both noise sources on.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use macdec::envs::bench::random_macro_steps;
+use macdec::envs::{EnvRng, EnvSpec};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+struct Counting;
+
+thread_local! {
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+fn note_allocation() {
+    if COUNTING.with(Cell::get) {
+        ALLOCATIONS.with(|n| n.set(n.get() + 1));
+    }
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        note_allocation();
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        note_allocation();
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made on this thread while `f` runs.
+fn allocations_during(f: impl FnOnce()) -> u64 {
+    ALLOCATIONS.with(|n| n.set(0));
+    COUNTING.with(|c| c.set(true));
+    f();
+    COUNTING.with(|c| c.set(false));
+    ALLOCATIONS.with(Cell::get)
+}
+
+#[test]
+fn osd_stepping_and_resetting_allocate_nothing() {
+    let noisy = toml::toml! { TB_move_noisy = 0.1  fetch_manip_noisy = 1.0  obs_human_wait = true };
+    let mut specs = Vec::new();
+    for id in ["OSD-D-v7", "OSD-T-v0", "OSD-T-v1", "OSD-F-v0"] {
+        specs.push(EnvSpec::new(id, &toml::Table::new()).unwrap());
+        specs.push(EnvSpec::new(id, &noisy).unwrap());
+    }
+    for spec in specs {
+        let mut env = spec.build().unwrap();
+        let mut policy_rng = ChaCha8Rng::seed_from_u64(3);
+        let mut env_rng = EnvRng::seed_from_u64(4);
+        let short = allocations_during(|| {
+            random_macro_steps(&mut env, 10, &mut policy_rng, &mut env_rng).unwrap();
+        });
+        let long = allocations_during(|| {
+            random_macro_steps(&mut env, 100_000, &mut policy_rng, &mut env_rng).unwrap();
+        });
+        assert_eq!(
+            long, short,
+            "{spec:?}: allocations grew with the number of steps"
+        );
+        assert!(allocations_during(|| drop(vec![0u8; 16])) >= 1);
+    }
+}
