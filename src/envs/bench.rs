@@ -97,7 +97,16 @@ pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
             "BP-MA-v0 14x14 (runner horizon 100)",
             crate::envs::bp_ma_v0::spec(14, 100),
         ),
+        ("OSD-D-v7 Warehouse A (published)", published("OSD-D-v7")),
+        ("OSD-T-v0 Warehouse C (published)", published("OSD-T-v0")),
+        ("OSD-T-v1 Warehouse D (published)", published("OSD-T-v1")),
+        ("OSD-F-v0 Warehouse E (published)", published("OSD-F-v0")),
     ]
+}
+
+/// The domain `name` at its defaults (MacroMARL's domains default to the published settings).
+fn published(name: &str) -> EnvSpec {
+    EnvSpec::new(name, &toml::Table::new()).expect("a built-in domain's defaults are valid")
 }
 
 #[cfg(test)]
