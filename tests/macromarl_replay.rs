@@ -147,3 +147,13 @@ fn osd_f_v0_replays_the_reference() {
         "osd_f_v0_e_actors",
     ]);
 }
+
+#[test]
+fn overcooked_ma_v1_replays_the_reference() {
+    all(&[
+        "overcooked_a_n3_random0",
+        "overcooked_b_n3_random0",
+        "overcooked_c_n3_random0",
+        "overcooked_a_n2_random1",
+    ]);
+}

@@ -18,6 +18,7 @@ pub mod custom_env;
 pub mod domain;
 pub mod macromarl;
 pub mod osd;
+pub mod overcooked;
 pub mod registry;
 pub mod replay;
 pub mod spec;

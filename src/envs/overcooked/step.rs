@@ -1,0 +1,280 @@
+//! The primitive step (`Overcooked_V1.step`): agents act in index order, each once; an agent
+//! walking into another that has not acted yet waits for it (a swap when the other walks into
+//! it), and walking into a non-floor cell picks up, puts down, chops or delivers.
+
+use serde::{Deserialize, Serialize};
+
+use super::layout::Tile;
+use super::world::{Cell, Held, World, DIRECTION, FOOD_NAMES, FOOD_TILES};
+
+/// The reference's `rewardList`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Rewards {
+    /// "subtask finished": a food of the task chopped through.
+    pub subtask_finished: f64,
+    /// "correct delivery": the task's dish delivered (terminal).
+    pub correct_delivery: f64,
+    /// "wrong delivery": anything else handed to the delivery counter.
+    pub wrong_delivery: f64,
+    /// "step penalty": every primitive step.
+    pub step_penalty: f64,
+}
+
+impl Default for Rewards {
+    /// MacroMARL's values (`pg_based_main.py`, with its default `--step_penalty`).
+    fn default() -> Self {
+        Rewards {
+            subtask_finished: 10.0,
+            correct_delivery: 200.0,
+            wrong_delivery: -5.0,
+            step_penalty: -0.1,
+        }
+    }
+}
+
+/// The dish name a plate holding `holds` (flags in food order) makes: its foods' names in the
+/// order lettuce, onion, tomato, joined by `-`, then " salad" (the delivery branch of `step`).
+pub fn dish_name(holds: [bool; 3]) -> String {
+    let mut name = String::new();
+    for k in [1, 2, 0] {
+        if holds[k] {
+            if !name.is_empty() {
+                name.push('-');
+            }
+            name.push_str(FOOD_NAMES[k]);
+        }
+    }
+    name + " salad"
+}
+
+/// One primitive step of all agents (`actions[i]`: 0..4 a move as [`DIRECTION`], 4 stay).
+/// Returns the team reward and whether the task's dish was delivered.
+///
+/// The reference loops until every agent has acted; an agent waiting for another is retried
+/// in the next pass. On a grid no three agents can wait on each other in a cycle, so passes
+/// are bounded; the cap only guards against a state the reference would loop in forever.
+pub fn primitive_step(w: &mut World, actions: &[u8], task: &str, r: &Rewards) -> (f64, bool) {
+    let mut reward = r.step_penalty;
+    let mut delivered = false;
+    for c in w.cooks.iter_mut() {
+        c.moved = false;
+    }
+    for _pass in 0..=w.cooks.len() * 4 {
+        for i in 0..w.cooks.len() {
+            if w.cooks[i].moved {
+                continue;
+            }
+            w.cooks[i].moved = true;
+            let a = actions[i];
+            if a >= 4 {
+                continue;
+            }
+            let target = w.cooks[i].at.plus(DIRECTION[a as usize]);
+            match w.tile(target) {
+                Tile::Agent => walk_into_agent(w, i, target, actions),
+                Tile::Space => {
+                    let at = w.cooks[i].at;
+                    w.set_tile(at, Tile::Space);
+                    w.move_cook(i, target);
+                    w.set_tile(target, Tile::Agent);
+                }
+                tile if w.cooks[i].holding.is_none() => {
+                    reward += take_or_chop(w, i, target, tile, task, r);
+                }
+                tile => {
+                    let (dr, done) = put(w, i, target, tile, task, r);
+                    reward += dr;
+                    delivered |= done;
+                }
+            }
+        }
+        if w.cooks.iter().all(|c| c.moved) {
+            break;
+        }
+    }
+    (reward, delivered)
+}
+
+/// Agent `i` walks into agent `j`'s cell: if `j` has not acted, `i` waits, or swaps with `j`
+/// when `j` walks into `i`'s cell; if `j` has acted, `i` stays.
+fn walk_into_agent(w: &mut World, i: usize, target: Cell, actions: &[u8]) {
+    let Some(j) = w.cook_at(target) else { return };
+    if w.cooks[j].moved {
+        return;
+    }
+    w.cooks[i].moved = false;
+    let b = actions[j];
+    if b < 4 {
+        let back = w.cooks[j].at.plus(DIRECTION[b as usize]);
+        if back == w.cooks[i].at {
+            w.move_cook(j, back);
+            w.move_cook(i, target);
+        }
+    }
+}
+
+/// Empty-handed agent `i` walks into `target` showing `tile`: takes a food or plate from a
+/// counter, a plate or chopped food from a knife, or chops the food on a knife. Returns the
+/// reward earned ("subtask finished" when a food of the task is chopped through).
+fn take_or_chop(w: &mut World, i: usize, target: Cell, tile: Tile, task: &str, r: &Rewards) -> f64 {
+    match tile {
+        Tile::Tomato | Tile::Lettuce | Tile::Onion | Tile::Plate => {
+            let item = if tile == Tile::Plate {
+                w.plate_at(target).map(Held::Plate)
+            } else {
+                w.food_at(target, tile).map(Held::Food)
+            };
+            // The reference raises here when the map shows an object that is not there.
+            if let Some(item) = item {
+                w.pickup(i, item);
+                w.set_tile(target, Tile::Counter);
+            }
+            0.0
+        }
+        Tile::Knife => {
+            let Some(k) = w.knife_at(target) else {
+                return 0.0;
+            };
+            match w.knives[k].holding {
+                Some(Held::Plate(p)) => {
+                    w.knives[k].holding = None;
+                    w.pickup(i, Held::Plate(p));
+                    0.0
+                }
+                Some(Held::Food(f)) if w.foods[f].chopped => {
+                    w.knives[k].holding = None;
+                    w.pickup(i, Held::Food(f));
+                    0.0
+                }
+                Some(Held::Food(f)) => {
+                    w.chop(f);
+                    if w.foods[f].chopped && task.contains(FOOD_NAMES[f]) {
+                        r.subtask_finished
+                    } else {
+                        0.0
+                    }
+                }
+                None => 0.0,
+            }
+        }
+        _ => 0.0,
+    }
+}
+
+/// Agent `i`, holding something, walks into `target` showing `tile`: puts it on a counter, a
+/// chopped food on a plate or knife, a plate under a chopped food, or delivers. Returns the
+/// reward and whether this was the correct delivery.
+fn put(w: &mut World, i: usize, target: Cell, tile: Tile, task: &str, r: &Rewards) -> (f64, bool) {
+    let Some(held) = w.cooks[i].holding else {
+        return (0.0, false);
+    };
+    match tile {
+        Tile::Counter => {
+            let shown = match held {
+                Held::Food(k) => FOOD_TILES[k],
+                Held::Plate(_) => Tile::Plate,
+            };
+            w.set_tile(target, shown);
+            w.putdown(i, target);
+        }
+        Tile::Plate => {
+            if let Held::Food(f) = held {
+                if w.foods[f].chopped {
+                    if let Some(p) = w.plate_at(target) {
+                        w.putdown(i, target);
+                        w.plate_contain(p, f);
+                    }
+                }
+            }
+        }
+        Tile::Knife => {
+            let Some(k) = w.knife_at(target) else {
+                return (0.0, false);
+            };
+            match (w.knives[k].holding, held) {
+                (None, _) => {
+                    w.putdown(i, target);
+                    w.knives[k].holding = Some(held);
+                }
+                (Some(Held::Food(f)), Held::Plate(p)) => {
+                    if w.foods[f].chopped {
+                        w.knives[k].holding = None;
+                        w.plate_contain(p, f);
+                    }
+                }
+                (Some(Held::Plate(p)), Held::Food(f)) => {
+                    if w.foods[f].chopped {
+                        w.knives[k].holding = None;
+                        w.pickup(i, Held::Plate(p));
+                        w.plate_contain(p, f);
+                    }
+                }
+                _ => {}
+            }
+        }
+        Tile::Delivery => return deliver(w, i, target, held, task, r),
+        Tile::Tomato | Tile::Lettuce | Tile::Onion => {
+            if let (Some(f), Held::Plate(p)) = (w.food_at(target, tile), held) {
+                if w.foods[f].chopped {
+                    w.plate_contain(p, f);
+                    w.set_tile(target, Tile::Counter);
+                }
+            }
+        }
+        _ => {}
+    }
+    (0.0, false)
+}
+
+/// Agent `i` hands `held` to the delivery counter at `target`. The task's dish stays there
+/// (terminal); anything else costs "wrong delivery" and goes back, whole, to where it started.
+fn deliver(
+    w: &mut World,
+    i: usize,
+    target: Cell,
+    held: Held,
+    task: &str,
+    r: &Rewards,
+) -> (f64, bool) {
+    match held {
+        Held::Plate(p) if w.plates[p].holds.iter().any(|&h| h) => {
+            if dish_name(w.plates[p].holds) == task {
+                w.putdown(i, target);
+                w.delivery.holding = Some(held);
+                return (r.correct_delivery, true);
+            }
+            w.putdown(i, target);
+            let foods = w.plates[p].holds;
+            w.plates[p].holds = [false; 3];
+            w.plates[p].at = w.plates[p].start;
+            w.set_tile(w.plates[p].at, Tile::Plate);
+            for (k, _) in foods.iter().enumerate().filter(|(_, &h)| h) {
+                w.refresh_food(k);
+                w.set_tile(w.foods[k].at, FOOD_TILES[k]);
+            }
+        }
+        Held::Plate(p) => {
+            w.putdown(i, target);
+            w.plates[p].at = w.plates[p].start;
+            w.set_tile(w.plates[p].at, Tile::Plate);
+        }
+        Held::Food(k) => {
+            w.putdown(i, target);
+            w.refresh_food(k);
+            w.set_tile(w.foods[k].at, FOOD_TILES[k]);
+        }
+    }
+    (r.wrong_delivery, false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dish_names_follow_the_references_food_order() {
+        assert_eq!(dish_name([true, true, true]), "lettuce-onion-tomato salad");
+        assert_eq!(dish_name([true, false, true]), "onion-tomato salad");
+        assert_eq!(dish_name([false, true, false]), "lettuce salad");
+    }
+}

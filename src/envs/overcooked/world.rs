@@ -1,0 +1,345 @@
+//! The kitchen's objects and the map that mirrors them (`items.py` and `Overcooked_V1`'s item
+//! lists): three foods, two plates, two knives (cutting boards), the delivery counter and the
+//! agents, each where the reference keeps it, with the reference's moves, pick-ups and put-downs.
+//!
+//! The map (`self.map` in the reference) is not derived from the objects: the step writes it
+//! beside them, and a few of its writes can disagree with them (a refreshed food written over a
+//! plate left on its start counter). Both are kept exactly as the reference keeps them.
+
+use serde::{Deserialize, Serialize};
+
+use super::layout::{Cells, Tile};
+
+/// A grid cell `(x, y)`: `x` the row of the printed map, `y` the column (the reference's order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Cell {
+    pub x: i32,
+    pub y: i32,
+}
+
+impl Cell {
+    pub const fn new(x: i32, y: i32) -> Self {
+        Cell { x, y }
+    }
+
+    /// Manhattan distance (the reference's `_calDistance`).
+    pub fn distance(self, other: Cell) -> i32 {
+        (self.x - other.x).abs() + (self.y - other.y).abs()
+    }
+
+    /// The neighbour in direction `(dx, dy)`.
+    pub fn plus(self, (dx, dy): (i32, i32)) -> Cell {
+        Cell::new(self.x + dx, self.y + dy)
+    }
+}
+
+/// The reference's primitive moves `DIRECTION`: right, down, left, up (index = action), then
+/// 4 = stay.
+pub const DIRECTION: [(i32, i32); 4] = [(0, 1), (1, 0), (0, -1), (-1, 0)];
+/// The primitive action "stay".
+pub const STAY: u8 = 4;
+
+/// The foods in the reference's item order (tomato, lettuce, onion).
+pub const FOOD_TILES: [Tile; 3] = [Tile::Tomato, Tile::Lettuce, Tile::Onion];
+/// The foods' `rawName`s, in [`FOOD_TILES`] order.
+pub const FOOD_NAMES: [&str; 3] = ["tomato", "lettuce", "onion"];
+/// Chops a food needs (`Food.required_chopped_times`).
+pub const REQUIRED_CHOPS: u32 = 3;
+
+/// Something an agent, a knife or the delivery counter can hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Held {
+    /// Food `k` in [`FOOD_TILES`] order.
+    Food(usize),
+    /// Plate `k` (0 is the first in map scan order, "plate 1").
+    Plate(usize),
+}
+
+/// A tomato, lettuce or onion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Food {
+    pub at: Cell,
+    pub start: Cell,
+    pub chopped: bool,
+    pub chops: u32,
+}
+
+/// A plate and the foods on it (the reference's `containing` list; each food exists once, so
+/// flags in [`FOOD_TILES`] order say the same).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Plate {
+    pub at: Cell,
+    pub start: Cell,
+    pub holds: [bool; 3],
+}
+
+/// A knife's cutting board or the delivery counter: fixed, and holding at most one thing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Station {
+    pub at: Cell,
+    pub holding: Option<Held>,
+}
+
+/// An agent in the kitchen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Cook {
+    pub at: Cell,
+    pub start: Cell,
+    pub holding: Option<Held>,
+    /// Done with the current primitive step's move (the reference's `moved`).
+    pub moved: bool,
+}
+
+/// Everything that moves or is held, and the map beside it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct World {
+    pub side: usize,
+    pub map: Cells,
+    pub foods: [Food; 3],
+    pub plates: [Plate; 2],
+    pub knives: [Station; 2],
+    pub delivery: Station,
+    pub cooks: Vec<Cook>,
+}
+
+/// Why a start map cannot make a kitchen (the reference's maps always can).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MissingItem(pub &'static str);
+
+impl World {
+    /// The kitchen of a start map, items in map scan order as `_createItems` finds them.
+    pub fn from_map(map: Cells, side: usize) -> Result<World, MissingItem> {
+        let mut foods: [Option<Cell>; 3] = [None; 3];
+        let (mut plates, mut knives, mut delivery, mut cooks) = (vec![], vec![], None, vec![]);
+        for x in 0..side {
+            for y in 0..side {
+                let c = Cell::new(x as i32, y as i32);
+                match map[x][y] {
+                    Tile::Agent => cooks.push(Cook {
+                        at: c,
+                        start: c,
+                        holding: None,
+                        moved: false,
+                    }),
+                    Tile::Knife => knives.push(Station {
+                        at: c,
+                        holding: None,
+                    }),
+                    Tile::Delivery => delivery = Some(c),
+                    Tile::Plate => plates.push(Plate {
+                        at: c,
+                        start: c,
+                        holds: [false; 3],
+                    }),
+                    t => {
+                        if let Some(k) = FOOD_TILES.iter().position(|&f| f == t) {
+                            foods[k].get_or_insert(c);
+                        }
+                    }
+                }
+            }
+        }
+        let food = |k: usize| {
+            foods[k].map(|c| Food {
+                at: c,
+                start: c,
+                chopped: false,
+                chops: 0,
+            })
+        };
+        Ok(World {
+            side,
+            map,
+            foods: [
+                food(0).ok_or(MissingItem("tomato"))?,
+                food(1).ok_or(MissingItem("lettuce"))?,
+                food(2).ok_or(MissingItem("onion"))?,
+            ],
+            plates: plates.try_into().map_err(|_| MissingItem("two plates"))?,
+            knives: knives.try_into().map_err(|_| MissingItem("two knives"))?,
+            delivery: Station {
+                at: delivery.ok_or(MissingItem("delivery"))?,
+                holding: None,
+            },
+            cooks,
+        })
+    }
+
+    /// The map's tile at `c`, a counter outside the grid.
+    pub fn tile(&self, c: Cell) -> Tile {
+        tile_of(&self.map, self.side, c)
+    }
+
+    /// Write the map at `c` (ignored outside the grid).
+    pub fn set_tile(&mut self, c: Cell, t: Tile) {
+        if inside(self.side, c) {
+            self.map[c.x as usize][c.y as usize] = t;
+        }
+    }
+
+    /// Where `h` is.
+    pub fn position(&self, h: Held) -> Cell {
+        match h {
+            Held::Food(k) => self.foods[k].at,
+            Held::Plate(k) => self.plates[k].at,
+        }
+    }
+
+    /// Move `h` to `to`; a plate carries its foods (`MovableItem.move`, `Plate.move`).
+    pub fn move_thing(&mut self, h: Held, to: Cell) {
+        match h {
+            Held::Food(k) => self.foods[k].at = to,
+            Held::Plate(p) => {
+                self.plates[p].at = to;
+                for k in 0..3 {
+                    if self.plates[p].holds[k] {
+                        self.foods[k].at = to;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Put food `k` on plate `p` (`Plate.contain`): it and all the plate's foods go to the plate.
+    pub fn plate_contain(&mut self, p: usize, k: usize) {
+        self.plates[p].holds[k] = true;
+        let at = self.plates[p].at;
+        self.move_thing(Held::Plate(p), at);
+    }
+
+    /// Move agent `i` to `to`, with what it holds (`Agent.move`; sets `moved`).
+    pub fn move_cook(&mut self, i: usize, to: Cell) {
+        self.cooks[i].at = to;
+        self.cooks[i].moved = true;
+        if let Some(h) = self.cooks[i].holding {
+            self.move_thing(h, to);
+        }
+    }
+
+    /// Agent `i` takes `h` (`Agent.pickup`).
+    pub fn pickup(&mut self, i: usize, h: Held) {
+        self.cooks[i].holding = Some(h);
+        self.move_thing(h, self.cooks[i].at);
+    }
+
+    /// Agent `i` puts what it holds at `to` (`Agent.putdown`); returns it.
+    pub fn putdown(&mut self, i: usize, to: Cell) -> Option<Held> {
+        let h = self.cooks[i].holding.take()?;
+        self.move_thing(h, to);
+        Some(h)
+    }
+
+    /// Food `k` back to its start, whole (`Food.refresh`).
+    pub fn refresh_food(&mut self, k: usize) {
+        let f = &mut self.foods[k];
+        f.at = f.start;
+        f.chopped = false;
+        f.chops = 0;
+    }
+
+    /// One chop of food `k` (`Food.chop`): nothing once chopped.
+    pub fn chop(&mut self, k: usize) {
+        let f = &mut self.foods[k];
+        if !f.chopped {
+            f.chops += 1;
+            if f.chops >= REQUIRED_CHOPS {
+                f.chopped = true;
+            }
+        }
+    }
+
+    /// The first object of the kind the map shows as `tile` at `c` (`_findItem`).
+    pub fn food_at(&self, c: Cell, tile: Tile) -> Option<usize> {
+        let k = FOOD_TILES.iter().position(|&f| f == tile)?;
+        (self.foods[k].at == c).then_some(k)
+    }
+
+    /// The first plate at `c`.
+    pub fn plate_at(&self, c: Cell) -> Option<usize> {
+        self.plates.iter().position(|p| p.at == c)
+    }
+
+    /// The first knife at `c`.
+    pub fn knife_at(&self, c: Cell) -> Option<usize> {
+        self.knives.iter().position(|k| k.at == c)
+    }
+
+    /// The first agent at `c`.
+    pub fn cook_at(&self, c: Cell) -> Option<usize> {
+        self.cooks.iter().position(|k| k.at == c)
+    }
+
+    /// Number of entries of the reference's `itemList`: foods, plates, knives, delivery, agents.
+    pub fn n_items(&self) -> usize {
+        3 + 2 + 2 + 1 + self.cooks.len()
+    }
+
+    /// Where `itemList[k]` is now, and where it started (fixed items never move).
+    pub fn item(&self, k: usize) -> (Cell, Cell) {
+        match k {
+            0..=2 => (self.foods[k].at, self.foods[k].start),
+            3..=4 => (self.plates[k - 3].at, self.plates[k - 3].start),
+            5..=6 => (self.knives[k - 5].at, self.knives[k - 5].at),
+            7 => (self.delivery.at, self.delivery.at),
+            _ => (self.cooks[k - 8].at, self.cooks[k - 8].start),
+        }
+    }
+
+    /// The tile of `itemList[k]`'s `rawName`.
+    pub fn item_tile(&self, k: usize) -> Tile {
+        match k {
+            0..=2 => FOOD_TILES[k],
+            3..=4 => Tile::Plate,
+            5..=6 => Tile::Knife,
+            7 => Tile::Delivery,
+            _ => Tile::Agent,
+        }
+    }
+}
+
+/// Whether `c` is on a `side` x `side` grid.
+pub fn inside(side: usize, c: Cell) -> bool {
+    c.x >= 0 && c.y >= 0 && (c.x as usize) < side && (c.y as usize) < side
+}
+
+/// `map[c]`, a counter outside the grid.
+pub fn tile_of(map: &Cells, side: usize, c: Cell) -> Tile {
+    if inside(side, c) {
+        map[c.x as usize][c.y as usize]
+    } else {
+        Tile::Counter
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::layout::{start_map, MapType};
+    use super::*;
+
+    #[test]
+    fn items_are_found_in_map_scan_order() {
+        let w = World::from_map(start_map(7, MapType::A, 3).unwrap(), 7).unwrap();
+        assert_eq!(w.foods[0].at, Cell::new(0, 5));
+        assert_eq!(w.foods[1].at, Cell::new(1, 6));
+        assert_eq!(w.foods[2].at, Cell::new(2, 6));
+        assert_eq!(w.plates[0].at, Cell::new(5, 6));
+        assert_eq!(w.plates[1].at, Cell::new(6, 5));
+        assert_eq!(w.knives[1].at, Cell::new(2, 0));
+        assert_eq!(w.delivery.at, Cell::new(3, 0));
+        let cooks: Vec<Cell> = w.cooks.iter().map(|c| c.at).collect();
+        assert_eq!(cooks, [Cell::new(1, 2), Cell::new(1, 4), Cell::new(5, 2)]);
+        assert_eq!(w.n_items(), 11);
+    }
+
+    #[test]
+    fn a_plate_carries_its_foods() {
+        let mut w = World::from_map(start_map(7, MapType::A, 2).unwrap(), 7).unwrap();
+        w.plate_contain(0, 2);
+        assert_eq!(w.foods[2].at, w.plates[0].at);
+        w.pickup(0, Held::Plate(0));
+        w.move_cook(0, Cell::new(2, 2));
+        assert_eq!(w.foods[2].at, Cell::new(2, 2));
+        assert_eq!(w.putdown(0, Cell::new(2, 3)), Some(Held::Plate(0)));
+        assert_eq!(w.foods[2].at, Cell::new(2, 3));
+    }
+}
