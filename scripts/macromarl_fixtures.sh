@@ -55,3 +55,10 @@ $PY $S --macromarl $MM --env OSD-F-v0 --params "{$WP, \"obs_human_wait\": true, 
 C="$WP"', "TB_move_cost": -0.5, "fetch_drop_obj_penalty": -5.0, "obs_human_wait": true'
 $PY $S --macromarl $MM --env OSD-D-v7 --params "{$C, \"human_speed_per_step\": [[18,15,15,15],[48,18,15,15]]}" --random-seed 2 --horizon 200 --out $F/osd_d_v7_costs_random2
 $PY $S --macromarl $MM --env OSD-T-v1 --params "{$C, \"human_speed_per_step\": [[8,8,8,8],[38,38,38,38],[27,27,27,27]]}" --random-seed 1 --horizon 250 --out $F/osd_t_v1_costs_random1
+# Overcooked episodes that reach the correct delivery (terminal) from scripted plans: map A's
+# full salad with 3 agents (chops, plate gathering, delivery), and a 2-agent tomato salad with a
+# wrong delivery first; then random episodes on the 9 x 9 map C and on map B with another task.
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --plan '[[1,6,9,4,6,7,0,0,0,0,0,0,0,0,0,0,0,0,6,8],[2,7,9,11,10,10,0],[3,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,6,9,10,10,0]]' --horizon 200 --out $F/overcooked_a_n3_salad_plan
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"tomato salad\", \"rewardList\": $R, \"debug\": false}" --plan '[[1,6,9,4,6,8],[2,8,10,10,0]]' --horizon 200 --out $F/overcooked_a_n2_tomato_plan
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [9, 9], \"map_type\": \"C\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --random-seed 2 --horizon 200 --out $F/overcooked_c9_n3_random2
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"B\", \"task\": \"onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 2}" --random-seed 3 --horizon 200 --out $F/overcooked_b_n2_random3

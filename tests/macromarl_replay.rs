@@ -155,5 +155,9 @@ fn overcooked_ma_v1_replays_the_reference() {
         "overcooked_b_n3_random0",
         "overcooked_c_n3_random0",
         "overcooked_a_n2_random1",
+        "overcooked_a_n3_salad_plan",
+        "overcooked_a_n2_tomato_plan",
+        "overcooked_c9_n3_random2",
+        "overcooked_b_n2_random3",
     ]);
 }
