@@ -45,8 +45,8 @@ fn default_rewards() -> toml::Table {
     ])
 }
 
-/// `rewardList` with every entry a number; missing entries take MacroMARL's values.
-fn reward_list(keys: &toml::Table) -> Result<(toml::Table, Rewards), KeyError> {
+/// The rewards of `rewardList`: every entry a number, missing ones MacroMARL's values.
+fn reward_list(keys: &toml::Table) -> Result<Rewards, KeyError> {
     let Some(toml::Value::Table(given)) = keys.get("rewardList") else {
         return Err(KeyError::new("rewardList", "expected a table of rewards"));
     };
@@ -77,7 +77,7 @@ fn reward_list(keys: &toml::Table) -> Result<(toml::Table, Rewards), KeyError> {
         wrong_delivery: get(REWARD_KEYS[2])?,
         step_penalty: get(REWARD_KEYS[3])?,
     };
-    Ok((table, rewards))
+    Ok(rewards)
 }
 
 /// The side of `grid_dim`, which must be square.
@@ -112,7 +112,7 @@ fn params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
         side: side(keys)?,
         map,
         task: string("task").unwrap_or_default(),
-        rewards: reward_list(keys)?.1,
+        rewards: reward_list(keys)?,
         n_agent: key_usize(keys, "n_agent")?,
         horizon: key_usize(keys, HORIZON_KEY)?,
         ..OvercookedParams::default()
@@ -150,7 +150,7 @@ impl Domain for OvercookedDomain {
     /// and `env_terminate_step` (200).
     fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
         let p = OvercookedParams::default();
-        let mut keys = fill_keys(
+        let keys = fill_keys(
             given,
             key_table([
                 ("grid_dim", toml::Value::Array(vec![7.into(), 7.into()])),
@@ -162,8 +162,8 @@ impl Domain for OvercookedDomain {
                 (HORIZON_KEY, (p.horizon as i64).into()),
             ]),
         )?;
-        let (rewards, _) = reward_list(&keys)?;
-        keys.insert("rewardList".into(), toml::Value::Table(rewards));
+        // Checked but kept as given (configs record what they were given; missing entries
+        // take MacroMARL's values when the environment is built).
         params(&keys)?.validate().map_err(key_of)?;
         Ok(keys)
     }
@@ -255,10 +255,13 @@ mod tests {
     #[test]
     fn a_partial_reward_list_keeps_the_other_entries() {
         let d = OvercookedDomain;
-        let keys = Domain::keys(&d, &toml::toml! { rewardList = { "step penalty" = -1 } }).unwrap();
-        let r = keys["rewardList"].as_table().unwrap();
-        assert_eq!(r["step penalty"].as_float(), Some(-1.0));
-        assert_eq!(r["correct delivery"].as_float(), Some(200.0));
+        let given = toml::toml! { rewardList = { "step penalty" = -1 } };
+        let keys = Domain::keys(&d, &given).unwrap();
+        // Recorded as given, built with the other entries at MacroMARL's values.
+        assert_eq!(keys["rewardList"], given["rewardList"]);
+        let r = Domain::build(&d, &keys).unwrap().params().rewards;
+        assert_eq!(r.step_penalty, -1.0);
+        assert_eq!(r.correct_delivery, 200.0);
         let nine = Domain::keys(&d, &toml::toml! { grid_dim = [9, 9] }).unwrap();
         assert_eq!(Domain::build(&d, &nine).unwrap().params().side, 9);
     }
