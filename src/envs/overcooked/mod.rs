@@ -239,11 +239,11 @@ impl Overcooked {
                 map: self.params.map,
                 radius: r,
             };
-            for i in 0..n {
+            for (i, &chosen) in actions.iter().enumerate() {
                 self.primitive[i] = low_level(
                     &ctx,
                     i,
-                    actions[i],
+                    chosen,
                     &self.beliefs[i],
                     &mut self.macs[i],
                     &mut self.heap,

@@ -196,18 +196,14 @@ fn put(w: &mut World, i: usize, target: Cell, tile: Tile, task: &str, r: &Reward
                     w.putdown(i, target);
                     w.knives[k].holding = Some(held);
                 }
-                (Some(Held::Food(f)), Held::Plate(p)) => {
-                    if w.foods[f].chopped {
-                        w.knives[k].holding = None;
-                        w.plate_contain(p, f);
-                    }
+                (Some(Held::Food(f)), Held::Plate(p)) if w.foods[f].chopped => {
+                    w.knives[k].holding = None;
+                    w.plate_contain(p, f);
                 }
-                (Some(Held::Plate(p)), Held::Food(f)) => {
-                    if w.foods[f].chopped {
-                        w.knives[k].holding = None;
-                        w.pickup(i, Held::Plate(p));
-                        w.plate_contain(p, f);
-                    }
+                (Some(Held::Plate(p)), Held::Food(f)) if w.foods[f].chopped => {
+                    w.knives[k].holding = None;
+                    w.pickup(i, Held::Plate(p));
+                    w.plate_contain(p, f);
                 }
                 _ => {}
             }

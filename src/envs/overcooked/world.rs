@@ -111,10 +111,10 @@ impl World {
     pub fn from_map(map: Cells, side: usize) -> Result<World, MissingItem> {
         let mut foods: [Option<Cell>; 3] = [None; 3];
         let (mut plates, mut knives, mut delivery, mut cooks) = (vec![], vec![], None, vec![]);
-        for x in 0..side {
-            for y in 0..side {
+        for (x, row) in map.iter().enumerate().take(side) {
+            for (y, &tile) in row.iter().enumerate().take(side) {
                 let c = Cell::new(x as i32, y as i32);
-                match map[x][y] {
+                match tile {
                     Tile::Agent => cooks.push(Cook {
                         at: c,
                         start: c,
