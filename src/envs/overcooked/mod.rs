@@ -9,6 +9,11 @@
 //! delivery". The episode has no horizon of its own: MacroMARL's runner cuts it at
 //! `env_terminate_step`, which is a truncation (the learner bootstraps), not a terminal.
 //!
+//! Two engine quirks need no code: `_checkMacroActionDone`'s "go to counter" branch tests a
+//! name with a trailing space and never fires (see [`macro_actions::ended_after_step`]), and
+//! `_checkCollision` reads `info['collision']`, which the primitive step leaves empty, so
+//! collisions never end a macro-action (spec 3.3, 5.2).
+//!
 //! The module follows the reference's layers: [`layout`] (maps), [`world`] (items), `step`
 //! (the primitive step), [`astar`] (navigation with Python's heap order), [`macro_actions`]
 //! and [`observe`] (belief and macro-observations); `domain` holds the config keys.
