@@ -159,5 +159,7 @@ fn overcooked_ma_v1_replays_the_reference() {
         "overcooked_a_n2_tomato_plan",
         "overcooked_c9_n3_random2",
         "overcooked_b_n2_random3",
+        "overcooked_a_n3_actors",
+        "overcooked_b_n3_actors",
     ]);
 }
