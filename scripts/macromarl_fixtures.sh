@@ -26,8 +26,9 @@ R='{"subtask finished": 10, "correct delivery": 200, "wrong delivery": -5, "step
 for m in A B C; do
   $PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"$m\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --random-seed 0 --horizon 200 --out $F/overcooked_$(echo $m | tr A-Z a-z)_n3_random0
 done
-# As published: the scripts never pass n_agent, so Overcooked trains 2 agents.
-$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false}" --random-seed 1 --horizon 200 --out $F/overcooked_a_n2_random1
+# As published: the scripts never pass n_agent, so the reference builds its default, 2 agents.
+# macdec's default is the paper's 3, so the file names the reference's 2 (the same kitchen).
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 2}" --random-seed 1 --horizon 200 --out $F/overcooked_a_n2_random1
 # The authors' trained actors (visualization/policy_nns), greedy with each GRU state carried
 # across its agent's decisions, under the published settings of each block (Warehouse: Turtlebot
 # speed 0.8, delay penalty -20), so their episodes replay here step for step.
@@ -59,6 +60,6 @@ $PY $S --macromarl $MM --env OSD-T-v1 --params "{$C, \"human_speed_per_step\": [
 # full salad with 3 agents (chops, plate gathering, delivery), and a 2-agent tomato salad with a
 # wrong delivery first; then random episodes on the 9 x 9 map C and on map B with another task.
 $PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --plan '[[1,6,9,4,6,7,0,0,0,0,0,0,0,0,0,0,0,0,6,8],[2,7,9,11,10,10,0],[3,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,6,9,10,10,0]]' --horizon 200 --out $F/overcooked_a_n3_salad_plan
-$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"tomato salad\", \"rewardList\": $R, \"debug\": false}" --plan '[[1,6,9,4,6,8],[2,8,10,10,0]]' --horizon 200 --out $F/overcooked_a_n2_tomato_plan
+$PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"A\", \"task\": \"tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 2}" --plan '[[1,6,9,4,6,8],[2,8,10,10,0]]' --horizon 200 --out $F/overcooked_a_n2_tomato_plan
 $PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [9, 9], \"map_type\": \"C\", \"task\": \"lettuce-onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 3}" --random-seed 2 --horizon 200 --out $F/overcooked_c9_n3_random2
 $PY $S --macromarl $MM --overcooked $OC --env Overcooked-MA-v1 --params "{\"grid_dim\": [7, 7], \"map_type\": \"B\", \"task\": \"onion-tomato salad\", \"rewardList\": $R, \"debug\": false, \"n_agent\": 2}" --random-seed 3 --horizon 200 --out $F/overcooked_b_n2_random3

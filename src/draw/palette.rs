@@ -40,11 +40,13 @@ pub enum Colour {
     Working,
     /// Status bar background.
     HudBackground,
+    /// A third robot: MacroMARL's Turtlebot 2 and Overcooked's third cook.
+    Agent2,
 }
 
 impl Colour {
     /// Every colour in discriminant order.
-    pub const ALL: [Colour; 20] = [
+    pub const ALL: [Colour; 21] = [
         Colour::Background,
         Colour::GridLine,
         Colour::Dark,
@@ -65,6 +67,7 @@ impl Colour {
         Colour::Workshop,
         Colour::Working,
         Colour::HudBackground,
+        Colour::Agent2,
     ];
 
     /// The colour stored as pixel value `index`, if any.
@@ -95,12 +98,23 @@ impl Colour {
             Colour::Workshop => [232, 239, 250],
             Colour::Working => [80, 205, 80],
             Colour::HudBackground => [236, 236, 236],
+            Colour::Agent2 => [150, 140, 10],
         }
     }
 
     /// The colour of Warehouse tool `k` (0..3); tools beyond the paper's three reuse the cycle.
     pub fn tool(k: usize) -> Colour {
         [Colour::Tool0, Colour::Tool1, Colour::Tool2][k % 3]
+    }
+
+    /// The colour of the `i`-th of several robots of one kind (MacroMARL's Turtlebots, the
+    /// cooks of Overcooked): green, blue, then olive for the third and any further one.
+    pub fn robot(i: usize) -> Colour {
+        match i {
+            0 => Colour::Agent0,
+            1 => Colour::Agent1,
+            _ => Colour::Agent2,
+        }
     }
 
     /// The colour of agent `i`'s robot (Box Pushing robots, Turtlebots; the Fetch is agent 2).

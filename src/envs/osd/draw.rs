@@ -63,16 +63,6 @@ pub fn room_of(area: [f64; 2]) -> ([f64; 2], [f64; 2]) {
     }
 }
 
-/// Colour of Turtlebot `i` (the palette has two robot colours; a third Turtlebot is drawn in
-/// the goal colour).
-fn tb_colour(i: usize) -> Colour {
-    match i {
-        0 => Colour::Agent0,
-        1 => Colour::Agent1,
-        _ => Colour::Goal,
-    }
-}
-
 fn draw_rooms(c: &mut Canvas, layout: &Layout) {
     let (w, h) = (c.width() as f64, c.height() as f64);
     for &area in layout.work_areas {
@@ -170,7 +160,7 @@ fn draw_turtlebots<const V: usize>(c: &mut Canvas, env: &Osd<V>) {
     let r = TB_RADIUS_M * PX_PER_M;
     for (i, tb) in env.turtlebots().iter().enumerate() {
         let (x, y) = to_px(tb.pos);
-        c.ringed_circle(x, y, r, 1.5, Colour::Dark, tb_colour(i));
+        c.ringed_circle(x, y, r, 1.5, Colour::Dark, Colour::robot(i));
         let text = if i < 2 { Colour::White } else { Colour::Dark };
         centred_text(c, x, y, &i.to_string(), text);
         let mut slot = 0.0;

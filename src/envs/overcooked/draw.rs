@@ -172,7 +172,7 @@ pub fn draw(env: &Overcooked) -> Picture {
             g.cell as f64 * 0.42,
             2.0,
             Colour::Dark,
-            Colour::agent(i),
+            Colour::robot(i),
         );
         if let Some(h) = c.holding {
             draw_thing(&mut canvas, w, cx, cy, r * 0.8, h);
@@ -201,9 +201,9 @@ mod tests {
         };
         // Agents (1,2), (1,4), (5,2) in their colours; the delivery counter (3,0); a counter
         // (6,0); floor (3,3); the tomato (0,5) red.
-        assert_eq!(at(Cell::new(1, 2)), Some(Colour::agent(0)));
-        assert_eq!(at(Cell::new(1, 4)), Some(Colour::agent(1)));
-        assert_eq!(at(Cell::new(5, 2)), Some(Colour::agent(2)));
+        assert_eq!(at(Cell::new(1, 2)), Some(Colour::Agent0));
+        assert_eq!(at(Cell::new(1, 4)), Some(Colour::Agent1));
+        assert_eq!(at(Cell::new(5, 2)), Some(Colour::Agent2));
         assert_eq!(at(Cell::new(3, 0)), Some(Colour::Goal));
         assert_eq!(at(Cell::new(6, 0)), Some(Colour::Table));
         assert_eq!(at(Cell::new(3, 3)), Some(Colour::Background));

@@ -31,7 +31,7 @@ pub mod world;
 #[cfg(test)]
 mod scenarios;
 
-pub use domain::{OvercookedDomain, DEFAULT_N_AGENT, PAPER_N_AGENT};
+pub use domain::{OvercookedDomain, PAPER_N_AGENT, REFERENCE_N_AGENT};
 
 use self::astar::PyHeap;
 use self::layout::{belief_base, start_map, Cells, MapType};
@@ -53,7 +53,7 @@ pub struct OvercookedParams {
     pub rewards: Rewards,
     /// 2 or 3. The reference's default is 2 and MacroMARL's scripts never pass `n_agent`, so
     /// as published they train 2 agents while the paper and the shipped policies use 3 (spec
-    /// 5.2 item 1; see [`DEFAULT_N_AGENT`] and [`PAPER_N_AGENT`]).
+    /// 5.2 item 1; see [`PAPER_N_AGENT`] and [`REFERENCE_N_AGENT`]).
     pub n_agent: usize,
     /// The runner's `env_terminate_step`: the step at which the episode is cut (truncated).
     pub horizon: usize,
