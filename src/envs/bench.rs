@@ -101,7 +101,22 @@ pub fn bench_suite() -> Vec<(&'static str, EnvSpec)> {
         ("OSD-T-v0 Warehouse C (published)", published("OSD-T-v0")),
         ("OSD-T-v1 Warehouse D (published)", published("OSD-T-v1")),
         ("OSD-F-v0 Warehouse E (published)", published("OSD-F-v0")),
+        (
+            "Overcooked-MA-v1 map A, 3 agents",
+            published("Overcooked-MA-v1"),
+        ),
+        ("Overcooked-MA-v1 map B, 3 agents", overcooked("B")),
+        ("Overcooked-MA-v1 map C, 3 agents", overcooked("C")),
     ]
+}
+
+/// Overcooked on map `map` at the published settings (3 agents).
+fn overcooked(map: &str) -> EnvSpec {
+    EnvSpec::new(
+        "Overcooked-MA-v1",
+        &toml::Table::from_iter([("map_type".into(), map.into())]),
+    )
+    .expect("maps A, B and C exist")
 }
 
 /// The domain `name` at its defaults (MacroMARL's domains default to the published settings).

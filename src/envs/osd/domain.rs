@@ -11,7 +11,9 @@
 
 use super::layout::{LAYOUTS, N_WORK_STEPS};
 use super::{Osd, OsdParams, D7, F0, T0, T1};
-use crate::envs::domain::{fill_keys, key_f64, key_usize, Domain, KeyError, HORIZON_KEY};
+use crate::envs::domain::{
+    fill_keys, key_f64, key_table, key_usize, Domain, KeyError, HORIZON_KEY,
+};
 use crate::envs::macromarl::without_ignored_kwargs;
 use crate::envs::EnvError;
 
@@ -172,6 +174,12 @@ impl<const V: usize> Domain for OsdDomain<V> {
 
     fn build(&self, keys: &toml::Table) -> Result<Osd<V>, KeyError> {
         Osd::new(params(keys)?).map_err(key_of)
+    }
+
+    /// MacroMARL's Warehouse runs are undiscounted (`gamma` 1.0 in every published block, for
+    /// the actor-critic and the value-based methods alike); its returns are reported so.
+    fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
+        key_table([("discount", 1.0.into())])
     }
 }
 

@@ -171,6 +171,12 @@ impl Domain for OvercookedDomain {
         Overcooked::new(params(keys)?).map_err(key_of)
     }
 
+    /// MacroMARL's Overcooked runs discount by 0.99 per primitive step (every published block);
+    /// the shipped policies' returns are reported so.
+    fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
+        key_table([("discount", 0.99.into())])
+    }
+
     /// `overcooked-a`, with the agent count and grid when not the paper's (`overcooked-b-n2`).
     fn short_name(&self, keys: &toml::Table) -> String {
         let Ok(p) = params(keys) else {
