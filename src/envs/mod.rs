@@ -1,6 +1,8 @@
-//! Macro-action multi-agent domains: Box Pushing and Warehouse Tool Delivery.
+//! Macro-action multi-agent domains: the ICRA paper's Box Pushing and Warehouse Tool Delivery,
+//! and MacroMARL's (`bp_ma_v0`, the Warehouse A-E of `osd`, `overcooked`), each in its folder and
+//! listed once in [`built_in`].
 //!
-//! Both follow the reference's step contract (spec `algorithms.md` 1.1): an agent picks a new
+//! All follow the references' step contract (spec `algorithms.md` 1.1): an agent picks a new
 //! macro-action only when its previous one finished; the value passed for a busy agent is ignored;
 //! the executed macro-actions, the held macro-observations, one shared team reward, the episode-done
 //! flag and the per-agent macro-action-done flags come back from every primitive step.
@@ -162,7 +164,7 @@ pub enum FirstRecordObs {
 /// `src/` to train with every method; to get the whole command line (configs, runs, plots,
 /// export, ...) it also implements [`domain::Domain`].
 pub trait MacroEnv {
-    /// Number of agents (Box Pushing 2, Warehouse 3).
+    /// Number of agents (Box Pushing 2, Warehouse 3, Overcooked 2 or 3).
     fn n_agents(&self) -> usize;
     /// Size of each agent's macro-observation, in agent order.
     fn obs_sizes(&self) -> &[usize];
