@@ -549,7 +549,8 @@ fn train(args: TrainArgs) -> Result<()> {
         jobs,
         args.out.join(&experiment.name).display()
     );
-    for (curve, home) in &experiment.shared_curves {
+    let selected = |curve: &String| experiment.methods.iter().any(|m| m.name() == curve);
+    for (curve, home) in experiment.shared_curves.iter().filter(|(c, _)| selected(c)) {
         eprintln!(
             "  {curve}: shared with {home}, runs in {}",
             args.out.join(home).join(curve).display()

@@ -131,7 +131,8 @@ pub struct Experiment {
     pub methods: Vec<Method>,
     pub seeds: Vec<u64>,
     /// Curves whose runs belong to another experiment (curve name -> that experiment's name):
-    /// Figure 6's Our-2 is Figure 5's Our-2, trained once and drawn in both.
+    /// Figure 6's Our-2 is Figure 5's Our-2, trained once and drawn in both. All the file
+    /// names, also when `--methods` selects fewer (the plots need them all).
     pub shared_curves: BTreeMap<String, String>,
     path: PathBuf,
     params: toml::Table,
@@ -192,18 +193,26 @@ impl Experiment {
             path: p(),
             message: e.message().to_string(),
         })?;
-        let methods = match (&overrides.methods, &file.methods) {
-            (Some(m), _) => m.clone(),
-            (None, Some(names)) => names
-                .iter()
-                .map(|n| {
-                    n.parse::<Method>().map_err(|e| ConfigError::BadValue {
-                        path: p(),
-                        key: "methods".into(),
-                        message: e.to_string(),
+        // The file's own methods (checked even when --methods selects some of them).
+        let listed: Option<Vec<Method>> = file
+            .methods
+            .as_ref()
+            .map(|names| {
+                names
+                    .iter()
+                    .map(|n| {
+                        n.parse::<Method>().map_err(|e| ConfigError::BadValue {
+                            path: p(),
+                            key: "methods".into(),
+                            message: e.to_string(),
+                        })
                     })
-                })
-                .collect::<Result<_, _>>()?,
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .transpose()?;
+        let methods = match (&overrides.methods, &listed) {
+            (Some(m), _) => m.clone(),
+            (None, Some(l)) => l.clone(),
             (None, None) => vec![Method::Our1],
         };
         if methods.is_empty() {
@@ -270,7 +279,8 @@ impl Experiment {
                 key: format!("shared_curves.{curve}"),
                 message,
             };
-            if !methods.iter().any(|m| m.name() == curve) {
+            let own = listed.as_ref().unwrap_or(&methods);
+            if !own.iter().any(|m| m.name() == curve) {
                 return Err(bad(format!(
                     "`{curve}` is not one of this experiment's methods"
                 )));
@@ -896,6 +906,31 @@ mod tests {
             ..Default::default()
         };
         assert!(Experiment::parse("", Path::new("t.toml"), "t", &o).is_err());
+    }
+
+    #[test]
+    fn every_committed_experiment_runs_each_of_its_methods_alone() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+        let mut checked = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let all = Experiment::parse(&text, &path, "x", &Overrides::default()).unwrap();
+            for &m in &all.methods {
+                let o = Overrides {
+                    methods: Some(vec![m]),
+                    ..Default::default()
+                };
+                let one = Experiment::parse(&text, &path, "x", &o)
+                    .unwrap_or_else(|e| panic!("{} --methods {}: {e}", path.display(), m.name()));
+                assert!(one.runs().unwrap().iter().all(|r| r.method == m));
+                checked += 1;
+            }
+        }
+        assert!(checked >= 10, "{checked}");
     }
 
     #[test]

@@ -23,8 +23,21 @@ pub struct RunnerOptions {
     pub jobs: usize,
     /// Recompute finished runs instead of skipping them.
     pub force: bool,
-    /// No progress bars (logs, CI); one line per finished run instead.
+    /// No progress bars (logs, CI); one line per finished run instead. Without a terminal
+    /// on stderr that is the default anyway, with a line every [`HEARTBEAT`] per run besides.
     pub quiet: bool,
+}
+
+/// How often a run reports how far it got when there are no progress bars and no `--quiet`
+/// (stderr is not a terminal: a log file, a pipe, a batch job).
+pub const HEARTBEAT: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// The heartbeat of one run drawn without bars: its name, its episode count and when it last
+/// reported.
+struct Heartbeat {
+    name: String,
+    total_epi: u64,
+    last: std::sync::Mutex<std::time::Instant>,
 }
 
 /// How a run that did not fail ended, as the function training it reports.
@@ -57,6 +70,7 @@ pub struct Progress {
     bar: ProgressBar,
     total: ProgressBar,
     last: Arc<std::sync::atomic::AtomicU64>,
+    heartbeat: Option<Arc<Heartbeat>>,
 }
 
 impl Progress {
@@ -66,6 +80,7 @@ impl Progress {
             bar: ProgressBar::hidden(),
             total: ProgressBar::hidden(),
             last: Arc::default(),
+            heartbeat: None,
         }
     }
 
@@ -75,6 +90,17 @@ impl Progress {
         let before = self.last.swap(episodes, Ordering::Relaxed);
         self.total.inc(episodes.saturating_sub(before));
         self.bar.set_position(episodes);
+        let message = message.into();
+        if let Some(h) = &self.heartbeat {
+            let mut last = h.last.lock().unwrap_or_else(|e| e.into_inner());
+            if last.elapsed() >= HEARTBEAT {
+                *last = std::time::Instant::now();
+                eprintln!(
+                    "{}: episode {episodes} of {} {message}",
+                    h.name, h.total_epi
+                );
+            }
+        }
         self.bar.set_message(message);
     }
 }
@@ -94,10 +120,14 @@ pub fn run_all<F>(runs: &[RunSpec], opts: &RunnerOptions, run_one: F) -> Vec<Run
 where
     F: Fn(&RunSpec, &Path, &Progress) -> Result<RunEnd, String> + Sync,
 {
-    let multi = MultiProgress::with_draw_target(if opts.quiet {
-        ProgressDrawTarget::hidden()
-    } else {
+    // Without a terminal, bars would draw nothing: print lines instead, as --quiet does, plus a
+    // heartbeat per run (a log of a long batch shows it is alive).
+    let bars = !opts.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let heartbeat = !opts.quiet && !bars;
+    let multi = MultiProgress::with_draw_target(if bars {
         ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
     });
     // What to do with each run: `Ok(true)` train, `Ok(false)` skip (finished, same identity),
     // `Err` fail at once (another run's results are in its directory).
@@ -129,8 +159,9 @@ where
     );
     // A line about one run: above the progress bars, or on stderr when they are hidden.
     let say = |line: String| {
-        let _ = multi.println(&line);
-        if opts.quiet {
+        if bars {
+            let _ = multi.println(&line);
+        } else {
             eprintln!("{line}");
         }
     };
@@ -164,6 +195,13 @@ where
             bar: bar.clone(),
             total: total.clone(),
             last: Arc::default(),
+            heartbeat: heartbeat.then(|| {
+                Arc::new(Heartbeat {
+                    name: name.clone(),
+                    total_epi: spec.config.total_epi as u64,
+                    last: std::sync::Mutex::new(std::time::Instant::now()),
+                })
+            }),
         };
         let start = std::time::Instant::now();
         // A panic is a bug, but it fails this run only, not its neighbours.
@@ -183,7 +221,7 @@ where
         let seconds = start.elapsed().as_secs_f64();
         match result {
             Ok(RunEnd::Trained) => {
-                if opts.quiet {
+                if !bars {
                     eprintln!("finished {name} in {seconds:.1} s");
                 }
                 RunStatus::Finished { seconds }
