@@ -82,6 +82,17 @@ impl Canvas {
         self.fill_rect(x + w - t, y, t, h, c);
     }
 
+    /// A `side`-pixel square centred on pixel point (cx, cy), filled with `fill`, with a
+    /// 1-pixel `rim`.
+    pub fn centred_square(&mut self, cx: f64, cy: f64, side: i64, fill: Colour, rim: Colour) {
+        let (x, y) = (
+            (cx - side as f64 / 2.0).round() as i64,
+            (cy - side as f64 / 2.0).round() as i64,
+        );
+        self.fill_rect(x, y, side, side, fill);
+        self.outline_rect(x, y, side, side, 1, rim);
+    }
+
     /// Fill every pixel whose centre lies within `r` of (cx, cy) (pixel coordinates, pixel
     /// (x, y) has its centre at (x + 0.5, y + 0.5)).
     pub fn fill_circle(&mut self, cx: f64, cy: f64, r: f64, c: Colour) {

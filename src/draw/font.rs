@@ -74,6 +74,13 @@ pub fn text_width(text: &str, scale: i64) -> i64 {
     }
 }
 
+/// `text` at `scale` centred on pixel point (cx, cy).
+pub fn draw_text_centred(canvas: &mut Canvas, cx: f64, cy: f64, text: &str, scale: i64, c: Colour) {
+    let x = (cx - text_width(text, scale) as f64 / 2.0).round() as i64;
+    let y = (cy - (GLYPH_H * scale) as f64 / 2.0).round() as i64;
+    draw_text(canvas, x, y, text, scale, c);
+}
+
 /// Draw `text` with its top-left corner at (x, y), each font pixel a `scale` x `scale` square.
 /// Returns the x just after the text (where the next character would start).
 pub fn draw_text(canvas: &mut Canvas, x: i64, y: i64, text: &str, scale: i64, c: Colour) -> i64 {

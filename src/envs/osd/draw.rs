@@ -7,12 +7,10 @@
 
 use super::layout::{Layout, FETCH_POS, N_WORK_STEPS};
 use super::{FetchAction, Osd};
-use crate::draw::font::{draw_text, text_width, GLYPH_H};
+use crate::draw::font::draw_text_centred;
 use crate::draw::{Canvas, Colour, Picture};
+use crate::envs::warehouse::draw::{to_px, world_rect, PX_PER_M, WORLD_H_M};
 
-/// Pixels per metre.
-pub const PX_PER_M: f64 = 60.0;
-const WORLD_H_M: f64 = 5.0;
 const TB_RADIUS_M: f64 = 0.17;
 const FETCH_RADIUS_M: f64 = 0.25;
 /// Centres of the two staging slots on the table, first-to-pass first.
@@ -20,39 +18,6 @@ const STAGING: [[f64; 2]; 2] = [[1.75, 2.75], [1.75, 2.25]];
 
 const LABELS_2: [&str; 3] = ["T0", "T1", "F"];
 const LABELS_3: [&str; 4] = ["T0", "T1", "T2", "F"];
-
-/// World point (m, y up) to pixel coordinates (y down).
-pub fn to_px(p: [f64; 2]) -> (f64, f64) {
-    (p[0] * PX_PER_M, (WORLD_H_M - p[1]) * PX_PER_M)
-}
-
-/// Fill (and rim) the world box [x0, x1] x [y0, y1] (m).
-fn world_rect(c: &mut Canvas, lo: [f64; 2], hi: [f64; 2], fill: Colour, rim: Option<Colour>) {
-    let (px0, py0) = to_px([lo[0], hi[1]]);
-    let (px1, py1) = to_px([hi[0], lo[1]]);
-    let (x, y) = (px0.round() as i64, py0.round() as i64);
-    let (w, h) = (px1.round() as i64 - x, py1.round() as i64 - y);
-    c.fill_rect(x, y, w, h, fill);
-    if let Some(rim) = rim {
-        c.outline_rect(x, y, w, h, 1, rim);
-    }
-}
-
-/// A `side`-pixel square centred on pixel point (cx, cy) with a 1-pixel rim.
-fn square(c: &mut Canvas, cx: f64, cy: f64, side: i64, fill: Colour, rim: Colour) {
-    let (x, y) = (
-        (cx - side as f64 / 2.0).round() as i64,
-        (cy - side as f64 / 2.0).round() as i64,
-    );
-    c.fill_rect(x, y, side, side, fill);
-    c.outline_rect(x, y, side, side, 1, rim);
-}
-
-fn centred_text(c: &mut Canvas, cx: f64, cy: f64, text: &str, colour: Colour) {
-    let x = (cx - text_width(text, 2) as f64 / 2.0).round() as i64;
-    let y = (cy - (GLYPH_H * 2) as f64 / 2.0).round() as i64;
-    draw_text(c, x, y, text, 2, colour);
-}
 
 /// The room of the human working at `area`: 2 m wide around it, along the top or bottom wall.
 pub fn room_of(area: [f64; 2]) -> ([f64; 2], [f64; 2]) {
@@ -106,12 +71,12 @@ fn draw_fetch<const V: usize>(c: &mut Canvas, env: &Osd<V>) {
         }
     }
     c.ringed_circle(fx, fy, r, 2.0, Colour::Dark, Colour::Fetch);
-    centred_text(c, fx, fy, "F", Colour::White);
+    draw_text_centred(c, fx, fy, "F", 2, Colour::White);
     for (slot, centre) in STAGING.iter().enumerate() {
         let (x, y) = to_px(*centre);
         match fetch.staged().get(slot) {
-            Some(&k) => square(c, x, y, 14, Colour::tool(k), Colour::Dark),
-            None => square(c, x, y, 14, Colour::Table, Colour::White),
+            Some(&k) => c.centred_square(x, y, 14, Colour::tool(k), Colour::Dark),
+            None => c.centred_square(x, y, 14, Colour::Table, Colour::White),
         }
     }
 }
@@ -136,8 +101,7 @@ fn draw_humans<const V: usize>(c: &mut Canvas, env: &Osd<V>) {
             } else {
                 Colour::Working
             };
-            square(
-                c,
+            c.centred_square(
                 bar_x + 7.0 + 20.0 * k as f64,
                 bar_y,
                 14,
@@ -162,12 +126,11 @@ fn draw_turtlebots<const V: usize>(c: &mut Canvas, env: &Osd<V>) {
         let (x, y) = to_px(tb.pos);
         c.ringed_circle(x, y, r, 1.5, Colour::Dark, Colour::robot(i));
         let text = if i < 2 { Colour::White } else { Colour::Dark };
-        centred_text(c, x, y, &i.to_string(), text);
+        draw_text_centred(c, x, y, &i.to_string(), 2, text);
         let mut slot = 0.0;
         for (k, &count) in tb.basket.iter().enumerate() {
             if count > 0.0 {
-                square(
-                    c,
+                c.centred_square(
                     x + r + 5.0,
                     y - r + 4.0 + 9.0 * slot,
                     8,

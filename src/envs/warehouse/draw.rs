@@ -6,7 +6,7 @@
 //! a bar of its work steps and the tool it needs next. Tools are coloured by index everywhere.
 
 use super::{FetchAction, Warehouse, FETCH_POS, WAYPOINTS};
-use crate::draw::font::{draw_text, text_width, GLYPH_H};
+use crate::draw::font::draw_text_centred;
 use crate::draw::{Canvas, Colour, Picture};
 
 /// Status-bar labels: Turtlebot 0, Turtlebot 1, Fetch.
@@ -15,7 +15,7 @@ pub const LABELS: [&str; 3] = ["T0", "T1", "F"];
 /// Pixels per metre: the world is 420 x 300 pixels.
 pub const PX_PER_M: f64 = 60.0;
 const WORLD_W_M: f64 = 7.0;
-const WORLD_H_M: f64 = 5.0;
+pub(crate) const WORLD_H_M: f64 = 5.0;
 
 /// Where the human stands in the workshop (the dynamics have no human position; spec section 1).
 const HUMAN_POS: [f64; 2] = [6.5, 3.9];
@@ -37,18 +37,17 @@ fn world_px() -> (usize, usize) {
     )
 }
 
-/// Fill (and rim) the axis-aligned world box [x0, x1] x [y0, y1] (m).
-fn world_rect(
+/// Fill (and rim) the axis-aligned world box from corner `lo` to corner `hi` (m). MacroMARL's
+/// Warehouse pictures (`envs::osd::draw`) use the same world scale and draw with it too.
+pub(crate) fn world_rect(
     c: &mut Canvas,
-    x0: f64,
-    y0: f64,
-    x1: f64,
-    y1: f64,
+    lo: [f64; 2],
+    hi: [f64; 2],
     fill: Colour,
     rim: Option<Colour>,
 ) {
-    let (px0, py0) = to_px([x0, y1]);
-    let (px1, py1) = to_px([x1, y0]);
+    let (px0, py0) = to_px([lo[0], hi[1]]);
+    let (px1, py1) = to_px([hi[0], lo[1]]);
     let (x, y) = (px0.round() as i64, py0.round() as i64);
     let (w, h) = (px1.round() as i64 - x, py1.round() as i64 - y);
     c.fill_rect(x, y, w, h, fill);
@@ -57,26 +56,9 @@ fn world_rect(
     }
 }
 
-/// A `side`-pixel square centred on pixel point (cx, cy): filled with `fill`, 1-pixel dark rim.
-fn square(c: &mut Canvas, cx: f64, cy: f64, side: i64, fill: Colour, rim: Colour) {
-    let (x, y) = (
-        (cx - side as f64 / 2.0).round() as i64,
-        (cy - side as f64 / 2.0).round() as i64,
-    );
-    c.fill_rect(x, y, side, side, fill);
-    c.outline_rect(x, y, side, side, 1, rim);
-}
-
-/// Text centred on pixel point (cx, cy).
-fn centred_text(c: &mut Canvas, cx: f64, cy: f64, text: &str, scale: i64, colour: Colour) {
-    let x = (cx - text_width(text, scale) as f64 / 2.0).round() as i64;
-    let y = (cy - (GLYPH_H * scale) as f64 / 2.0).round() as i64;
-    draw_text(c, x, y, text, scale, colour);
-}
-
 fn draw_rooms(c: &mut Canvas) {
     let (w, h) = world_px();
-    world_rect(c, 5.0, 3.0, 7.0, 5.0, Colour::Workshop, None);
+    world_rect(c, [5.0, 3.0], [7.0, 5.0], Colour::Workshop, None);
     let (wall_x, _) = to_px([3.5, 0.0]);
     c.dashed_line(wall_x, 0.0, wall_x, h as f64, 2.0, 6.0, 5.0, Colour::Dark);
     let (ws_x, ws_y) = to_px([5.0, 3.0]);
@@ -84,7 +66,13 @@ fn draw_rooms(c: &mut Canvas) {
     c.dashed_line(ws_x, ws_y, w as f64, ws_y, 2.0, 6.0, 5.0, Colour::Dark);
     c.outline_rect(0, 0, w as i64, h as i64, 3, Colour::Dark);
     // Table centred at (1.75, 1.8), 0.6 m x 1.8 m.
-    world_rect(c, 1.45, 0.9, 2.05, 2.7, Colour::Table, Some(Colour::Dark));
+    world_rect(
+        c,
+        [1.45, 0.9],
+        [2.05, 2.7],
+        Colour::Table,
+        Some(Colour::Dark),
+    );
     for robot in WAYPOINTS {
         for wp in robot {
             let (x, y) = to_px(wp);
@@ -112,12 +100,12 @@ fn draw_fetch(c: &mut Canvas, env: &Warehouse) {
         _ => {}
     }
     c.ringed_circle(fx, fy, r, 2.0, Colour::Dark, Colour::Fetch);
-    centred_text(c, fx, fy, "F", 2, Colour::White);
+    draw_text_centred(c, fx, fy, "F", 2, Colour::White);
     for (slot, centre) in STAGING.iter().enumerate() {
         let (x, y) = to_px(*centre);
         match fetch.staged().get(slot) {
-            Some(&k) => square(c, x, y, 14, Colour::tool(k), Colour::Dark),
-            None => square(c, x, y, 14, Colour::Table, Colour::White),
+            Some(&k) => c.centred_square(x, y, 14, Colour::tool(k), Colour::Dark),
+            None => c.centred_square(x, y, 14, Colour::Table, Colour::White),
         }
     }
 }
@@ -140,8 +128,7 @@ fn draw_human(c: &mut Canvas, env: &Warehouse) {
         } else {
             Colour::Working
         };
-        square(
-            c,
+        c.centred_square(
             bar_x + 7.0 + 20.0 * k as f64,
             13.0,
             14,
@@ -170,13 +157,12 @@ fn draw_turtlebots(c: &mut Canvas, env: &Warehouse) {
             x += if i == 0 { -0.7 * r } else { 0.7 * r };
         }
         c.ringed_circle(x, y, r, 1.5, Colour::Dark, Colour::agent(i));
-        centred_text(c, x, y, if i == 0 { "0" } else { "1" }, 2, Colour::White);
+        draw_text_centred(c, x, y, if i == 0 { "0" } else { "1" }, 2, Colour::White);
         let mut slot = 0.0;
         for (k, &count) in env.turtlebot(i).basket.iter().enumerate() {
             if count > 0.0 {
                 let sx = if i == 0 { x - r - 5.0 } else { x + r + 5.0 };
-                square(
-                    c,
+                c.centred_square(
                     sx,
                     y - r + 4.0 + 9.0 * slot,
                     8,
