@@ -5,6 +5,7 @@
 # --trajectories` and compares the return, the length and every step's executed macro-actions and
 # reward with the reference's own greedy episode (tests/fixtures/macromarl/*_actors, written by
 # scripts/macromarl_fixtures.sh from the reference code). Needs torch for the conversion only:
+#   python3.11 -m venv torchvenv && torchvenv/bin/pip install torch safetensors numpy
 #   TORCH_PY=torchvenv/bin/python MACDEC=target/release/macdec scripts/macromarl_actors_check.sh MACROMARL
 set -e
 MM=$1; TORCH_PY=${TORCH_PY:-python3}; MACDEC=${MACDEC:-target/release/macdec}
