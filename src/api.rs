@@ -124,7 +124,7 @@ impl TrainedPolicy {
                 env: spec.clone(),
                 config: self.config.clone(),
             }),
-            PolicyEnv::Custom(_) => serde_json::to_value(&self.config),
+            PolicyEnv::Custom(_) => serde_json::to_value(self.config.to_table()),
         }
         .expect("a config serializes to JSON");
         let run = RunInfo {
@@ -136,7 +136,7 @@ impl TrainedPolicy {
             config,
         };
         let dec: Vec<&QNet> = self.dec.iter().collect();
-        export_nets(out, domain, env, self.config.discount, run, &dec)
+        export_nets(out, domain, env, self.config.discount(), run, &dec)
     }
 }
 
@@ -144,7 +144,7 @@ impl TrainedPolicy {
 mod tests {
     use super::*;
     use crate::envs::{AnyEnv, EnvSpec};
-    use crate::experiment::paper::paper_defaults;
+    use crate::experiment::paper::value_paper_defaults;
 
     /// The library trains on BP 10x10 here.
     fn spec() -> EnvSpec {
@@ -152,10 +152,10 @@ mod tests {
     }
 
     fn short(method: Method) -> RunConfig {
-        let mut c = paper_defaults(&spec(), method);
+        let mut c = value_paper_defaults(&spec(), method);
         c.total_epi = 12;
         c.eval_freq = 4;
-        c
+        c.into()
     }
 
     #[test]
@@ -236,7 +236,7 @@ mod tests {
     #[test]
     fn a_bad_config_key_is_named_before_training() {
         let mut c = short(Method::Our1);
-        c.batch_size = 0;
+        c.value_mut().unwrap().batch_size = 0;
         let spec = spec();
         let err = train(|| spec.build(), &c, Method::Our1, 0, |_| {}).unwrap_err();
         assert!(err.to_string().contains("batch_size"), "{err}");

@@ -31,4 +31,4 @@ pub use algos::training_loop::EvalPoint;
 pub use api::{train, train_policy, LibraryTrainError, TrainedPolicy};
 pub use deploy::PolicyEnv;
 pub use envs::{EnvError, EnvRng, EnvSpec, FirstRecordObs, MacroEnv, StepOutcome};
-pub use experiment::paper::paper_defaults;
+pub use experiment::paper::{actor_critic_defaults, paper_defaults, value_paper_defaults};

@@ -10,7 +10,7 @@ use macdec::deploy::link::JsonLink;
 use macdec::deploy::manifest::Manifest;
 use macdec::deploy::protocol::Reply;
 use macdec::deploy::{greedy_action, PolicyEnv};
-use macdec::{paper_defaults, EnvError, EnvRng, MacroEnv, Method, StepOutcome};
+use macdec::{value_paper_defaults, EnvError, EnvRng, MacroEnv, Method, StepOutcome};
 use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;
 use std::path::Path;
@@ -128,7 +128,7 @@ impl MacroEnv for Beacon {
 
 /// A few episodes of Our-1 on [`Beacon`] through the library, exported to `dir`.
 fn train_and_export(dir: &Path) -> (macdec::TrainedPolicy, Manifest) {
-    let mut config = paper_defaults(&macdec::envs::warehouse::paper_spec(), Method::Our1);
+    let mut config = value_paper_defaults(&macdec::envs::warehouse::paper_spec(), Method::Our1);
     config.total_epi = 12;
     config.eps_l_d_steps = 6;
     config.h_stable_at = 6;
@@ -141,6 +141,7 @@ fn train_and_export(dir: &Path) -> (macdec::TrainedPolicy, Manifest) {
     config.dec_rnn_h_size = 8;
     config.cen_mlp_layer_size = 8;
     config.cen_rnn_h_size = 8;
+    let config = config.into();
     let trained = macdec::train_policy(Beacon::new, &config, Method::Our1, 4, |_| {}).unwrap();
     assert_eq!(trained.episodes_trained, 12);
     assert!(trained.evals.iter().any(|e| e.updates > 0), "it trained");
@@ -249,7 +250,7 @@ fn your_own_program_runs_the_custom_domain_against_its_robots_as_the_learner_eva
     let learner = greedy_episode(
         &mut env,
         GreedyPolicy::Dec(&nets),
-        trained.config.discount,
+        trained.config.discount(),
         &mut EnvRng::seed_from_u64(0),
         |e, _, reward| steps.push((e.executed().to_vec(), reward)),
     )

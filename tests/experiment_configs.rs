@@ -59,7 +59,7 @@ fn paper_figures_have_forty_seeds_and_their_methods() {
 #[test]
 fn bp30_uses_longer_windows_and_horizon() {
     let runs = load("fig4b_bp30.toml").runs().unwrap();
-    let c = &runs[0].config;
+    let c = runs[0].config.value().expect("a value method");
     assert_eq!(runs[0].env, macdec::envs::box_pushing::spec(30, 200));
     assert_eq!((c.trace_len, c.train_freq), (45, 45));
 }

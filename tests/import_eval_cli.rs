@@ -231,7 +231,7 @@ fn deploys_paper_discounts_are_the_learners() {
         assert_eq!(spec.paper_discount(), Some(paper), "{spec:?}");
         for method in [Method::Our1, Method::CenDdrqn, Method::DecHddrqn] {
             assert_eq!(
-                paper_defaults(&spec, method).discount,
+                paper_defaults(&spec, method).discount(),
                 paper,
                 "{spec:?} {method:?}"
             );

@@ -1,6 +1,7 @@
 //! A training loop of whichever family a method belongs to, chosen by value: the run on disk, its
 //! checkpoint and the library API hold an [`AnyLoop`] and never name a learner type.
 
+use crate::algos::actor_critic::learner::AcLearner;
 use crate::algos::hyper::RunConfig;
 use crate::algos::learner::SavedNets;
 use crate::algos::method::{Family, Method};
@@ -15,7 +16,9 @@ use serde::{Deserialize, Serialize};
 #[serde(bound(deserialize = "E: serde::de::DeserializeOwned"))]
 pub enum AnyLoop<E = AnyEnv> {
     /// The ICRA 2020 Q-learning methods.
-    Value(TrainingLoop<ValueLearner, E>),
+    Value(Box<TrainingLoop<ValueLearner, E>>),
+    /// MacroMARL's actor-critic methods.
+    ActorCritic(Box<TrainingLoop<AcLearner, E>>),
 }
 
 /// Forward a method call to the family's loop.
@@ -23,6 +26,7 @@ macro_rules! dispatch {
     ($self:expr, $l:ident => $call:expr) => {
         match $self {
             AnyLoop::Value($l) => $call,
+            AnyLoop::ActorCritic($l) => $call,
         }
     };
 }
@@ -37,9 +41,12 @@ impl<E: MacroEnv> AnyLoop<E> {
         make_env: impl Fn() -> Result<E, EnvError>,
     ) -> Result<Self, TrainError> {
         Ok(match method.family() {
-            Family::Value => {
-                AnyLoop::Value(TrainingLoop::new(config, method, seed, rngs, make_env)?)
-            }
+            Family::Value => AnyLoop::Value(Box::new(TrainingLoop::new(
+                config, method, seed, rngs, make_env,
+            )?)),
+            Family::ActorCritic => AnyLoop::ActorCritic(Box::new(TrainingLoop::new(
+                config, method, seed, rngs, make_env,
+            )?)),
         })
     }
 

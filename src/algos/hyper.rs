@@ -1,17 +1,132 @@
-//! Every hyperparameter of a run, concrete, with the paper's values as defaults.
+//! Every hyperparameter of a run, concrete, with the papers' values as defaults.
 //!
-//! The learner reads only this struct; `experiment::config` builds it from files, sweeps and
-//! `--set` overrides. Field names are the reference's command-line flags (spec `algorithms.md` 10).
-//! It names no domain: the loop is handed a way to build the environment, and a run on disk
-//! records its domain beside these keys (`experiment::run_settings`).
+//! A run's [`RunConfig`] is its family's own set of keys: the ICRA code's flags for the value
+//! methods ([`ValueConfig`], spec `algorithms.md` 10) and MacroMARL's for the actor-critic methods
+//! ([`AcConfig`], spec `macromarl.md` 1.4). A learner reads only its own struct;
+//! `experiment::config` builds them from files, sweeps and `--set` overrides. They name no domain:
+//! the loop is handed a way to build the environment, and a run on disk records its domain beside
+//! these keys (`experiment::run_settings`).
 
 use serde::{Deserialize, Serialize};
 
-/// The resolved hyperparameters of one run: every one concrete and validated. Unknown keys are
-/// refused, so a typo in a hand-edited config fails instead of being ignored.
+pub use crate::algos::actor_critic::config::AcConfig;
+
+/// The resolved hyperparameters of one run, by method family: every one concrete and validated.
+/// On disk (`config.toml`) it is the family's flat table of keys; which family a table is follows
+/// from its keys (only actor-critic tables have `a_lr`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum RunConfig {
+    /// The ICRA 2020 Q-learning methods.
+    Value(ValueConfig),
+    /// MacroMARL's macro-action actor-critic methods.
+    ActorCritic(AcConfig),
+}
+
+impl RunConfig {
+    /// Training episodes.
+    pub fn total_epi(&self) -> usize {
+        match self {
+            RunConfig::Value(c) => c.total_epi,
+            RunConfig::ActorCritic(c) => c.total_epi,
+        }
+    }
+
+    /// Set the number of training episodes (e.g. a shortened run in a benchmark).
+    pub fn set_total_epi(&mut self, episodes: usize) {
+        match self {
+            RunConfig::Value(c) => c.total_epi = episodes,
+            RunConfig::ActorCritic(c) => c.total_epi = episodes,
+        }
+    }
+
+    /// Training episodes between checkpoints.
+    pub fn checkpoint_freq(&self) -> usize {
+        match self {
+            RunConfig::Value(c) => c.checkpoint_freq,
+            RunConfig::ActorCritic(c) => c.checkpoint_freq,
+        }
+    }
+
+    /// The discount of evaluation returns and exported policies (per primitive step).
+    pub fn discount(&self) -> f64 {
+        match self {
+            RunConfig::Value(c) => c.discount,
+            RunConfig::ActorCritic(c) => c.gamma,
+        }
+    }
+
+    /// The value family's keys, if this is a value-method config.
+    pub fn value(&self) -> Option<&ValueConfig> {
+        match self {
+            RunConfig::Value(c) => Some(c),
+            RunConfig::ActorCritic(_) => None,
+        }
+    }
+
+    /// The same, mutable (e.g. to shorten a run built from the paper's defaults in code).
+    pub fn value_mut(&mut self) -> Option<&mut ValueConfig> {
+        match self {
+            RunConfig::Value(c) => Some(c),
+            RunConfig::ActorCritic(_) => None,
+        }
+    }
+
+    /// The actor-critic family's keys, if this is an actor-critic config.
+    pub fn actor_critic(&self) -> Option<&AcConfig> {
+        match self {
+            RunConfig::ActorCritic(c) => Some(c),
+            RunConfig::Value(_) => None,
+        }
+    }
+
+    /// The same, mutable.
+    pub fn actor_critic_mut(&mut self) -> Option<&mut AcConfig> {
+        match self {
+            RunConfig::ActorCritic(c) => Some(c),
+            RunConfig::Value(_) => None,
+        }
+    }
+
+    /// The flat table of keys `config.toml` records.
+    pub fn to_table(&self) -> toml::Table {
+        match self {
+            RunConfig::Value(c) => toml::Table::try_from(c),
+            RunConfig::ActorCritic(c) => toml::Table::try_from(c),
+        }
+        .expect("a config serializes to a table")
+    }
+
+    /// Read the table [`Self::to_table`] writes: the family follows from the keys (`a_lr` only
+    /// exists for the actor-critic methods); unknown keys are refused, naming them.
+    pub fn from_table(table: toml::Table) -> Result<Self, String> {
+        let value = toml::Value::Table(table);
+        let is_ac = value.get("a_lr").is_some();
+        if is_ac {
+            AcConfig::deserialize(value).map(RunConfig::ActorCritic)
+        } else {
+            ValueConfig::deserialize(value).map(RunConfig::Value)
+        }
+        .map_err(|e| e.message().to_string())
+    }
+}
+
+impl From<ValueConfig> for RunConfig {
+    fn from(c: ValueConfig) -> Self {
+        RunConfig::Value(c)
+    }
+}
+
+impl From<AcConfig> for RunConfig {
+    fn from(c: AcConfig) -> Self {
+        RunConfig::ActorCritic(c)
+    }
+}
+
+/// The value methods' resolved hyperparameters (the ICRA code's flags). Unknown keys are refused,
+/// so a typo in a hand-edited config fails instead of being ignored.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct RunConfig {
+pub struct ValueConfig {
     /// Training episodes (Our-2: decentralized-env episodes).
     pub total_epi: usize,
     /// Replay capacity: windows for the windowed buffer, episodes with `sample_epi` (spec 3).

@@ -30,6 +30,18 @@ pub enum Schedule {
         train_freq: u64,
         start_train: u64,
         target_update_freq: u64,
+        /// Evaluate before training and every `eval_freq` training episodes.
+        eval_freq: u64,
+    },
+    /// MacroMARL's collection (spec `macromarl.md` 2.3): every update first resets every lane,
+    /// steps them in lockstep until at least `train_freq` episodes have completed (the
+    /// unfinished ones are dropped), trains once and counts exactly `train_freq` episodes;
+    /// targets are hard-copied when the count is a multiple of `target_update_freq`. An
+    /// evaluation precedes every update whose episode count is a multiple of `eval_period`.
+    EpisodeBatches {
+        train_freq: u64,
+        target_update_freq: u64,
+        eval_period: u64,
     },
 }
 
@@ -55,6 +67,9 @@ pub struct LearnerRngs {
 
 /// The nets a learner saves as the run's policy files, and which of them the evaluated policy is.
 pub struct SavedNets<'a> {
+    /// The actor-critic methods' actors: agent i's is `actors[i]`, or the one centralized actor
+    /// (Mac-CAC); empty for the value methods.
+    pub actors: Vec<&'a crate::nn::GruActor>,
     /// Agent i's decentralized Q-net is `dec[i]` (empty when the method has none).
     pub dec: Vec<&'a QNet>,
     /// The centralized Q-net, when the method trains one.
@@ -108,6 +123,12 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
     /// Start a lane's next episode (`env` just reset).
     fn begin_episode<E: MacroEnv>(&self, lane: &mut Self::Lane, env: &E) -> Result<(), TrainError>;
 
+    /// Called before the lanes collect an [`Schedule::EpisodeBatches`] batch, with the training
+    /// episodes done so far (the batch's exploration rate follows from it).
+    fn begin_batch(&mut self, episodes: u64) {
+        let _ = episodes;
+    }
+
     /// One training iteration on what the lanes collected (in [`Self::lanes`] order);
     /// `episodes` is the number of training episodes done.
     fn train_iteration(&mut self, lanes: &[&Self::Lane], episodes: u64) -> Result<(), TrainError>;
@@ -117,6 +138,17 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
     /// The evaluated policy's mean return over `config().eval_num_epi` episodes of `env`
     /// (one if the domain is deterministic), discounted per primitive step.
     fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng) -> Result<f64, EnvError>;
+
+    /// The evaluation of an [`Schedule::EpisodeBatches`] learner, on the training lanes'
+    /// environments (MacroMARL evaluates on its workers; the lanes are reset before the next
+    /// batch anyway). By default [`Self::evaluate`] on the first lane.
+    fn evaluate_lanes<E: MacroEnv>(
+        &self,
+        envs: &mut [&mut E],
+        rng: &mut EnvRng,
+    ) -> Result<f64, EnvError> {
+        self.evaluate(&mut *envs[0], rng)
+    }
 
     /// The family's own `metrics.csv` columns, after `eval_return` and before `wall_seconds`.
     fn metric_columns(&self) -> &'static [&'static str];

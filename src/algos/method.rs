@@ -1,6 +1,8 @@
-//! The five methods as small values naming only what the paper varies between them
-//! (spec `algorithms.md` 4.6 and 5): which nets exist, who picks the action inside each target,
-//! how the training env(s) explore, and whether a loss is hysteretic.
+//! The methods as small values naming only what their papers vary between them: for the ICRA
+//! 2020 value methods (spec `algorithms.md` 4.6 and 5) which nets exist, who picks the action
+//! inside each target, how the training env(s) explore, and whether a loss is hysteretic; for
+//! MacroMARL's actor-critic methods (spec `macromarl.md` 2.7) whose actor acts and what the
+//! critic sees ([`Method::actor_critic`]).
 
 use crate::algos::value::schedule::HysteresisSchedule;
 use serde::{Deserialize, Serialize};
@@ -22,6 +24,66 @@ pub enum Method {
     Our1R,
     /// Parallel-MacDec-MADDRQN, "Our-2": separate centralized and decentralized envs (spec 5.5).
     Our2,
+    /// Mac-IAC: independent actors and history critics (MacroMARL's `MacIAC`).
+    MacIac,
+    /// Mac-CAC: one centralized actor over joint macro-actions and a joint critic (`MacCAC`).
+    MacCac,
+    /// Naive Mac-IACC: decentralized actors, one shared joint-history critic (`NaiveMacIACC`).
+    NaiveMacIacc,
+    /// Naive Mac-IACC with the shared critic on the global state (`NaiveMacIASC`).
+    NaiveMacIasc,
+    /// Mac-IAICC: decentralized actors, a joint-history critic per agent (`MacIAICC`).
+    MacIaicc,
+    /// Mac-IAICC with each agent's critic on the global state (`MacIAISC`).
+    MacIaisc,
+}
+
+/// The actor-critic methods, as a pattern (value-family `match`es list them in one arm).
+macro_rules! actor_critic_methods {
+    () => {
+        Method::MacIac
+            | Method::MacCac
+            | Method::NaiveMacIacc
+            | Method::NaiveMacIasc
+            | Method::MacIaicc
+            | Method::MacIaisc
+    };
+}
+
+/// Who acts in an actor-critic method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AcActor {
+    /// Each agent samples from its own actor on its own observation history.
+    Decentralized,
+    /// One actor over the joint observation samples a joint macro-action, conditioned on the
+    /// busy agents' running ones (Mac-CAC).
+    Centralized,
+}
+
+/// What an actor-critic method's critic sees and whose return it learns (spec 2.7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AcCritic {
+    /// Agent i's own critic on its own observation history, its own macro-rewards (Mac-IAC).
+    OwnHistory,
+    /// One critic on the joint observation history at joint macro-steps, the joint reward
+    /// (Mac-CAC; Naive Mac-IACC, whose agents take the joint advantage where they finished).
+    JointHistory,
+    /// One critic on the global state at joint macro-steps (Naive Mac-IASC).
+    JointState,
+    /// A critic per agent on the joint observation history, agent i's rewards and durations
+    /// (Mac-IAICC).
+    AgentJointHistory,
+    /// A critic per agent on the global state at agent i's macro-action starts (Mac-IAISC).
+    AgentState,
+}
+
+/// An actor-critic method's design: its actor and its critic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AcDesign {
+    pub actor: AcActor,
+    pub critic: AcCritic,
+    /// The name of the reference's class (`--alg`), which keys its published settings.
+    pub reference_alg: &'static str,
 }
 
 /// A method family: the learner type the training loop drives for a method (see
@@ -31,6 +93,9 @@ pub enum Method {
 pub enum Family {
     /// The ICRA 2020 Q-learning methods ([`crate::algos::value::learner::ValueLearner`]).
     Value,
+    /// MacroMARL's actor-critic methods
+    /// ([`crate::algos::actor_critic::learner::AcLearner`]).
+    ActorCritic,
 }
 
 /// Who chooses a*_i inside agent i's decentralized target.
@@ -54,13 +119,19 @@ pub enum Exploration {
 }
 
 impl Method {
-    /// All methods, in the order the paper introduces them.
-    pub const ALL: [Method; 5] = [
+    /// All methods: the ICRA paper's in the order it introduces them, then MacroMARL's.
+    pub const ALL: [Method; 11] = [
         Method::DecHddrqn,
         Method::CenDdrqn,
         Method::Our1,
         Method::Our1R,
         Method::Our2,
+        Method::MacIac,
+        Method::MacCac,
+        Method::NaiveMacIacc,
+        Method::NaiveMacIasc,
+        Method::MacIaicc,
+        Method::MacIaisc,
     ];
 
     /// The family whose learner trains this method.
@@ -68,6 +139,31 @@ impl Method {
         match self {
             Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => {
                 Family::Value
+            }
+            actor_critic_methods!() => Family::ActorCritic,
+        }
+    }
+
+    /// An actor-critic method's actor and critic (`None` for the value methods): the one place
+    /// the six differ (spec `macromarl.md` 2.7).
+    pub fn actor_critic(self) -> Option<AcDesign> {
+        let design = |actor, critic, reference_alg| {
+            Some(AcDesign {
+                actor,
+                critic,
+                reference_alg,
+            })
+        };
+        use AcActor::{Centralized, Decentralized};
+        match self {
+            Method::MacIac => design(Decentralized, AcCritic::OwnHistory, "MacIAC"),
+            Method::MacCac => design(Centralized, AcCritic::JointHistory, "MacCAC"),
+            Method::NaiveMacIacc => design(Decentralized, AcCritic::JointHistory, "NaiveMacIACC"),
+            Method::NaiveMacIasc => design(Decentralized, AcCritic::JointState, "NaiveMacIASC"),
+            Method::MacIaicc => design(Decentralized, AcCritic::AgentJointHistory, "MacIAICC"),
+            Method::MacIaisc => design(Decentralized, AcCritic::AgentState, "MacIAISC"),
+            Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => {
+                None
             }
         }
     }
@@ -80,6 +176,12 @@ impl Method {
             Method::Our1 => "our1",
             Method::Our1R => "our1-r",
             Method::Our2 => "our2",
+            Method::MacIac => "mac-iac",
+            Method::MacCac => "mac-cac",
+            Method::NaiveMacIacc => "naive-mac-iacc",
+            Method::NaiveMacIasc => "naive-mac-iasc",
+            Method::MacIaicc => "mac-iaicc",
+            Method::MacIaisc => "mac-iaisc",
         }
     }
 
@@ -91,6 +193,12 @@ impl Method {
             Method::Our1 => "Our-1",
             Method::Our1R => "Our-1-R",
             Method::Our2 => "Our-2",
+            Method::MacIac => "Mac-IAC",
+            Method::MacCac => "Mac-CAC",
+            Method::NaiveMacIacc => "Naive Mac-IACC",
+            Method::NaiveMacIasc => "Naive Mac-IASC",
+            Method::MacIaicc => "Mac-IAICC",
+            Method::MacIaisc => "Mac-IAISC",
         }
     }
 
@@ -99,6 +207,8 @@ impl Method {
         match self {
             Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => true,
             Method::CenDdrqn => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -107,6 +217,8 @@ impl Method {
         match self {
             Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => true,
             Method::DecHddrqn => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -116,6 +228,8 @@ impl Method {
             Method::DecHddrqn | Method::Our1R => Some(DecTargetAction::OwnDoubleQ),
             Method::Our1 | Method::Our2 => Some(DecTargetAction::CenCondArgmax),
             Method::CenDdrqn => None,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => None,
         }
     }
 
@@ -125,6 +239,8 @@ impl Method {
         match self {
             Method::CenDdrqn => true,
             Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -135,6 +251,8 @@ impl Method {
         match self {
             Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => true,
             Method::CenDdrqn => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -144,6 +262,8 @@ impl Method {
         match self {
             Method::DecHddrqn => (0.2, 0.4),
             Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => (1.0, 1.0),
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => (1.0, 1.0),
         }
     }
 
@@ -153,6 +273,8 @@ impl Method {
         match self {
             Method::DecHddrqn => 20,
             Method::CenDdrqn | Method::Our1 | Method::Our1R | Method::Our2 => 1,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => 1,
         }
     }
 
@@ -162,6 +284,8 @@ impl Method {
         match self {
             Method::Our1 | Method::Our1R => true,
             Method::DecHddrqn | Method::CenDdrqn | Method::Our2 => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -173,6 +297,8 @@ impl Method {
             Method::Our1 | Method::Our1R if cen_explore => Exploration::Centralized,
             Method::Our1 | Method::Our1R => Exploration::Decentralized,
             Method::Our2 => Exploration::Parallel,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => Exploration::Decentralized,
         }
     }
 
@@ -183,6 +309,8 @@ impl Method {
         match self {
             Method::Our1 | Method::Our1R => exploration == Exploration::Centralized,
             Method::DecHddrqn | Method::CenDdrqn | Method::Our2 => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -193,6 +321,8 @@ impl Method {
             Method::DecHddrqn | Method::Our1 | Method::Our1R | Method::Our2 => {
                 EvaluatedPolicy::Decentralized
             }
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => EvaluatedPolicy::Decentralized,
         }
     }
 
@@ -203,6 +333,8 @@ impl Method {
         match self {
             Method::Our2 => true,
             Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 
@@ -212,6 +344,8 @@ impl Method {
         match self {
             Method::Our2 => true,
             Method::DecHddrqn | Method::CenDdrqn | Method::Our1 | Method::Our1R => false,
+            // Not a value method: nothing of this family applies.
+            actor_critic_methods!() => false,
         }
     }
 }
@@ -266,7 +400,7 @@ impl fmt::Display for Method {
 
 /// The name given is not one of the five methods.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown method `{0}`: expected one of dec-hddrqn, cen-ddrqn, our1, our1-r, our2")]
+#[error("unknown method `{0}`: expected one of dec-hddrqn, cen-ddrqn, our1, our1-r, our2, mac-iac, mac-cac, naive-mac-iacc, naive-mac-iasc, mac-iaicc, mac-iaisc")]
 pub struct UnknownMethod(pub String);
 
 impl FromStr for Method {
@@ -282,6 +416,38 @@ impl FromStr for Method {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exactly_the_actor_critic_methods_have_a_design_and_names_match_the_reference() {
+        for m in Method::ALL {
+            assert_eq!(
+                m.actor_critic().is_some(),
+                m.family() == Family::ActorCritic
+            );
+        }
+        let algs: Vec<&str> = Method::ALL
+            .iter()
+            .filter_map(|m| m.actor_critic())
+            .map(|d| d.reference_alg)
+            .collect();
+        assert_eq!(
+            algs,
+            [
+                "MacIAC",
+                "MacCAC",
+                "NaiveMacIACC",
+                "NaiveMacIASC",
+                "MacIAICC",
+                "MacIAISC"
+            ]
+        );
+        // Only Mac-CAC acts centrally; the state critics are the -sc variants.
+        for m in Method::ALL.iter().filter_map(|m| m.actor_critic()) {
+            assert_eq!(m.actor == AcActor::Centralized, m.reference_alg == "MacCAC");
+            let state = matches!(m.critic, AcCritic::JointState | AcCritic::AgentState);
+            assert_eq!(state, m.reference_alg.ends_with("SC"));
+        }
+    }
 
     #[test]
     fn names_round_trip_through_from_str() {
@@ -328,7 +494,10 @@ mod tests {
 
     #[test]
     fn only_dec_hddrqn_has_a_hysteresis_schedule_and_only_cen_ddrqn_acts_centrally() {
-        for m in Method::ALL {
+        for m in Method::ALL
+            .into_iter()
+            .filter(|m| m.family() == Family::Value)
+        {
             assert_eq!(m.paper_hysteresis() != (1.0, 1.0), m == Method::DecHddrqn);
             assert_eq!(
                 m.evaluated_policy() == EvaluatedPolicy::Centralized,

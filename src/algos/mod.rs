@@ -8,8 +8,10 @@
 //! training iteration and a target sync do. [`method::Method`] names the methods and picks each
 //! one's family ([`method::Family`]); within a family, methods differ in exhaustive `match`es.
 //!
-//! Families: [`value`] (the ICRA 2020 Q-learning methods).
+//! Families: [`value`] (the ICRA 2020 Q-learning methods) and [`actor_critic`] (MacroMARL's
+//! macro-action actor-critic methods).
 
+pub mod actor_critic;
 pub mod any_loop;
 pub mod hyper;
 pub mod learner;

@@ -21,6 +21,10 @@ pub enum TrainError {
         what: &'static str,
         episode: u64,
     },
+    #[error("{0}")]
+    Nets(String),
+    #[error("{method}: the config holds another method family's keys")]
+    WrongFamily { method: Method },
     #[error("{method} asks for {asked} training lanes; runs have random streams for {available}")]
     TooManyLanes {
         method: Method,

@@ -27,6 +27,11 @@ pub struct RunRngs {
 
 pub use super::train_error::TrainError;
 
+/// Training lanes one run may have (MacroMARL's `n_env`; published at most 48).
+pub const MAX_LANES: usize = crate::algos::actor_critic::config::MAX_N_ENV;
+/// Stream ids of lanes beyond the second: clear of the per-role ids.
+const EXTRA_LANE_STREAMS: u64 = 1 << 32;
+
 /// One evaluation point, as the metrics file records it (one `metrics.csv` row).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EvalPoint {
@@ -104,13 +109,21 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         };
         let learner = L::new(config, method, seed, &eval_env, learner_rngs)?;
         let plans = learner.lanes();
-        let mut streams = vec![rngs.env, rngs.cen_env];
-        if plans.len() > streams.len() {
+        if plans.len() > MAX_LANES {
             return Err(TrainError::TooManyLanes {
                 method,
                 asked: plans.len(),
-                available: streams.len(),
+                available: MAX_LANES,
             });
+        }
+        // The first two lanes keep their roles' streams (the value methods' runs are unchanged);
+        // further lanes (MacroMARL's n_env environments) take streams of the env stream's key.
+        let mut streams = vec![rngs.env.clone(), rngs.cen_env];
+        for k in 2..plans.len() {
+            let mut s = rngs.env.clone();
+            s.set_stream(EXTRA_LANE_STREAMS + k as u64);
+            s.set_word_pos(0);
+            streams.push(s);
         }
         streams.truncate(plans.len());
         let mut lanes = Vec::with_capacity(plans.len());
@@ -213,22 +226,44 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 
     /// Whether training is complete.
     pub fn is_finished(&self) -> bool {
-        self.episodes >= self.config().total_epi as u64
+        self.episodes >= self.config().total_epi() as u64
     }
 
-    /// Run main-loop iterations until a training episode finishes or training is complete.
+    /// Run until a training episode (an [`Schedule::EpisodeBatches`] batch) finishes or
+    /// training is complete.
     pub fn advance(&mut self) -> Result<Advance, TrainError> {
         self.segment_start
             .get_or_insert_with(std::time::Instant::now);
+        let checkpoint_freq = self.config().checkpoint_freq() as u64;
         loop {
             if self.is_finished() {
                 return Ok(Advance::Finished);
             }
-            let finished = self.main_loop_iteration()?;
+            let before = self.episodes;
+            let finished = match self.learner.schedule() {
+                Schedule::EveryStep {
+                    train_freq,
+                    start_train,
+                    target_update_freq,
+                    eval_freq,
+                } => self.main_loop_iteration(
+                    train_freq,
+                    start_train,
+                    target_update_freq,
+                    eval_freq,
+                )?,
+                Schedule::EpisodeBatches {
+                    train_freq,
+                    target_update_freq,
+                    eval_period,
+                } => {
+                    self.batch_iteration(train_freq, target_update_freq, eval_period)?;
+                    true
+                }
+            };
             if finished {
-                let due = self
-                    .episodes
-                    .is_multiple_of(self.config().checkpoint_freq as u64);
+                // Due when the count reached or passed a multiple of checkpoint_freq.
+                let due = self.episodes / checkpoint_freq > before / checkpoint_freq;
                 return Ok(Advance::Episode {
                     checkpoint_due: due,
                 });
@@ -236,8 +271,50 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         }
     }
 
-    /// One main-loop iteration (spec 6). Returns whether a training episode finished.
-    fn main_loop_iteration(&mut self) -> Result<bool, TrainError> {
+    /// One update of MacroMARL's loop (spec `macromarl.md` 2.3): evaluate when due, reset every
+    /// lane, step them in lockstep until `train_freq` episodes completed, train, count exactly
+    /// `train_freq` episodes, sync targets when due.
+    fn batch_iteration(
+        &mut self,
+        train_freq: u64,
+        target_update_freq: u64,
+        eval_period: u64,
+    ) -> Result<(), TrainError> {
+        if self.episodes.is_multiple_of(eval_period) {
+            self.evaluate()?;
+        }
+        self.learner.begin_batch(self.episodes);
+        for lane in &mut self.lanes {
+            lane.env.reset(&mut lane.rng);
+            self.learner.begin_episode(&mut lane.state, &lane.env)?;
+        }
+        let mut completed = 0u64;
+        while completed < train_freq {
+            // A whole lockstep step, then the check (`while n_epi_count < n_epis: _step()`).
+            for lane in 0..self.lanes.len() {
+                completed += u64::from(self.step_lane(lane)?);
+            }
+        }
+        let lanes: Vec<&L::Lane> = self.lanes.iter().map(|l| &l.state).collect();
+        self.learner.train_iteration(&lanes, self.episodes)?;
+        self.updates += 1;
+        self.episodes += train_freq;
+        self.step += 1;
+        if self.episodes.is_multiple_of(target_update_freq) {
+            self.learner.sync_targets();
+        }
+        Ok(())
+    }
+
+    /// One main-loop iteration (spec 6) of the [`Schedule::EveryStep`] schedule. Returns
+    /// whether a training episode finished.
+    fn main_loop_iteration(
+        &mut self,
+        train_freq: u64,
+        start_train: u64,
+        target_update_freq: u64,
+        eval_freq: u64,
+    ) -> Result<bool, TrainError> {
         if !self.evaluated_once {
             self.evaluated_once = true;
             self.evaluate()?;
@@ -247,28 +324,19 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         for lane in 0..self.lanes.len() {
             finished += u64::from(self.step_lane(lane)?);
         }
-        let eval_freq = self.config().eval_freq as u64;
         for _ in 0..finished {
             self.episodes += 1;
             if self.episodes.is_multiple_of(eval_freq) {
                 self.evaluate()?;
             }
         }
-        match self.learner.schedule() {
-            Schedule::EveryStep {
-                train_freq,
-                start_train,
-                target_update_freq,
-            } => {
-                if self.step.is_multiple_of(train_freq) && self.episodes >= start_train {
-                    let lanes: Vec<&L::Lane> = self.lanes.iter().map(|l| &l.state).collect();
-                    self.learner.train_iteration(&lanes, self.episodes)?;
-                    self.updates += 1;
-                }
-                if self.step.is_multiple_of(target_update_freq) {
-                    self.learner.sync_targets();
-                }
-            }
+        if self.step.is_multiple_of(train_freq) && self.episodes >= start_train {
+            let lanes: Vec<&L::Lane> = self.lanes.iter().map(|l| &l.state).collect();
+            self.learner.train_iteration(&lanes, self.episodes)?;
+            self.updates += 1;
+        }
+        if self.step.is_multiple_of(target_update_freq) {
+            self.learner.sync_targets();
         }
         self.step += 1;
         Ok(finished > 0)
@@ -292,9 +360,15 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 
     /// Evaluate the learner's policy (spec 7.1), appended to the curve.
     fn evaluate(&mut self) -> Result<(), TrainError> {
-        let eval_return = self
-            .learner
-            .evaluate(&mut self.eval_env, &mut self.eval_rng)?;
+        let eval_return = match self.learner.schedule() {
+            Schedule::EveryStep { .. } => self
+                .learner
+                .evaluate(&mut self.eval_env, &mut self.eval_rng)?,
+            Schedule::EpisodeBatches { .. } => {
+                let mut envs: Vec<&mut E> = self.lanes.iter_mut().map(|l| &mut l.env).collect();
+                self.learner.evaluate_lanes(&mut envs, &mut self.eval_rng)?
+            }
+        };
         let family = self.learner.metric_values();
         self.evals.push(EvalPoint {
             episode: self.episodes,
@@ -313,7 +387,7 @@ mod tests {
     use super::*;
     use crate::algos::learner::LanePlan;
     use crate::envs::StepOutcome;
-    use crate::experiment::paper::paper_defaults;
+    use crate::experiment::paper::value_paper_defaults;
     use crate::experiment::train_run::run_rngs;
 
     /// A learner that acts with macro-action 0 and logs when the loop calls it, so the loop's
@@ -358,6 +432,7 @@ mod tests {
                 train_freq: 3,
                 start_train: 1,
                 target_update_freq: 5,
+                eval_freq: 2,
             }
         }
         fn lanes(&self) -> Vec<LanePlan> {
@@ -412,6 +487,7 @@ mod tests {
         }
         fn saved_nets(&self) -> SavedNets<'_> {
             SavedNets {
+                actors: Vec::new(),
                 dec: Vec::new(),
                 cen: None,
                 evaluated_is_centralized: false,
@@ -424,10 +500,11 @@ mod tests {
         // Box Pushing 8x8 with horizon 10 and every agent always on action 0: each episode runs
         // to the horizon, so episode k ends at main-loop step 10k - 1.
         let spec = crate::envs::box_pushing::spec(8, 10);
-        let mut config = paper_defaults(&spec, Method::Our2);
+        let mut config = value_paper_defaults(&spec, Method::Our2);
         config.total_epi = 4;
         config.eval_freq = 2;
         config.checkpoint_freq = 3;
+        let config: RunConfig = config.into();
         let mut l: TrainingLoop<Probe, _> =
             TrainingLoop::new(&config, Method::Our2, 0, run_rngs(0), || spec.build()).unwrap();
         let mut stops = Vec::new();

@@ -57,7 +57,7 @@ pub fn bench_train(
     episodes: usize,
 ) -> Result<TrainBench, TrainError> {
     let mut config = paper_defaults(&env, method);
-    config.total_epi = episodes;
+    config.set_total_epi(episodes);
     let start = Instant::now();
     let mut trainer = AnyLoop::new(&config, method, 0, run_rngs(0), || env.build())?;
     while trainer.advance()? != Advance::Finished {}

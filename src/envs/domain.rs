@@ -118,6 +118,15 @@ pub trait Domain: Send + Sync + 'static {
         toml::Table::new()
     }
 
+    /// The settings MacroMARL published for actor-critic method `alg` (the reference's `--alg`:
+    /// `MacIAC`, `MacCAC`, `NaiveMacIACC`, `NaiveMacIASC`, `MacIAICC`, `MacIAISC`) on this
+    /// setting, as config keys (`a_lr`, `n_env`, ...), applied over the reference's argparse
+    /// defaults before the user's keys. Empty (the default) for a domain it was not published on.
+    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
+        let _ = (keys, alg);
+        toml::Table::new()
+    }
+
     /// A short label for tables, benchmarks and file names (`bp10`, `wtd`); the name by default.
     fn short_name(&self, keys: &toml::Table) -> String {
         let _ = keys;

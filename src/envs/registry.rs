@@ -38,6 +38,8 @@ pub trait DomainEntry: Send + Sync + 'static {
     fn restore(&self, bytes: &[u8]) -> Result<AnyEnv, String>;
     /// See [`Domain::paper_settings`].
     fn paper_settings(&self, keys: &toml::Table) -> toml::Table;
+    /// See [`Domain::actor_critic_settings`].
+    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table;
     /// See [`Domain::short_name`].
     fn short_name(&self, keys: &toml::Table) -> String;
     /// See [`Domain::tag`].
@@ -70,6 +72,9 @@ impl<D: Domain> DomainEntry for D {
     }
     fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
         Domain::paper_settings(self, keys)
+    }
+    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
+        Domain::actor_critic_settings(self, keys, alg)
     }
     fn short_name(&self, keys: &toml::Table) -> String {
         Domain::short_name(self, keys)

@@ -115,6 +115,12 @@ impl EnvSpec {
         self.domain.paper_settings(&self.keys)
     }
 
+    /// MacroMARL's published actor-critic settings for `alg` on this setting
+    /// ([`super::domain::Domain::actor_critic_settings`]).
+    pub fn actor_critic_settings(&self, alg: &str) -> toml::Table {
+        self.domain.actor_critic_settings(&self.keys, alg)
+    }
+
     /// The discount per primitive step the paper trains and evaluates this setting under (Box
     /// Pushing 0.98, Warehouse 1.0; spec 10), the one its known optimum is stated for; `None`
     /// for a domain no paper trained on.

@@ -1,5 +1,7 @@
 //! MacroMARL's recurrent actor (spec `macromarl.md` 2.4, `cores/pg_based/mac_iac/models.py:
-//! Actor`), for acting: the authors' trained actors run here, greedy or sampled.
+//! Actor`): the authors' trained actors run here, greedy or sampled, and the actor-critic
+//! learners train it. Its history critic (`models.py: Critic`) is the same layers with one output
+//! and no log_softmax, so it is this type too ([`GruActor::forward`] gives fc4's output).
 //!
 //! ```text
 //! obs -> fc1 (in -> m0) -> leaky_relu(0.01) -> fc2 (m0 -> m0) -> leaky_relu -> GRU (m0 -> H)
@@ -16,10 +18,14 @@ use std::path::Path;
 
 use ndarray::ArrayViewD;
 
+use rand_chacha::ChaCha8Rng;
+
 use super::gru::GruState;
-use super::params::{GruParams, LinearParams};
+use super::init::LEAKY_RELU_GAIN;
+use super::linear::LinearVars;
+use super::params::{flat, flat_mut, GruParams, LinearParams, Params};
 use super::safetensors_io::{read_exact, tensor_shape, WeightsError};
-use crate::autograd::Activation;
+use crate::autograd::{Activation, GruVars, SeqPacking, Tape, Var};
 
 /// The actor's tensors, in its `state_dict` order.
 pub const GRU_ACTOR_TENSOR_NAMES: [&str; 12] = [
@@ -69,8 +75,8 @@ impl GruActorConfig {
     }
 }
 
-/// The actor's parameters.
-#[derive(Debug, Clone, PartialEq)]
+/// The actor's parameters (also the history critic's, with one output).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GruActor {
     fc1: LinearParams,
     fc2: LinearParams,
@@ -81,7 +87,7 @@ pub struct GruActor {
 
 /// One agent's recurrent state while acting, with the scratch the forward writes into (acting
 /// never allocates after the first step).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GruActorState {
     gru: GruState,
     a1: Vec<f32>,
@@ -221,6 +227,135 @@ impl GruActor {
     /// The GRU's parameters.
     pub fn gru(&self) -> &GruParams {
         &self.gru
+    }
+}
+
+/// A [`GruActor`]'s parameters on a tape, from [`GruActor::bind`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GruActorVars {
+    fc1: LinearVars,
+    fc2: LinearVars,
+    gru: GruVars,
+    fc3: LinearVars,
+    fc4: LinearVars,
+}
+
+impl GruActor {
+    /// A freshly initialized net (spec 2.4): Xavier-uniform with the leaky-ReLU gain on fc1..fc3,
+    /// gain 1 on fc4, zero Linear biases, PyTorch's GRU default; drawn in module order.
+    pub fn new(cfg: GruActorConfig, rng: &mut ChaCha8Rng) -> Self {
+        let ([m0, m1], h) = (cfg.mlp, cfg.hidden);
+        GruActor {
+            fc1: LinearParams::xavier(cfg.input, m0, LEAKY_RELU_GAIN, rng),
+            fc2: LinearParams::xavier(m0, m0, LEAKY_RELU_GAIN, rng),
+            gru: GruParams::pytorch_default(m0, h, rng),
+            fc3: LinearParams::xavier(h, m1, LEAKY_RELU_GAIN, rng),
+            fc4: LinearParams::xavier(m1, cfg.output, 1.0, rng),
+        }
+    }
+
+    /// All-zero tensors of these sizes (a gradient buffer).
+    pub fn zeros(cfg: GruActorConfig) -> Self {
+        let ([m0, m1], h) = (cfg.mlp, cfg.hidden);
+        GruActor {
+            fc1: LinearParams::zeros(cfg.input, m0),
+            fc2: LinearParams::zeros(m0, m0),
+            gru: GruParams::zeros(m0, h),
+            fc3: LinearParams::zeros(h, m1),
+            fc4: LinearParams::zeros(m1, cfg.output),
+        }
+    }
+
+    /// Overwrite with `other`'s values (same sizes): the hard target copy.
+    pub fn copy_from(&mut self, other: &GruActor) {
+        for (d, s) in self.slices_mut().into_iter().zip(other.slices()) {
+            d.copy_from_slice(s);
+        }
+    }
+
+    /// Whether every parameter is finite.
+    pub fn is_finite(&self) -> bool {
+        self.slices()
+            .iter()
+            .all(|s| s.iter().all(|v| v.is_finite()))
+    }
+
+    /// Put the parameters on `tape` as trainable leaves.
+    pub fn bind(&self, tape: &mut Tape) -> GruActorVars {
+        GruActorVars {
+            fc1: self.fc1.bind(tape),
+            fc2: self.fc2.bind(tape),
+            gru: self.gru.bind(tape),
+            fc3: self.fc3.bind(tape),
+            fc4: self.fc4.bind(tape),
+        }
+    }
+
+    /// fc4's output [K, out] for every position of a batch of sequences, each unrolled from a
+    /// zero state, with x: [K, in] in packed order (see [`SeqPacking`]); the result is in the
+    /// same order. The reference runs padded batches; padding sits after each sequence and the
+    /// GRU is causal, so the valid positions are the same numbers.
+    pub fn forward(
+        &self,
+        tape: &mut Tape,
+        vars: &GruActorVars,
+        x: Var,
+        packing: &SeqPacking,
+    ) -> Var {
+        let a1 = vars.fc1.forward(tape, x, LEAKY);
+        let a2 = vars.fc2.forward(tape, a1, LEAKY);
+        let h = vars.gru.forward_packed(tape, a2, packing);
+        let a3 = vars.fc3.forward(tape, h, LEAKY);
+        vars.fc4.forward(tape, a3, Activation::Identity)
+    }
+}
+
+impl GruActorVars {
+    /// Copy the gradients from the tape into `into` (zero where none reached a tensor).
+    pub fn grads_into(&self, tape: &Tape, into: &mut GruActor) {
+        self.fc1.grads_into(tape, &mut into.fc1);
+        self.fc2.grads_into(tape, &mut into.fc2);
+        self.gru.grads_into(tape, &mut into.gru);
+        self.fc3.grads_into(tape, &mut into.fc3);
+        self.fc4.grads_into(tape, &mut into.fc4);
+    }
+}
+
+impl Params for GruActor {
+    fn slices(&self) -> Vec<&[f32]> {
+        let g = &self.gru;
+        vec![
+            flat(&self.fc1.weight),
+            flat(&self.fc1.bias),
+            flat(&self.fc2.weight),
+            flat(&self.fc2.bias),
+            flat(&g.weight_ih),
+            flat(&g.weight_hh),
+            flat(&g.bias_ih),
+            flat(&g.bias_hh),
+            flat(&self.fc3.weight),
+            flat(&self.fc3.bias),
+            flat(&self.fc4.weight),
+            flat(&self.fc4.bias),
+        ]
+    }
+
+    fn slices_mut(&mut self) -> Vec<&mut [f32]> {
+        let g = &mut self.gru;
+        vec![
+            flat_mut(&mut self.fc1.weight),
+            flat_mut(&mut self.fc1.bias),
+            flat_mut(&mut self.fc2.weight),
+            flat_mut(&mut self.fc2.bias),
+            flat_mut(&mut g.weight_ih),
+            flat_mut(&mut g.weight_hh),
+            flat_mut(&mut g.bias_ih),
+            flat_mut(&mut g.bias_hh),
+            flat_mut(&mut self.fc3.weight),
+            flat_mut(&mut self.fc3.bias),
+            flat_mut(&mut self.fc4.weight),
+            flat_mut(&mut self.fc4.bias),
+        ]
     }
 }
 

@@ -6,7 +6,8 @@
 //! - [`GruParams`]: a one-layer GRU as PyTorch's `nn.GRU` (gate order, init, state_dict
 //!   names), run on a tape over packed sequences (`Tape::gru_packed`) or one step at a time
 //!   with a [`GruState`] (acting).
-//! - [`GruActor`]: MacroMARL's actor fc1 -> fc2 -> GRU -> fc3 -> fc4 -> log_softmax, for acting.
+//! - [`GruActor`]: MacroMARL's actor fc1 -> fc2 -> GRU -> fc3 -> fc4 -> log_softmax (and its
+//!   history critic), for acting and training; [`StateCritic`]: its MLP critic on the state.
 //! - [`Adam`]: PyTorch's Adam (spec 2.4); [`Updater::td_step`]: one full TD gradient step.
 //! - `safetensors_io`: weight files with PyTorch's state_dict names.
 
@@ -23,6 +24,7 @@ mod lstm;
 mod params;
 mod qnet;
 pub mod safetensors_io;
+mod state_critic;
 mod update;
 
 /// Widest layer of any net a config or a policy file may ask for (paper: 32 and 64), so neither
@@ -33,7 +35,9 @@ pub use acting_net::{ActingNet, ActingState};
 pub use adam::{Adam, AdamConfig};
 pub use argmax::argmax;
 pub use gru::{GruState, GRU_TENSOR_NAMES};
-pub use gru_actor::{GruActor, GruActorConfig, GruActorState, GRU_ACTOR_TENSOR_NAMES};
+pub use gru_actor::{
+    GruActor, GruActorConfig, GruActorState, GruActorVars, GRU_ACTOR_TENSOR_NAMES,
+};
 pub use linear::LinearVars;
 pub use lstm::LstmState;
 pub use params::{GruParams, LinearParams, LstmParams, Params};
@@ -41,4 +45,5 @@ pub use qnet::{
     flatten_padded, Dim, QNet, QNetConfig, QNetParams, QNetVars, TensorSpec, TENSORS, TENSOR_NAMES,
 };
 pub use safetensors_io::WeightsError;
+pub use state_critic::{StateCritic, StateCriticVars, STATE_CRITIC_TENSOR_NAMES};
 pub use update::{TdBatch, Updater};

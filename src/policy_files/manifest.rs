@@ -7,8 +7,8 @@ use super::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::read_regular_file;
-use crate::nn::safetensors_io::to_safetensors_bytes;
-use crate::nn::{ActingNet, QNet, QNetConfig};
+use crate::nn::safetensors_io::{named_to_safetensors_bytes, to_safetensors_bytes};
+use crate::nn::{ActingNet, GruActor, QNet, QNetConfig};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -186,6 +186,23 @@ impl NetFile {
             output: c.output,
             architecture: Architecture::ddrqn(c.mlp, c.hidden),
             bytes: to_safetensors_bytes(&net.params),
+        }
+    }
+
+    /// The entry and weights of a trained MacroMARL actor: agent `agent`'s (role `dec`) or the
+    /// centralized one over joint macro-actions (role `cen`, Mac-CAC), under its `state_dict`
+    /// names.
+    pub fn actor(role: NetRole, agent: Option<usize>, file: String, net: &GruActor) -> NetFile {
+        let c = net.config();
+        NetFile {
+            kind: NetKind::Actor,
+            role,
+            agent,
+            file,
+            input: c.input,
+            output: c.output,
+            architecture: Architecture::gru_actor(c.mlp, c.hidden),
+            bytes: named_to_safetensors_bytes(&net.named()),
         }
     }
 }

@@ -8,7 +8,7 @@
 use super::error::PolicyError;
 use super::manifest::{AgentLayout, Manifest, NetFile, NetKind, NetRole, RunInfo, POLICY_FILE};
 use super::policy_env::PolicyEnv;
-use crate::nn::QNet;
+use crate::nn::{GruActor, QNet};
 use std::path::Path;
 
 /// The policy directory inside a run directory.
@@ -50,6 +50,36 @@ pub fn write_policy_files(
         .map(|(i, n)| NetFile::qnet(NetRole::Dec, Some(i), dec_file_name(i), n))
         .chain(cen.map(|n| NetFile::qnet(NetRole::Cen, None, CEN_FILE.to_string(), n)))
         .collect();
+    let dir = run_dir.join(POLICY_DIR);
+    Manifest::write_new(&dir, env, agents, discount, evaluated, run, &nets)
+}
+
+/// Write an actor-critic run's actors as its policy files (`run_dir/policy/`): agent i's actor
+/// as [`dec_file_name`] (the evaluated nets), or Mac-CAC's one centralized actor as
+/// [`CEN_FILE`], kind `actor`.
+pub fn write_actor_policy_files(
+    run_dir: &Path,
+    env: PolicyEnv,
+    agents: Vec<AgentLayout>,
+    discount: f64,
+    run: RunInfo,
+    actors: &[&GruActor],
+    centralized: bool,
+) -> Result<Manifest, PolicyError> {
+    let (evaluated, nets): (NetRole, Vec<NetFile>) = if centralized {
+        let nets = actors
+            .iter()
+            .map(|n| NetFile::actor(NetRole::Cen, None, CEN_FILE.to_string(), n))
+            .collect();
+        (NetRole::Cen, nets)
+    } else {
+        let nets = actors
+            .iter()
+            .enumerate()
+            .map(|(i, n)| NetFile::actor(NetRole::Dec, Some(i), dec_file_name(i), n))
+            .collect();
+        (NetRole::Dec, nets)
+    };
     let dir = run_dir.join(POLICY_DIR);
     Manifest::write_new(&dir, env, agents, discount, evaluated, run, &nets)
 }

@@ -2,7 +2,7 @@
 //! exploration, replay, training iteration and evaluated policy (spec `algorithms.md` 4-7).
 //! Where the methods differ, [`Method`]'s exhaustive `match`es decide.
 
-use crate::algos::hyper::RunConfig;
+use crate::algos::hyper::{RunConfig, ValueConfig};
 use crate::algos::learner::{LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
 use crate::algos::method::{EvaluatedPolicy, Exploration, HysteresisRule, Method};
 use crate::algos::training_loop::TrainError;
@@ -62,6 +62,13 @@ pub struct ValueLearner {
 }
 
 impl ValueLearner {
+    /// The value family's keys (a value learner is only built from a value config).
+    fn c(&self) -> &ValueConfig {
+        self.config
+            .value()
+            .expect("a value learner is built from a value config")
+    }
+
     /// The current exploration rate.
     pub fn epsilon(&self) -> f64 {
         self.epsilon
@@ -80,7 +87,7 @@ impl ValueLearner {
     /// The lanes' explorations: the method's, with Our-2's parallel exploration split into a
     /// decentralized lane and a centralized one (spec 4.6, 5.5).
     fn lane_explorations(&self) -> Vec<Exploration> {
-        match self.method.exploration(self.config.cen_explore) {
+        match self.method.exploration(self.c().cen_explore) {
             Exploration::Parallel => vec![Exploration::Decentralized, Exploration::Centralized],
             e => vec![e],
         }
@@ -100,12 +107,15 @@ impl Learner for ValueLearner {
     type Lane = ValueLane;
 
     fn new<E: MacroEnv>(
-        config: &RunConfig,
+        run_config: &RunConfig,
         method: Method,
         seed: u64,
         env: &E,
         mut rngs: LearnerRngs,
     ) -> Result<Self, TrainError> {
+        let config = run_config
+            .value()
+            .ok_or(TrainError::WrongFamily { method })?;
         let layout = Layout::of_env(env)?;
         let dec: Vec<Nets> = if method.has_dec_nets() {
             (0..layout.n_agents())
@@ -133,7 +143,7 @@ impl Learner for ValueLearner {
         });
         Ok(ValueLearner {
             h: hysteresis_rule(config).initial(),
-            config: config.clone(),
+            config: run_config.clone(),
             method,
             seed,
             layout,
@@ -163,9 +173,10 @@ impl Learner for ValueLearner {
 
     fn schedule(&self) -> Schedule {
         Schedule::EveryStep {
-            train_freq: self.config.train_freq as u64,
-            start_train: self.config.start_train as u64,
-            target_update_freq: self.config.target_update_freq as u64,
+            train_freq: self.c().train_freq as u64,
+            start_train: self.c().start_train as u64,
+            target_update_freq: self.c().target_update_freq as u64,
+            eval_freq: self.c().eval_freq as u64,
         }
     }
 
@@ -180,7 +191,7 @@ impl Learner for ValueLearner {
 
     fn begin_lane<E: MacroEnv>(&self, lane: usize, env: &E) -> Result<ValueLane, TrainError> {
         let exploration = self.lane_explorations()[lane];
-        let c = &self.config;
+        let c = self.c();
         let mut recorder = Recorder::new(&self.layout, env.first_record_obs(), self.horizon);
         recorder.begin_from_env(env)?;
         let buffer = if c.sample_epi {
@@ -202,7 +213,7 @@ impl Learner for ValueLearner {
 
     fn act<E: MacroEnv>(&mut self, lane: &mut ValueLane, env: &E, actions: &mut [usize]) {
         let scratch = lane.scratch.get_or_insert_with(|| ActScratch::new(env));
-        let carry = self.config.h_explore;
+        let carry = self.c().h_explore;
         let explore_dec = lane.exploration == Exploration::Decentralized;
         if explore_dec || lane.shadow_dec_selection {
             let dec_nets: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
@@ -267,7 +278,8 @@ impl Learner for ValueLearner {
     /// for the decentralized nets, Our-2's centralized lane's for the centralized net; h moves
     /// along its schedule before, epsilon after, as the reference does.
     fn train_iteration(&mut self, lanes: &[&ValueLane], episodes: u64) -> Result<(), TrainError> {
-        let c = &self.config;
+        let c = self.c().clone();
+        let c = &c;
         let e = episodes as f64;
         self.h = hysteresis_rule(c).at(e, self.epsilon);
         let params = IterationParams {
@@ -305,7 +317,7 @@ impl Learner for ValueLearner {
             self.loss_sum += loss.total;
             self.loss_count += 1;
         }
-        let c = &self.config;
+        let c = self.c();
         self.epsilon = if c.eps_l_d {
             EpsilonSchedule::new(c.eps_end, c.eps_l_d_steps as f64)
                 .map(|s| s.at(e))
@@ -335,7 +347,7 @@ impl Learner for ValueLearner {
             ),
             EvaluatedPolicy::Decentralized => GreedyPolicy::Dec(&dec),
         };
-        let c = &self.config;
+        let c = self.c();
         evaluate(
             env,
             policy,
@@ -363,6 +375,7 @@ impl Learner for ValueLearner {
 
     fn saved_nets(&self) -> SavedNets<'_> {
         SavedNets {
+            actors: Vec::new(),
             dec: self.dec_policies(),
             cen: self.cen_policy(),
             evaluated_is_centralized: self.method.evaluated_policy()
@@ -372,7 +385,7 @@ impl Learner for ValueLearner {
 }
 
 /// The hysteresis settings of a config.
-fn hysteresis_rule(c: &RunConfig) -> HysteresisRule {
+fn hysteresis_rule(c: &ValueConfig) -> HysteresisRule {
     HysteresisRule {
         dynamic: c.dynamic_h,
         init_h: c.init_h,

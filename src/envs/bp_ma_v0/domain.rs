@@ -144,6 +144,12 @@ impl Domain for BpMaV0Domain {
         ])
     }
 
+    /// The grid's published rows ([`super::actor_critic`]).
+    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
+        let grid = grid_side(&keys["grid_dim"]).unwrap_or(DEFAULT_GRID);
+        super::actor_critic::settings(grid, alg)
+    }
+
     fn short_name(&self, keys: &toml::Table) -> String {
         format!(
             "bpma{}",

@@ -181,6 +181,19 @@ impl<const V: usize> Domain for OsdDomain<V> {
     fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
         key_table([("discount", 1.0.into())])
     }
+
+    /// Warehouse A or B on `OSD-D-v7` (by the humans' speeds), C on `OSD-T-v0`, D on
+    /// `OSD-T-v1`, E on `OSD-F-v0` ([`super::actor_critic`]).
+    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
+        use super::actor_critic::{double_room_block, settings, Block};
+        let block = match LAYOUTS[V].gym_id {
+            "OSD-D-v7" => double_room_block(keys.get(HUMAN_SPEEDS)),
+            "OSD-T-v0" => Block::C,
+            "OSD-T-v1" => Block::D,
+            _ => Block::E,
+        };
+        settings(block, alg)
+    }
 }
 
 #[cfg(test)]

@@ -177,6 +177,12 @@ impl Domain for OvercookedDomain {
         key_table([("discount", 0.99.into())])
     }
 
+    /// The map's published rows ([`super::actor_critic`]).
+    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
+        let map = params(keys).map_or('A', |p| p.map.letter().chars().next().unwrap_or('A'));
+        super::actor_critic::settings(map, alg)
+    }
+
     /// `overcooked-a`, with the agent count and grid when not the paper's (`overcooked-b-n2`).
     fn short_name(&self, keys: &toml::Table) -> String {
         let Ok(p) = params(keys) else {

@@ -18,6 +18,7 @@
 //! (the primitive step), [`astar`] (navigation with Python's heap order), [`macro_actions`]
 //! and [`observe`] (belief and macro-observations); `domain` holds the config keys.
 
+pub mod actor_critic;
 pub mod astar;
 mod domain;
 pub mod draw;

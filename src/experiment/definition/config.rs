@@ -6,8 +6,8 @@
 //! chosen domain and method (spec `algorithms.md` 10): `env_name = "BP_MA"` alone is Figure 4a's
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
-use crate::algos::hyper::RunConfig;
-use crate::algos::method::Method;
+use crate::algos::hyper::{RunConfig, ValueConfig};
+use crate::algos::method::{Family, Method};
 use crate::envs::EnvSpec;
 use crate::experiment::limits;
 use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
@@ -445,17 +445,23 @@ fn list_depth(v: &toml::Value) -> usize {
     }
 }
 
-/// For each key whose value is itself a list in a domain `table` names (`env_name`, Box
-/// Pushing when absent; every name of a swept `env_name`), the depth of that list: such a
-/// key's value is one value at that depth and a sweep one level deeper
-/// (`human_speed_per_step = [[18, 18, 18, 18], [18, 18, 18, 18]]` is one setting).
+/// For each key whose value is itself a list (the actor-critic MLP widths, and the list keys
+/// of the domain `table` names: `env_name`, Box Pushing when absent, every name of a swept
+/// `env_name`), the depth of that list: such a key's value is one value at that depth and a
+/// sweep one level deeper (`human_speed_per_step = [[18, 18, 18, 18], [18, 18, 18, 18]]` is
+/// one setting, `a_mlp_layer_size = [[32, 32], [64, 64]]` two).
 fn list_valued_keys(table: &toml::Table) -> std::collections::HashMap<String, usize> {
     let names: Vec<&str> = match table.get("env_name") {
         Some(toml::Value::String(name)) => vec![name.as_str()],
         Some(toml::Value::Array(items)) => items.iter().filter_map(|v| v.as_str()).collect(),
         _ => vec!["BP_MA"],
     };
-    let mut depths = std::collections::HashMap::new();
+    // The actor-critic MLP widths are a list by nature for every domain.
+    let mut depths: std::collections::HashMap<String, usize> =
+        crate::algos::actor_critic::config::LIST_KEYS
+            .iter()
+            .map(|k| (k.to_string(), 1))
+            .collect();
     for name in names {
         let Ok(domain) = crate::envs::registry::lookup(name) else {
             continue; // resolve names the bad env_name
@@ -639,6 +645,24 @@ pub fn validate(
     method: Method,
     horizon: usize,
 ) -> Result<(), (&'static str, String)> {
+    match (c, method.family()) {
+        (RunConfig::Value(v), Family::Value) => validate_value(v, method, horizon),
+        (RunConfig::ActorCritic(a), Family::ActorCritic) => {
+            crate::algos::actor_critic::config::validate(a, horizon)
+        }
+        _ => Err((
+            "config",
+            format!("{method} needs its own family's keys; this config holds the other family's"),
+        )),
+    }
+}
+
+/// [`validate`] for a value method's keys.
+fn validate_value(
+    c: &ValueConfig,
+    method: Method,
+    horizon: usize,
+) -> Result<(), (&'static str, String)> {
     let positive = [
         ("env_terminate_step", horizon),
         ("total_epi", c.total_epi),
@@ -728,7 +752,7 @@ mod tests {
     #[test]
     fn env_name_alone_gives_the_papers_bp10_setting() {
         let e = parse("methods = [\"our1\"]\n[params]\nenv_name = \"BP_MA\"", &[]).unwrap();
-        let c = &e.runs().unwrap()[0].config;
+        let c = e.runs().unwrap()[0].config.value().unwrap().clone();
         assert_eq!((c.total_epi, c.trace_len, c.batch_size), (15000, 15, 128));
         assert_eq!((c.dec_rnn_h_size, c.cen_rnn_h_size), (32, 64));
         assert!(c.cen_explore && !c.h_explore && !c.sample_epi);
@@ -739,8 +763,20 @@ mod tests {
     fn dec_hddrqn_defaults_are_hysteretic_and_others_are_not() {
         let e = parse("methods = [\"dec-hddrqn\", \"cen-ddrqn\"]", &[]).unwrap();
         let runs = e.runs().unwrap();
-        assert_eq!((runs[0].config.init_h, runs[0].config.end_h), (0.2, 0.4));
-        assert_eq!((runs[1].config.init_h, runs[1].config.end_h), (1.0, 1.0));
+        assert_eq!(
+            (
+                runs[0].config.value().unwrap().init_h,
+                runs[0].config.value().unwrap().end_h
+            ),
+            (0.2, 0.4)
+        );
+        assert_eq!(
+            (
+                runs[1].config.value().unwrap().init_h,
+                runs[1].config.value().unwrap().end_h
+            ),
+            (1.0, 1.0)
+        );
     }
 
     #[test]
@@ -750,7 +786,7 @@ mod tests {
             &["total_epi=300", "our1.l_rate=0.01"],
         )
         .unwrap();
-        let c = &e.runs().unwrap()[0].config;
+        let c = e.runs().unwrap()[0].config.value().unwrap().clone();
         assert_eq!(c.total_epi, 300);
         assert_eq!(c.l_rate, 0.01);
     }
@@ -800,7 +836,8 @@ mod tests {
             .iter()
             .find(|r| r.variant == "l_rate=0.01,trace_len=10")
             .unwrap();
-        assert_eq!((r.config.trace_len, r.config.l_rate), (10, 0.01));
+        let c = r.config.value().unwrap();
+        assert_eq!((c.trace_len, c.l_rate), (10, 0.01));
     }
 
     #[test]
@@ -810,7 +847,7 @@ mod tests {
             &[],
         )
         .unwrap();
-        let c = &e.runs().unwrap()[0].config;
+        let c = e.runs().unwrap()[0].config.value().unwrap().clone();
         assert!(c.sample_epi && c.h_explore);
         assert_eq!((c.batch_size, c.train_freq, c.total_epi), (16, 30, 40000));
         assert_eq!(
@@ -864,8 +901,11 @@ mod tests {
     fn resolved_config_round_trips_through_toml() {
         let e = parse(DEFAULT_EXPERIMENT, &[]).unwrap();
         let c = e.runs().unwrap()[0].config.clone();
-        let text = toml::to_string(&c).unwrap();
-        assert_eq!(toml::from_str::<RunConfig>(&text).unwrap(), c);
+        let text = toml::to_string(&c.to_table()).unwrap();
+        assert_eq!(
+            RunConfig::from_table(toml::from_str(&text).unwrap()).unwrap(),
+            c
+        );
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! process on allocation: a value beyond one is a config error naming the key, found before any
 //! run starts, instead of an out-of-memory abort that takes every parallel run down with it.
 
-use crate::algos::hyper::RunConfig;
+use crate::algos::hyper::ValueConfig;
 
 /// Runs one invocation may expand to (methods x sweep points x seeds).
 pub const MAX_RUNS: usize = 100_000;
@@ -37,7 +37,7 @@ pub const MAX_EVAL_NUM_EPI: usize = 100_000;
 
 /// Check a resolved config's sizes against the bounds above, for a domain whose episodes last at
 /// most `horizon` primitive steps. Returns the key and why.
-pub fn check_sizes(c: &RunConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+pub fn check_sizes(c: &ValueConfig, horizon: usize) -> Result<(), (&'static str, String)> {
     let simple = [
         ("env_terminate_step", horizon, MAX_HORIZON),
         ("trace_len", c.trace_len, MAX_TRACE_LEN),
@@ -114,7 +114,7 @@ mod tests {
     use super::*;
     use crate::algos::method::Method;
 
-    use crate::experiment::paper::paper_defaults;
+    use crate::experiment::paper::value_paper_defaults as paper_defaults;
 
     #[test]
     fn the_papers_settings_are_within_every_bound() {
@@ -136,7 +136,7 @@ mod tests {
     #[test]
     fn each_size_beyond_its_bound_names_its_key() {
         let base = paper_defaults(&crate::envs::box_pushing::paper_spec(10), Method::Our1);
-        type Edit = fn(&mut RunConfig, &mut usize);
+        type Edit = fn(&mut ValueConfig, &mut usize);
         let cases: [(&str, Edit); 6] = [
             ("batch_size", |c, _| c.batch_size = MAX_BATCH_SIZE + 1),
             ("dec_rnn_h_size", |c, _| c.dec_rnn_h_size = usize::MAX),

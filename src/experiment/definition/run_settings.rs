@@ -31,7 +31,7 @@ impl RunSettings {
         let mut table = toml::Table::new();
         table.insert("env_name".into(), self.env.env_name().into());
         table.extend(self.env.keys().clone());
-        table.extend(toml::Table::try_from(&self.config).expect("RunConfig serializes to a table"));
+        table.extend(self.config.to_table());
         table
     }
 
@@ -50,8 +50,7 @@ impl RunSettings {
         for key in env.keys().keys() {
             table.remove(key);
         }
-        let config = RunConfig::deserialize(toml::Value::Table(table))
-            .map_err(|e| e.message().to_string())?;
+        let config = RunConfig::from_table(table)?;
         Ok(RunSettings { env, config })
     }
 }
@@ -91,7 +90,7 @@ mod tests {
         let back: RunSettings = toml::from_str(&text).unwrap();
         assert_eq!(back, c);
         // The hyperparameters alone are the same keys without the domain's.
-        let alone = toml::to_string(&c.config).unwrap();
+        let alone = toml::to_string(&c.config.to_table()).unwrap();
         assert!(alone.starts_with("total_epi = 40000\n"), "{alone}");
         assert!(text.ends_with(&alone));
     }
@@ -112,7 +111,7 @@ mod tests {
         assert_ne!(noisy, text);
         assert_eq!(toml::from_str::<RunSettings>(&noisy).unwrap().env, c.env);
         // A hyperparameter table refuses the domain's keys: the learner's config names none.
-        let err = toml::from_str::<RunConfig>(&text).unwrap_err();
-        assert!(err.message().contains("env_name"), "{err}");
+        let err = RunConfig::from_table(toml::from_str(&text).unwrap()).unwrap_err();
+        assert!(err.contains("env_name"), "{err}");
     }
 }

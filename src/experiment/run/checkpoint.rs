@@ -201,8 +201,9 @@ mod tests {
 
     fn tiny() -> (CheckpointIdentity, AnyLoop) {
         let mut c = RunSettings::paper(crate::envs::box_pushing::paper_spec(8), Method::Our1);
-        c.config.batch_size = 4;
-        c.config.replay_buffer_size = 50;
+        let v = c.config.value_mut().unwrap();
+        v.batch_size = 4;
+        v.replay_buffer_size = 50;
         let env = c.env.clone();
         let t = AnyLoop::new(&c.config, Method::Our1, 3, run_rngs(3), || env.build()).unwrap();
         (CheckpointIdentity::new("e", Method::Our1, "", 3, &c), t)

@@ -148,7 +148,7 @@ where
         .iter()
         .zip(&todo)
         .filter(|(_, t)| matches!(t, Ok(true)))
-        .map(|(r, _)| r.config.total_epi as u64)
+        .map(|(r, _)| r.config.total_epi() as u64)
         .sum();
     let total = multi.add(ProgressBar::new(total_episodes));
     total.set_style(
@@ -185,7 +185,7 @@ where
         let spec = &runs[i];
         let name = run_name(spec);
         let dir = spec.dir(&opts.out);
-        let bar = multi.insert_before(&total, ProgressBar::new(spec.config.total_epi as u64));
+        let bar = multi.insert_before(&total, ProgressBar::new(spec.config.total_epi() as u64));
         bar.set_style(
             ProgressStyle::with_template("{prefix:32} {bar:20} {pos}/{len} {msg}")
                 .expect("valid template"),
@@ -198,7 +198,7 @@ where
             heartbeat: heartbeat.then(|| {
                 Arc::new(Heartbeat {
                     name: name.clone(),
-                    total_epi: spec.config.total_epi as u64,
+                    total_epi: spec.config.total_epi() as u64,
                     last: std::sync::Mutex::new(std::time::Instant::now()),
                 })
             }),

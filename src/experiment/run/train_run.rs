@@ -21,7 +21,9 @@ use crate::experiment::run_settings::RunSettings;
 use crate::experiment::runner::{Progress, RunEnd};
 use crate::experiment::seeds::{stream, Role};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
-use crate::policy_files::{write_policy_files, AgentLayout, NetRole, PolicyError, RunInfo};
+use crate::policy_files::{
+    write_actor_policy_files, write_policy_files, AgentLayout, NetRole, PolicyError, RunInfo,
+};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -312,11 +314,24 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<()
     };
     // The layout robots and `render` check the nets against; building the domain draws nothing.
     let domain = spec.env.build().map_err(|e| io(dir, e))?;
+    if !nets.actors.is_empty() {
+        write_actor_policy_files(
+            dir,
+            spec.env.clone().into(),
+            AgentLayout::of_domain(&domain),
+            config.discount(),
+            run,
+            &nets.actors,
+            nets.evaluated_is_centralized,
+        )
+        .map_err(Box::new)?;
+        return Ok(());
+    }
     write_policy_files(
         dir,
         spec.env.clone().into(),
         AgentLayout::of_domain(&domain),
-        config.discount,
+        config.discount(),
         evaluated,
         run,
         &nets.dec,

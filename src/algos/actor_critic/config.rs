@@ -1,0 +1,288 @@
+//! The actor-critic methods' hyperparameters, under MacroMARL's flag names
+//! (`scripts/pg_based_main.py`; spec `macromarl.md` 1.4), with the reference's argparse defaults
+//! where no published experiment sets a key. A domain's published values per method live in its
+//! folder ([`crate::envs::Domain::actor_critic_settings`]).
+
+use serde::{Deserialize, Serialize};
+
+/// The resolved hyperparameters of one actor-critic run. Unknown keys are refused.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AcConfig {
+    /// Training episodes; `epi_count` advances by `train_freq` per update (spec 2.3).
+    pub total_epi: usize,
+    /// Discount per primitive step, inside macro-actions too (P6).
+    pub gamma: f64,
+    /// Adam learning rates of the actors and the critics.
+    pub a_lr: f64,
+    pub c_lr: f64,
+    /// Environments stepped in lockstep while collecting (P1).
+    pub n_env: usize,
+    /// Completed episodes per update (the on-policy batch).
+    pub train_freq: usize,
+    /// Episodes between hard copies of the critics into their targets (P10).
+    pub c_target_update_freq: usize,
+    /// Macro-steps of the SMDP n-step return; 0 and 1 are the one-step return (spec 2.6).
+    #[serde(rename = "n_step_TD")]
+    pub n_step_td: usize,
+    /// The exploration mixture's weight moves linearly from eps_start to eps_end over
+    /// eps_stable_at episodes (`Linear_Decay`).
+    pub eps_start: f64,
+    pub eps_end: f64,
+    pub eps_stable_at: usize,
+    /// Actor: MLP widths [before, after] the GRU, and the GRU's width.
+    pub a_mlp_layer_size: Vec<usize>,
+    pub a_rnn_layer_size: usize,
+    /// History critic: MLP widths [before, after] the GRU, and the GRU's width; the state
+    /// critic's MLP uses c_mlp_layer_size and c_mid_layer_size.
+    pub c_mlp_layer_size: Vec<usize>,
+    pub c_rnn_layer_size: usize,
+    pub c_mid_layer_size: usize,
+    /// Evaluate every `eval_freq - eval_freq % train_freq` episodes, from episode 0 (P8).
+    pub eval_freq: usize,
+    /// Sampled episodes averaged per evaluation (the last ones to complete).
+    pub eval_num_epi: usize,
+    /// Training episodes between checkpoints (ours; rounded up to whole updates).
+    pub checkpoint_freq: usize,
+    /// Quirk P2 switch: weight the policy gradient by gamma^t at the macro-action's start
+    /// instead of its end (faithful: false).
+    pub pg_discount_at_start: bool,
+    /// Quirk P3 switch: train on the actor's own log-probability instead of the
+    /// epsilon-mixture's (faithful: false).
+    pub pg_plain_log_prob: bool,
+}
+
+/// The keys whose value is a list by nature (one setting, not a sweep).
+pub const LIST_KEYS: [&str; 2] = ["a_mlp_layer_size", "c_mlp_layer_size"];
+
+impl AcConfig {
+    /// The reference's argparse defaults (`pg_based_main.py`) with every published run's common
+    /// flags (`--eps_start=1.0 --eval_policy --sample_epi`), before a domain's published values.
+    pub fn reference_defaults() -> Self {
+        AcConfig {
+            total_epi: 40_000,
+            gamma: 0.95,
+            a_lr: 1e-4,
+            c_lr: 1e-3,
+            n_env: 1,
+            train_freq: 2,
+            c_target_update_freq: 16,
+            n_step_td: 0,
+            eps_start: 1.0,
+            eps_end: 0.01,
+            eps_stable_at: 4000,
+            a_mlp_layer_size: vec![32, 32],
+            a_rnn_layer_size: 32,
+            c_mlp_layer_size: vec![32, 32],
+            c_rnn_layer_size: 32,
+            c_mid_layer_size: 32,
+            eval_freq: 100,
+            eval_num_epi: 10,
+            checkpoint_freq: 2000,
+            pg_discount_at_start: false,
+            pg_plain_log_prob: false,
+        }
+    }
+
+    /// Episodes between evaluations: `eval_freq - eval_freq % train_freq` (96 for train_freq
+    /// 8, 16, 32 or 48 and eval_freq 100), at least one update.
+    pub fn eval_period(&self) -> usize {
+        (self.eval_freq - self.eval_freq % self.train_freq).max(self.train_freq)
+    }
+
+    /// The exploration weight at `episodes` training episodes (`Linear_Decay.get_value`).
+    pub fn eps_at(&self, episodes: u64) -> f64 {
+        let e = episodes as f64;
+        let span = self.eps_stable_at as f64;
+        if span <= 0.0 || e >= span {
+            self.eps_end
+        } else {
+            self.eps_start - (self.eps_start - self.eps_end) * e / span
+        }
+    }
+}
+
+/// Range checks beyond the types, naming the key.
+pub fn validate(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+    use crate::experiment::limits::{MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_TOTAL_EPI};
+    let positive = [
+        ("env_terminate_step", horizon),
+        ("total_epi", c.total_epi),
+        ("n_env", c.n_env),
+        ("train_freq", c.train_freq),
+        ("c_target_update_freq", c.c_target_update_freq),
+        ("a_rnn_layer_size", c.a_rnn_layer_size),
+        ("c_rnn_layer_size", c.c_rnn_layer_size),
+        ("c_mid_layer_size", c.c_mid_layer_size),
+        ("eval_freq", c.eval_freq),
+        ("eval_num_epi", c.eval_num_epi),
+        ("checkpoint_freq", c.checkpoint_freq),
+    ];
+    for (key, value) in positive {
+        if value == 0 {
+            return Err((key, "must be > 0, got 0".into()));
+        }
+    }
+    let bounded = [
+        ("env_terminate_step", horizon, MAX_HORIZON),
+        ("total_epi", c.total_epi, MAX_TOTAL_EPI),
+        ("eval_num_epi", c.eval_num_epi, MAX_EVAL_NUM_EPI),
+        ("n_env", c.n_env, MAX_N_ENV),
+        ("train_freq", c.train_freq, MAX_N_ENV * 16),
+        ("n_step_TD", c.n_step_td, MAX_HORIZON),
+        (
+            "a_rnn_layer_size",
+            c.a_rnn_layer_size,
+            crate::nn::MAX_NET_WIDTH,
+        ),
+        (
+            "c_rnn_layer_size",
+            c.c_rnn_layer_size,
+            crate::nn::MAX_NET_WIDTH,
+        ),
+        (
+            "c_mid_layer_size",
+            c.c_mid_layer_size,
+            crate::nn::MAX_NET_WIDTH,
+        ),
+    ];
+    for (key, value, max) in bounded {
+        if value > max {
+            return Err((key, format!("must be at most {max}, got {value}")));
+        }
+    }
+    for (key, sizes) in [
+        ("a_mlp_layer_size", &c.a_mlp_layer_size),
+        ("c_mlp_layer_size", &c.c_mlp_layer_size),
+    ] {
+        if sizes.len() != 2
+            || sizes
+                .iter()
+                .any(|&s| s == 0 || s > crate::nn::MAX_NET_WIDTH)
+        {
+            return Err((
+                key,
+                format!(
+                    "must be two widths [before, after] the recurrent layer, each 1..={}, got {sizes:?}",
+                    crate::nn::MAX_NET_WIDTH
+                ),
+            ));
+        }
+    }
+    // Episodes in one update's batch x horizon x widest layer bounds the batch activations.
+    let widest = [c.a_rnn_layer_size, c.c_rnn_layer_size, c.c_mid_layer_size]
+        .into_iter()
+        .chain(c.a_mlp_layer_size.iter().copied())
+        .chain(c.c_mlp_layer_size.iter().copied())
+        .max()
+        .unwrap_or(1) as u128;
+    let elements = c.train_freq as u128 * horizon as u128 * widest * 3;
+    if elements > crate::experiment::limits::MAX_BATCH_ELEMENTS {
+        return Err((
+            "train_freq",
+            format!(
+                "train_freq x env_terminate_step x the widest layer is {elements} activations, beyond {}",
+                crate::experiment::limits::MAX_BATCH_ELEMENTS
+            ),
+        ));
+    }
+    let unit = [
+        ("gamma", c.gamma),
+        ("eps_start", c.eps_start),
+        ("eps_end", c.eps_end),
+    ];
+    for (key, value) in unit {
+        if !(0.0..=1.0).contains(&value) {
+            return Err((key, format!("must be in [0, 1], got {value}")));
+        }
+    }
+    if c.gamma == 0.0 {
+        return Err(("gamma", "must be in (0, 1], got 0".into()));
+    }
+    for (key, lr) in [("a_lr", c.a_lr), ("c_lr", c.c_lr)] {
+        if !(lr > 0.0 && lr.is_finite()) {
+            return Err((key, format!("must be a positive number, got {lr}")));
+        }
+    }
+    Ok(())
+}
+
+/// Environments one run may step in lockstep (published: at most 48).
+pub const MAX_N_ENV: usize = 4096;
+
+/// One published experiment block's settings (a row of spec `macromarl_hp_table.md`), as
+/// config keys. Widths are (a_rnn, c_rnn, c_mlp).
+#[allow(clippy::too_many_arguments)]
+pub fn published_row(
+    a_lr: f64,
+    c_lr: f64,
+    n_env: i64,
+    train_freq: i64,
+    c_target_update_freq: i64,
+    n_step_td: i64,
+    eps_end: f64,
+    eps_stable_at: i64,
+    total_epi: i64,
+    gamma: f64,
+    widths: (i64, i64, [i64; 2]),
+) -> toml::Table {
+    let (a_rnn, c_rnn, c_mlp) = widths;
+    let mut t = toml::Table::new();
+    let mut put = |k: &str, v: toml::Value| {
+        t.insert(k.to_string(), v);
+    };
+    put("a_lr", a_lr.into());
+    put("c_lr", c_lr.into());
+    put("n_env", n_env.into());
+    put("train_freq", train_freq.into());
+    put("c_target_update_freq", c_target_update_freq.into());
+    put("n_step_TD", n_step_td.into());
+    put("eps_end", eps_end.into());
+    put("eps_stable_at", eps_stable_at.into());
+    put("total_epi", total_epi.into());
+    put("gamma", gamma.into());
+    put("a_rnn_layer_size", a_rnn.into());
+    put("c_rnn_layer_size", c_rnn.into());
+    put(
+        "c_mlp_layer_size",
+        toml::Value::Array(c_mlp.iter().map(|&w| w.into()).collect()),
+    );
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eval_period_and_eps_follow_the_reference() {
+        let mut c = AcConfig::reference_defaults();
+        for (tf, period) in [(2, 100), (4, 100), (8, 96), (16, 96), (32, 96), (48, 96)] {
+            c.train_freq = tf;
+            assert_eq!(c.eval_period(), period, "train_freq {tf}");
+        }
+        c.eps_end = 0.01;
+        c.eps_stable_at = 4000;
+        assert_eq!(c.eps_at(0), 1.0);
+        assert!((c.eps_at(2000) - 0.505).abs() < 1e-12);
+        assert_eq!(c.eps_at(4000), 0.01);
+        assert_eq!(c.eps_at(9000), 0.01);
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        let mut c = AcConfig::reference_defaults();
+        assert!(validate(&c, 100).is_ok());
+        c.a_mlp_layer_size = vec![32];
+        assert_eq!(validate(&c, 100).unwrap_err().0, "a_mlp_layer_size");
+        c = AcConfig::reference_defaults();
+        c.gamma = 1.5;
+        assert_eq!(validate(&c, 100).unwrap_err().0, "gamma");
+        c = AcConfig::reference_defaults();
+        c.n_env = 0;
+        assert_eq!(validate(&c, 100).unwrap_err().0, "n_env");
+        c = AcConfig::reference_defaults();
+        c.c_lr = f64::NAN;
+        assert_eq!(validate(&c, 100).unwrap_err().0, "c_lr");
+    }
+}

@@ -1,0 +1,405 @@
+//! The actor-critic family as the training loop drives it (spec `macromarl.md` 2): n_env lanes
+//! stepped in lockstep, an on-policy batch of the last `train_freq` completed episodes, one
+//! update per batch, sampled evaluation on n_env environments. Where the six methods differ,
+//! [`Method::actor_critic`]'s design decides.
+
+use std::collections::VecDeque;
+
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::acting::{act_centralized, act_decentralized};
+use super::config::AcConfig;
+use super::episode::{Episode, EpisodeRecorder};
+use super::nets::{AcNets, NetSizes};
+use super::update::{update, UpdateParams, UpdateTrace};
+use crate::algos::hyper::RunConfig;
+use crate::algos::learner::{LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
+use crate::algos::method::{AcActor, AcCritic, AcDesign, Method};
+use crate::algos::training_loop::TrainError;
+use crate::autograd::Tape;
+use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use crate::nn::{GruActor, GruActorState};
+
+/// The family's `metrics.csv` columns: the exploration weight of the batch before the
+/// evaluation, the mean critic and actor losses over the updates since the previous row (mean
+/// over nets), and the mean discounted return of the training episodes completed since then.
+pub const METRIC_COLUMNS: [&str; 4] = ["eps", "critic_loss", "actor_loss", "train_return"];
+
+/// One training lane: the episode being recorded and the actors' recurrent states.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct AcLane {
+    recorder: EpisodeRecorder,
+    states: Vec<GruActorState>,
+}
+
+/// The nets, the on-policy batch and the learner-side random stream of an actor-critic run.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct AcLearner {
+    config: RunConfig,
+    method: Method,
+    seed: u64,
+    sizes: NetSizes,
+    nets: AcNets,
+    explore_rng: ChaCha8Rng,
+    /// The current batch's exploration weight.
+    eps: f64,
+    /// The last `train_freq` completed training episodes (`Memory_epi`).
+    memory: VecDeque<Episode>,
+    critic_loss_sum: f64,
+    actor_loss_sum: f64,
+    loss_count: u64,
+    return_sum: f64,
+    return_count: u64,
+    #[serde(skip, default)]
+    tape: TapeCell,
+}
+
+/// The learner's tape: scratch, rebuilt empty after a resume.
+#[derive(Debug, Default)]
+struct TapeCell(Tape);
+
+impl Clone for TapeCell {
+    fn clone(&self) -> Self {
+        TapeCell::default()
+    }
+}
+
+impl AcLearner {
+    /// The family's keys (an actor-critic learner is only built from them).
+    fn c(&self) -> &AcConfig {
+        self.config
+            .actor_critic()
+            .expect("an actor-critic learner is built from an actor-critic config")
+    }
+
+    /// The method's actor and critic.
+    fn design(&self) -> AcDesign {
+        self.method
+            .actor_critic()
+            .expect("an actor-critic learner trains an actor-critic method")
+    }
+
+    fn update_params(&self) -> UpdateParams {
+        let c = self.c();
+        UpdateParams {
+            design: self.design(),
+            gamma: c.gamma,
+            n_step: c.n_step_td,
+            eps: self.eps,
+            pg_discount_at_start: c.pg_discount_at_start,
+            pg_plain_log_prob: c.pg_plain_log_prob,
+            obs_sizes: self.sizes.obs_sizes.clone(),
+            n_actions: self.sizes.n_actions.clone(),
+        }
+    }
+
+    /// The nets (for tests and the golden comparison).
+    pub fn nets(&self) -> &AcNets {
+        &self.nets
+    }
+
+    /// One update on `batch` with exploration weight `eps`, as a training iteration runs it,
+    /// returning everything it computed (the golden tests drive the reference's batches
+    /// through this).
+    pub fn update_traced(&mut self, batch: &[Episode], eps: f64) -> UpdateTrace {
+        self.eps = eps;
+        let p = self.update_params();
+        update(&mut self.nets, &p, batch, &mut self.tape.0)
+    }
+
+    /// Mutable nets (the golden tests load the reference's weights into them).
+    pub fn nets_mut(&mut self) -> &mut AcNets {
+        &mut self.nets
+    }
+
+    /// Choose the free agents' macro-actions: `eps` is the exploration mixture's weight while
+    /// training, `None` when evaluated.
+    fn choose<E: MacroEnv>(
+        &self,
+        env: &E,
+        free: &[bool],
+        states: &mut [GruActorState],
+        eps: Option<f64>,
+        rng: &mut ChaCha8Rng,
+        actions: &mut [usize],
+    ) {
+        let running: Vec<usize> = env.executed().to_vec();
+        match self.design().actor {
+            AcActor::Decentralized => {
+                let actors: Vec<&GruActor> = self.nets.actors.iter().map(|a| &a.net).collect();
+                let obs = |i: usize| env.obs(i).to_vec();
+                act_decentralized(&actors, states, &obs, free, &running, eps, rng, actions);
+            }
+            AcActor::Centralized => {
+                let mut joint = vec![0.0; env.joint_obs_size()];
+                env.write_joint_obs(&mut joint);
+                act_centralized(
+                    &self.nets.actors[0].net,
+                    &mut states[0],
+                    &joint,
+                    free,
+                    &running,
+                    &self.sizes.n_actions,
+                    eps,
+                    rng,
+                    actions,
+                );
+            }
+        }
+    }
+
+    fn zero_states(&self) -> Vec<GruActorState> {
+        self.nets
+            .actors
+            .iter()
+            .map(|a| a.net.zero_state())
+            .collect()
+    }
+
+    fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
+        TrainError::NonFinite {
+            method: self.method,
+            seed: self.seed,
+            what,
+            episode: episodes,
+        }
+    }
+}
+
+impl Learner for AcLearner {
+    type Lane = AcLane;
+
+    fn new<E: MacroEnv>(
+        run_config: &RunConfig,
+        method: Method,
+        seed: u64,
+        env: &E,
+        mut rngs: LearnerRngs,
+    ) -> Result<Self, TrainError> {
+        let config = run_config
+            .actor_critic()
+            .ok_or(TrainError::WrongFamily { method })?;
+        let design = method
+            .actor_critic()
+            .ok_or(TrainError::WrongFamily { method })?;
+        let needs_state = matches!(design.critic, AcCritic::JointState | AcCritic::AgentState);
+        let sizes = NetSizes {
+            obs_sizes: env.obs_sizes().to_vec(),
+            n_actions: env.n_actions().to_vec(),
+            state_size: if needs_state { env.state_size() } else { 0 },
+        };
+        let nets = AcNets::new(design, config, &sizes, &mut rngs.init)
+            .map_err(|e| TrainError::Nets(e.to_string()))?;
+        Ok(AcLearner {
+            config: run_config.clone(),
+            method,
+            seed,
+            sizes,
+            nets,
+            explore_rng: rngs.explore,
+            eps: config.eps_start,
+            memory: VecDeque::new(),
+            critic_loss_sum: 0.0,
+            actor_loss_sum: 0.0,
+            loss_count: 0,
+            return_sum: 0.0,
+            return_count: 0,
+            tape: TapeCell::default(),
+        })
+    }
+
+    fn method(&self) -> Method {
+        self.method
+    }
+
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    fn config(&self) -> &RunConfig {
+        &self.config
+    }
+
+    fn schedule(&self) -> Schedule {
+        let c = self.c();
+        Schedule::EpisodeBatches {
+            train_freq: c.train_freq as u64,
+            target_update_freq: c.c_target_update_freq as u64,
+            eval_period: c.eval_period() as u64,
+        }
+    }
+
+    fn lanes(&self) -> Vec<LanePlan> {
+        vec![
+            LanePlan {
+                counts_episodes: true
+            };
+            self.c().n_env
+        ]
+    }
+
+    fn begin_lane<E: MacroEnv>(&self, _lane: usize, env: &E) -> Result<AcLane, TrainError> {
+        let with_state = self.sizes.state_size > 0;
+        Ok(AcLane {
+            recorder: EpisodeRecorder::new(env, self.c().gamma, with_state),
+            states: self.zero_states(),
+        })
+    }
+
+    fn begin_batch(&mut self, episodes: u64) {
+        self.eps = self.c().eps_at(episodes);
+    }
+
+    fn act<E: MacroEnv>(&mut self, lane: &mut AcLane, env: &E, actions: &mut [usize]) {
+        let mut rng = std::mem::replace(&mut self.explore_rng, rand::SeedableRng::seed_from_u64(0));
+        let free = lane.recorder.free().to_vec();
+        self.choose(
+            env,
+            &free,
+            &mut lane.states,
+            Some(self.eps),
+            &mut rng,
+            actions,
+        );
+        self.explore_rng = rng;
+    }
+
+    fn record<E: MacroEnv>(
+        &mut self,
+        lane: &mut AcLane,
+        env: &E,
+        outcome: StepOutcome,
+    ) -> Result<bool, TrainError> {
+        lane.recorder.record(env, outcome);
+        if !outcome.done {
+            return Ok(false);
+        }
+        self.return_sum += lane.recorder.discounted_return();
+        self.return_count += 1;
+        self.memory.push_back(lane.recorder.episode().clone());
+        while self.memory.len() > self.c().train_freq {
+            self.memory.pop_front();
+        }
+        Ok(true)
+    }
+
+    fn begin_episode<E: MacroEnv>(&self, lane: &mut AcLane, env: &E) -> Result<(), TrainError> {
+        lane.recorder.begin(env);
+        for s in &mut lane.states {
+            s.reset();
+        }
+        Ok(())
+    }
+
+    fn train_iteration(&mut self, _lanes: &[&AcLane], episodes: u64) -> Result<(), TrainError> {
+        let batch: Vec<Episode> = self.memory.iter().cloned().collect();
+        let eps = self.eps;
+        let trace = self.update_traced(&batch, eps);
+        let critic: Vec<f64> = trace
+            .critics
+            .iter()
+            .flatten()
+            .map(|c| f64::from(c.loss))
+            .collect();
+        let actor: Vec<f64> = trace
+            .actors
+            .iter()
+            .flatten()
+            .map(|a| f64::from(a.loss))
+            .collect();
+        if critic.iter().chain(&actor).any(|l| !l.is_finite()) {
+            return Err(self.non_finite("loss", episodes));
+        }
+        if !self.nets.is_finite() {
+            return Err(self.non_finite("parameter", episodes));
+        }
+        if !critic.is_empty() && !actor.is_empty() {
+            self.critic_loss_sum += critic.iter().sum::<f64>() / critic.len() as f64;
+            self.actor_loss_sum += actor.iter().sum::<f64>() / actor.len() as f64;
+            self.loss_count += 1;
+        }
+        Ok(())
+    }
+
+    fn sync_targets(&mut self) {
+        self.nets.sync_targets();
+    }
+
+    /// The reference's evaluation (P8): `n_env` environments reset and stepped in lockstep with
+    /// actions sampled from the plain actors, until `eval_num_epi` episodes completed; the mean
+    /// discounted return of the last `eval_num_epi` to complete.
+    fn evaluate_lanes<E: MacroEnv>(
+        &self,
+        envs: &mut [&mut E],
+        rng: &mut EnvRng,
+    ) -> Result<f64, EnvError> {
+        let c = self.c();
+        let n_agents = envs[0].n_agents();
+        let mut recorders = Vec::with_capacity(envs.len());
+        let mut states = Vec::with_capacity(envs.len());
+        for e in envs.iter_mut() {
+            e.reset(rng);
+            recorders.push(EpisodeRecorder::new(&**e, c.gamma, false));
+            states.push(self.zero_states());
+        }
+        let mut returns = Vec::new();
+        let mut actions = vec![0; n_agents];
+        while returns.len() < c.eval_num_epi {
+            for k in 0..envs.len() {
+                let free = recorders[k].free().to_vec();
+                self.choose(&*envs[k], &free, &mut states[k], None, rng, &mut actions);
+                let outcome = envs[k].step(&actions, rng)?;
+                recorders[k].record(&*envs[k], outcome);
+                if outcome.done {
+                    returns.push(recorders[k].discounted_return());
+                    envs[k].reset(rng);
+                    recorders[k].begin(&*envs[k]);
+                    for s in &mut states[k] {
+                        s.reset();
+                    }
+                }
+            }
+        }
+        let last = &returns[returns.len() - c.eval_num_epi..];
+        Ok(last.iter().sum::<f64>() / last.len() as f64)
+    }
+
+    /// One environment: the lockstep evaluation with a single lane.
+    fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng) -> Result<f64, EnvError> {
+        self.evaluate_lanes(&mut [env], rng)
+    }
+
+    fn metric_columns(&self) -> &'static [&'static str] {
+        &METRIC_COLUMNS
+    }
+
+    fn metric_values(&mut self) -> Vec<Option<f64>> {
+        let mean = |sum: f64, n: u64| (n > 0).then(|| sum / n as f64);
+        let row = vec![
+            Some(self.eps),
+            mean(self.critic_loss_sum, self.loss_count),
+            mean(self.actor_loss_sum, self.loss_count),
+            mean(self.return_sum, self.return_count),
+        ];
+        self.critic_loss_sum = 0.0;
+        self.actor_loss_sum = 0.0;
+        self.loss_count = 0;
+        self.return_sum = 0.0;
+        self.return_count = 0;
+        row
+    }
+
+    fn progress(&self) -> String {
+        format!("eps {:.3}", self.eps)
+    }
+
+    fn saved_nets(&self) -> SavedNets<'_> {
+        SavedNets {
+            actors: self.nets.actors.iter().map(|a| &a.net).collect(),
+            dec: Vec::new(),
+            cen: None,
+            evaluated_is_centralized: self.design().actor == AcActor::Centralized,
+        }
+    }
+}
