@@ -5,6 +5,9 @@
 #
 #   scripts/campaign.sh run       # train, in the order Fig 4a; Fig 5/6 seeds 0..10; Fig 4b; then
 #                                 # Fig 5/6 seeds 10..40 in blocks of 5
+#   scripts/campaign.sh macromarl # MacroMARL's actor-critic campaign (issue 28) into
+#                                 # reproduction/macromarl: Box Pushing 6..14 at 20 seeds, then
+#                                 # Warehouse A and B seeds 0..5
 #   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
 #                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
@@ -24,6 +27,34 @@ train() {
     "$MACDEC" train --config "experiments/$1.toml" --out "$OUT" --jobs 1 --quiet --no-plot "${@:2}"
 }
 
+train_macromarl() {
+    "$MACDEC" train --config "experiments/macromarl/$1.toml" --out "$OUT/macromarl" --jobs 1 \
+        --quiet --no-plot "${@:2}"
+}
+
+macromarl_lane() {
+    set -e
+    for block in bp6 bp8 bp10 bp12 bp14; do
+        train_macromarl "$block"
+    done
+    train_macromarl wh_a --seeds 0..5
+    train_macromarl wh_b --seeds 0..5
+}
+
+lanes() {
+    pids=()
+    for _ in $(seq "$JOBS"); do
+        "$1" &
+        pids+=($!)
+        sleep 1
+    done
+    status=0
+    for pid in "${pids[@]}"; do
+        wait "$pid" || status=1
+    done
+    return "$status"
+}
+
 lane() {
     set -e
     train fig4a_bp10
@@ -39,17 +70,10 @@ lane() {
 
 case "${1:-}" in
 run)
-    pids=()
-    for _ in $(seq "$JOBS"); do
-        lane &
-        pids+=($!)
-        sleep 1
-    done
-    status=0
-    for pid in "${pids[@]}"; do
-        wait "$pid" || status=1
-    done
-    exit "$status"
+    lanes lane
+    ;;
+macromarl)
+    lanes macromarl_lane
     ;;
 collect)
     find "$OUT" -name finished -type f | sort | while read -r marker; do
@@ -64,14 +88,15 @@ collect)
     find "$OUT" -maxdepth 2 -name shared_curves.toml -type f -exec git add -f {} +
     ;;
 status)
-    for curve in "$OUT"/*/*/; do
-        [[ -d $curve ]] || continue
-        n=$(find "$curve" -maxdepth 2 -name finished | wc -l)
-        echo "$(basename "$(dirname "$curve")")/$(basename "$curve"): $n finished"
+    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/; do
+        [[ -d $curve && $curve != "$OUT"/macromarl/*/ || $curve == "$OUT"/macromarl/*/*/ ]] || continue
+        n=$(find "$curve" -mindepth 2 -maxdepth 2 -name finished | wc -l)
+        [[ $n -gt 0 ]] || continue
+        echo "${curve#"$OUT"/}: $n finished"
     done
     ;;
 *)
-    echo "usage: $0 run|collect|status" >&2
+    echo "usage: $0 run|macromarl|collect|status" >&2
     exit 2
     ;;
 esac

@@ -31,6 +31,72 @@ fn every_shipped_config_parses_and_resolves() {
 }
 
 #[test]
+fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/macromarl");
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let e = Experiment::load(&path, &Overrides::default())
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(e.seeds, (0..20).collect::<Vec<u64>>(), "{}", e.name);
+        // Box Pushing's published Naive Mac-IACC and Mac-IAICC runs use the state critics.
+        let critics = if e.name.starts_with("bp") {
+            [Method::NaiveMacIasc, Method::MacIaisc]
+        } else {
+            [Method::NaiveMacIacc, Method::MacIaicc]
+        };
+        assert_eq!(
+            e.methods,
+            [Method::MacIac, Method::MacCac, critics[0], critics[1]],
+            "{}",
+            e.name
+        );
+        for run in e.runs().unwrap().iter().filter(|r| r.seed == 0) {
+            let c = run.config.actor_critic().expect("an actor-critic config");
+            // Every published block differs from the argparse defaults in its learning rates.
+            assert_ne!((c.a_lr, c.c_lr), (1e-4, 1e-3), "{} {}", e.name, run.method);
+            assert!(c.train_freq >= c.n_env, "{} {}", e.name, run.method);
+        }
+        names.push(e.name);
+    }
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "bp10",
+            "bp12",
+            "bp14",
+            "bp6",
+            "bp8",
+            "overcooked_a",
+            "overcooked_b",
+            "overcooked_c",
+            "wh_a",
+            "wh_b",
+            "wh_c",
+            "wh_d",
+            "wh_e"
+        ]
+    );
+    // Spot checks against spec macromarl_hp_table.md.
+    let bp12 = load("macromarl/bp12.toml").runs().unwrap();
+    let iac = bp12[0].config.actor_critic().unwrap();
+    assert_eq!(
+        (iac.n_env, iac.train_freq, iac.c_target_update_freq),
+        (8, 16, 128)
+    );
+    let wh_b = load("macromarl/wh_b.toml").runs().unwrap();
+    let cac = wh_b
+        .iter()
+        .find(|r| r.method == Method::MacCac)
+        .unwrap()
+        .config
+        .actor_critic()
+        .unwrap();
+    assert_eq!((cac.a_rnn_layer_size, cac.c_target_update_freq), (64, 16));
+}
+
+#[test]
 fn paper_figures_have_forty_seeds_and_their_methods() {
     for (file, methods) in [
         (

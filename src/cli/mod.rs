@@ -357,6 +357,10 @@ struct ImportArgs {
 struct EvalArgs {
     #[command(flatten)]
     episodes: EpisodeArgs,
+    /// Sample each macro-action from the actors' distributions (MacroMARL's evaluation protocol)
+    /// instead of taking the greedy one; actor policies only.
+    #[arg(long)]
+    sample: bool,
 }
 
 #[derive(clap::Args)]
@@ -1165,13 +1169,20 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
 }
 
 fn eval(args: EvalArgs) -> Result<()> {
+    let sample = args.sample;
     let args = args.episodes;
     let mut run = args.load()?;
     let mut printer = EpisodePrinter::new(args.trajectories);
+    let choice = if sample {
+        crate::deploy::local_eval::Choice::Sampled
+    } else {
+        crate::deploy::local_eval::Choice::Greedy
+    };
     crate::deploy::local_eval::eval_policy(
         &run.manifest,
         &run.verified,
         args.episodes,
+        choice,
         &mut run.rng,
         |trace| printer.print(trace),
     )

@@ -86,20 +86,35 @@ impl GruParams {
 }
 
 /// A GRU's recurrent state h, zero at the start of each episode, plus the scratch the acting
-/// forward writes into so that acting never allocates.
+/// forward writes into so that acting never allocates. Saved (in checkpoints) as h alone; the
+/// scratch is rebuilt on load.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "SavedGruState", into = "SavedGruState")]
 pub struct GruState {
     h: Vec<f32>,
-    #[serde(skip)]
     h_next: Vec<f32>,
-    #[serde(skip)]
     a: Vec<f32>,
-    #[serde(skip)]
     b: Vec<f32>,
-    #[serde(skip)]
     hn: Vec<f32>,
-    #[serde(skip)]
     zero_bias: Vec<f32>,
+}
+
+/// What a [`GruState`] saves.
+#[derive(Serialize, Deserialize)]
+struct SavedGruState {
+    h: Vec<f32>,
+}
+
+impl From<SavedGruState> for GruState {
+    fn from(s: SavedGruState) -> Self {
+        GruState::from_h(&s.h)
+    }
+}
+
+impl From<GruState> for SavedGruState {
+    fn from(s: GruState) -> Self {
+        SavedGruState { h: s.h }
+    }
 }
 
 impl GruState {

@@ -72,6 +72,8 @@ pub enum PolicyError {
         agent: usize,
         method: String,
     },
+    #[error("agent {agent}'s net is a Q-net: sampling (--sample) needs an actor policy, whose scores are log-probabilities; Q-net policies act greedily")]
+    NotAnActor { agent: usize },
 }
 
 impl PolicyError {

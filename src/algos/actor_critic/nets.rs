@@ -66,6 +66,9 @@ pub struct AcNets {
     pub critics: Vec<Critic>,
 }
 
+/// Joint macro-actions Mac-CAC's actor may output (3-agent Overcooked: 14^3 = 2744).
+pub const MAX_JOINT_ACTIONS: usize = 1 << 16;
+
 /// The sizes a method's nets are built for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NetSizes {
@@ -131,10 +134,10 @@ impl AcNets {
                 .collect(),
             AcActor::Centralized => {
                 let count: u128 = sizes.n_actions.iter().map(|&a| a as u128).product();
-                if count > crate::nn::MAX_NET_WIDTH as u128 {
+                if count > MAX_JOINT_ACTIONS as u128 {
                     return Err(NetsError::TooManyJointActions {
                         count,
-                        max: crate::nn::MAX_NET_WIDTH,
+                        max: MAX_JOINT_ACTIONS,
                     });
                 }
                 vec![actor(sizes.joint_obs(), sizes.joint_actions(), rng)]

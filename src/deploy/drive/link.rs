@@ -183,16 +183,30 @@ impl<R: BufRead, W: Write> RobotLink for JsonLink<R, W> {
     }
 }
 
-/// A policy called in-process: greedy decentralized execution without any transport.
+/// A policy called in-process: decentralized execution without any transport, greedy or (for an
+/// actor, whose scores are log-probabilities) sampled.
 pub struct LocalLink<P> {
     policy: P,
     q: Vec<f32>,
+    sampler: Option<rand_chacha::ChaCha8Rng>,
+    probs: Vec<f64>,
 }
 
 impl<P: AgentPolicy> LocalLink<P> {
+    /// A greedy link.
     pub fn new(policy: P) -> Self {
+        Self::with_sampler(policy, None)
+    }
+
+    /// A link that samples from exp(score) with `sampler` when given, else greedy.
+    pub fn with_sampler(policy: P, sampler: Option<rand_chacha::ChaCha8Rng>) -> Self {
         let q = vec![0.0; policy.n_actions()];
-        LocalLink { policy, q }
+        LocalLink {
+            policy,
+            q,
+            sampler,
+            probs: Vec::new(),
+        }
     }
 }
 
@@ -225,7 +239,13 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
                 ProtocolError::NonFiniteQ { action, value }.to_string(),
             ));
         }
-        Ok(Some(greedy_action(&self.q)))
+        Ok(Some(match &mut self.sampler {
+            None => greedy_action(&self.q),
+            Some(rng) => {
+                crate::algos::actor_critic::acting::mixture(&self.q, None, &mut self.probs);
+                crate::algos::actor_critic::acting::sample_weighted(&self.probs, rng)
+            }
+        }))
     }
 }
 

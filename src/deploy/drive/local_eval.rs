@@ -2,6 +2,8 @@
 //! driver loop as `macdec deploy` ([`run_episodes_with`]) with each robot replaced by an
 //! in-process link to the same Q-net ([`LocalLink`] over [`NetPolicy`]), so for the same policy
 //! and seed it gives exactly deploy's episodes, without starting a process or opening a socket.
+//! Actor policies can also be evaluated as MacroMARL does, sampling each macro-action from the
+//! actor's distribution ([`Choice::Sampled`]; each agent draws from its own stream of the seed).
 
 use crate::deploy::driver::{run_episodes_with, DeployError, EpisodeTrace};
 use crate::deploy::link::LocalLink;
@@ -10,27 +12,59 @@ use crate::envs::EnvRng;
 use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};
 use std::sync::Arc;
 
-/// One in-process link per agent, each running that agent's verified net from a zero state.
+/// How each agent picks its macro-action from its net's scores.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Choice {
+    /// The highest score (greedy; Q-nets and actors alike).
+    Greedy,
+    /// A draw from the actor's distribution (its scores are log-probabilities).
+    Sampled,
+}
+
+/// One in-process link per agent, each running that agent's verified net from a zero state;
+/// with [`Choice::Sampled`], agent i draws from stream `i` of `rng`'s key (actors only).
 pub fn local_links(
     manifest: &Manifest,
     verified: &[VerifiedAgent],
+    choice: Choice,
+    rng: &EnvRng,
 ) -> Result<Vec<LocalLink<NetPolicy>>, PolicyError> {
     verified
         .iter()
-        .map(|v| {
+        .enumerate()
+        .map(|(i, v)| {
             let net = load_net(manifest, v)?;
-            Ok(LocalLink::new(NetPolicy::new(Arc::new(net))))
+            let sampler = match choice {
+                Choice::Greedy => None,
+                Choice::Sampled if net.as_q().is_some() => {
+                    return Err(PolicyError::NotAnActor { agent: v.index })
+                }
+                Choice::Sampled => {
+                    let mut s = rng.clone();
+                    s.set_stream(SAMPLING_STREAMS + i as u64);
+                    s.set_word_pos(0);
+                    Some(s)
+                }
+            };
+            Ok(LocalLink::with_sampler(
+                NetPolicy::new(Arc::new(net)),
+                sampler,
+            ))
         })
         .collect()
 }
 
-/// Run `episodes` greedy episodes of the manifest's domain on one random stream (`rng`, the
-/// caller's choice of seed; deploy uses the evaluation stream of the run's seed), handing each
-/// to `on_episode` as it ends.
+/// Stream ids of the agents' sampling streams: clear of the evaluation env's own.
+const SAMPLING_STREAMS: u64 = 1 << 33;
+
+/// Run `episodes` episodes of the manifest's domain on one random stream (`rng`, the caller's
+/// choice of seed; deploy uses the evaluation stream of the run's seed), each agent choosing by
+/// `choice`, handing each episode to `on_episode` as it ends.
 pub fn eval_policy(
     manifest: &Manifest,
     verified: &[VerifiedAgent],
     episodes: usize,
+    choice: Choice,
     rng: &mut EnvRng,
     on_episode: impl FnMut(EpisodeTrace) -> Result<(), DeployError>,
 ) -> Result<(), DeployError> {
@@ -38,8 +72,8 @@ pub fn eval_policy(
         .env
         .build()
         .map_err(|e| DeployError::Policy(e.to_string()))?;
-    let mut links =
-        local_links(manifest, verified).map_err(|e| DeployError::Policy(e.to_string()))?;
+    let mut links = local_links(manifest, verified, choice, rng)
+        .map_err(|e| DeployError::Policy(e.to_string()))?;
     run_episodes_with(
         &mut env,
         &mut links,
@@ -67,6 +101,7 @@ mod tests {
             &manifest,
             &verified,
             5,
+            Choice::Greedy,
             &mut EnvRng::seed_from_u64(0),
             |_| {
                 calls += 1;

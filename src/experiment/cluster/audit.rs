@@ -86,26 +86,40 @@ impl RunAudit {
     }
 }
 
-/// Every finished run under `results` (`<experiment>/<curve>/seed-<k>/` with `finished`),
+/// Every finished run under `results` (`<experiment>/<curve>/seed-<k>/` with `finished`, also
+/// one level deeper for a group of experiments such as `macromarl/<block>/<method>/seed-<k>/`),
 /// sorted by path. Shared curves reached through another experiment are listed once, where they
 /// live.
 pub fn finished_runs(results: &Path) -> Result<Vec<PathBuf>, AuditError> {
-    let read_err = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| AuditError::ReadTree { path, source }
-    };
     let mut runs = Vec::new();
-    for exp in subdirs(results).map_err(read_err(results))? {
-        for curve in subdirs(&exp).map_err(read_err(&exp))? {
-            for run in subdirs(&curve).map_err(read_err(&curve))? {
-                if results_tree::is_finished(&run) && run.join(CONFIG).is_file() {
-                    runs.push(run);
-                }
-            }
-        }
-    }
+    collect_runs(results, RUN_DEPTHS.end, &mut runs)?;
     runs.sort();
     Ok(runs)
+}
+
+/// How deep below the results root a run directory may sit.
+const RUN_DEPTHS: std::ops::Range<usize> = 3..5;
+
+fn collect_runs(dir: &Path, levels: usize, runs: &mut Vec<PathBuf>) -> Result<(), AuditError> {
+    if levels == 0 {
+        return Ok(());
+    }
+    let subs = subdirs(dir).map_err(|source| AuditError::ReadTree {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    for sub in subs {
+        let depth = RUN_DEPTHS.end - levels + 1;
+        if RUN_DEPTHS.contains(&depth)
+            && results_tree::is_finished(&sub)
+            && sub.join(CONFIG).is_file()
+        {
+            runs.push(sub);
+        } else {
+            collect_runs(&sub, levels - 1, runs)?;
+        }
+    }
+    Ok(())
 }
 
 fn subdirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
@@ -271,6 +285,26 @@ mod tests {
             rows_without_wall(&p),
             Err(AuditError::BadHeader { .. })
         ));
+    }
+
+    #[test]
+    fn runs_are_found_in_experiments_and_in_groups_of_experiments() {
+        let t = tempfile::tempdir().unwrap();
+        let make = |rel: &str, finished: bool| {
+            let d = t.path().join(rel);
+            std::fs::create_dir_all(&d).unwrap();
+            std::fs::write(d.join(CONFIG), "").unwrap();
+            if finished {
+                std::fs::write(d.join(results_tree::FINISHED), "").unwrap();
+            }
+            d
+        };
+        let icra = make("fig4a/our1/seed-0", true);
+        let grouped = make("macromarl/bp6/mac-iac/seed-3", true);
+        make("macromarl/bp6/mac-iac/seed-4", false);
+        make("too/deep/for/a/run/seed-0", true);
+        make("shallow/seed-0", true);
+        assert_eq!(finished_runs(t.path()).unwrap(), [icra, grouped]);
     }
 
     #[test]
