@@ -277,6 +277,7 @@ fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
         &manifest,
         &verified,
         3,
+        macdec::deploy::local_eval::Choice::Greedy,
         &mut EnvRng::seed_from_u64(9),
         |t| {
             seen.push(t);
