@@ -84,8 +84,8 @@ enum Command {
     },
     /// Write a Slurm job-array script (one task per run) to stdout.
     Slurm(SlurmArgs),
-    /// Export a trained run's decentralized Q-nets for robots: one safetensors file per agent and
-    /// policy.json (domain, layout, architectures, run, SHA-256 of each file).
+    /// Export a trained run's decentralized nets (Q-nets or actors) for robots: one safetensors
+    /// file per agent and policy.json (domain, layout, architectures, run, SHA-256 of each file).
     Export {
         /// A run directory: <results>/<experiment>/<method>/seed-<k>.
         #[arg(long)]

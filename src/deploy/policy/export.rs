@@ -1,6 +1,7 @@
 //! `macdec export`: turn a trained run directory into a policy directory for robots (issue 7):
 //! the run's `policy/` files (issue 11; written with every checkpoint) in the same format,
-//! holding each agent's decentralized Q-net only (as `agent-<i>.safetensors`) beside the layout,
+//! holding each agent's decentralized net only (a Q-net or an actor, as `agent-<i>.safetensors`)
+//! beside the layout,
 //! domain and run. Reads nothing of the trainer: no checkpoint, no learner types. [`export_nets`] writes
 //! the same directory from plain nets and any [`MacroEnv`], for domains defined outside this
 //! binary (the library's `TrainedPolicy::export`).
@@ -9,8 +10,8 @@ use crate::envs::MacroEnv;
 use crate::nn::QNet;
 use crate::policy_files::legacy::MANIFEST_FILE_V1;
 use crate::policy_files::{
-    read_policy_files, weights_file_name, AgentLayout, Manifest, NetFile, NetRole, PolicyEnv,
-    PolicyError, RunInfo, POLICY_FILE,
+    weights_file_name, AgentLayout, Manifest, NetFile, NetRole, PolicyEnv, PolicyError, RunInfo,
+    POLICY_DIR, POLICY_FILE,
 };
 use std::path::{Path, PathBuf};
 
@@ -19,7 +20,7 @@ use std::path::{Path, PathBuf};
 pub enum ExportError {
     #[error(transparent)]
     Policy(#[from] PolicyError),
-    #[error("{dir}: the run trained {method}, which has no decentralized Q-nets to put on robots (export a dec-hddrqn, our1, our1-r or our2 run)")]
+    #[error("{dir}: the run trained {method}, which has no decentralized nets to put on robots (export a dec-hddrqn, our1, our1-r, our2 run or a decentralized actor-critic run)")]
     NotDecentralized { dir: PathBuf, method: String },
     #[error("{dir}: holds {file}, which is not part of a policy export; choose an empty or new --out directory")]
     NotAPolicyDir { dir: PathBuf, file: String },
@@ -74,21 +75,47 @@ fn previous_export_files(out: &Path) -> Result<Vec<PathBuf>, ExportError> {
 
 /// Export the run in `run_dir` (its `policy/` files of any format version, see
 /// [`crate::policy_files`]; never its checkpoint) to the policy directory `out`: the same
-/// format, holding only each agent's decentralized Q-net. The nets are exported as the last
-/// checkpoint wrote them: a run still training exports its current nets (`episodes_trained`
-/// says how far it got).
+/// format, holding only each agent's decentralized net (a Q-net, or an actor-critic run's
+/// actor), its bytes copied as verified. The nets are exported as the last checkpoint wrote
+/// them: a run still training exports its current nets (`episodes_trained` says how far it
+/// got).
 pub fn export_run(run_dir: &Path, out: &Path) -> Result<Manifest, ExportError> {
     let previous = previous_export_files(out)?;
-    let policy = read_policy_files(run_dir)?;
-    let m = policy.manifest;
-    if policy.dec.is_empty() {
-        return Err(ExportError::NotDecentralized {
+    let dir = run_dir.join(POLICY_DIR);
+    if !dir.join(POLICY_FILE).exists() {
+        return Err(PolicyError::MissingRun {
             dir: run_dir.to_path_buf(),
-            method: m.run.method,
+        }
+        .into());
+    }
+    let m = Manifest::read(&dir)?;
+    let mut files = Vec::with_capacity(m.agents.len());
+    for agent in 0..m.agents.len() {
+        let verified = match m.verify_agent(&dir, agent) {
+            Ok(v) => v,
+            Err(PolicyError::NoAgentNet { .. }) => {
+                return Err(ExportError::NotDecentralized {
+                    dir: run_dir.to_path_buf(),
+                    method: m.run.method,
+                })
+            }
+            Err(e) => return Err(e.into()),
+        };
+        // The weights must build the net their entry describes, whatever its kind.
+        m.agent_acting_net(&verified)?;
+        let entry = &m.nets[m.agent_net(agent)?];
+        files.push(NetFile {
+            kind: entry.kind,
+            role: NetRole::Dec,
+            agent: Some(agent),
+            file: weights_file_name(agent),
+            input: entry.input,
+            output: entry.output,
+            architecture: entry.architecture.clone(),
+            bytes: verified.weights,
         });
     }
-    let nets: Vec<&QNet> = policy.dec.iter().collect();
-    write_export(out, previous, m.env, m.agents, m.discount, m.run, &nets)
+    write_files(out, previous, m.env, m.agents, m.discount, m.run, files)
 }
 
 /// Write agent i's decentralized net `nets[i]` of a policy trained on `domain` (any
@@ -118,25 +145,25 @@ pub fn export_nets(
         });
     }
     let agents = AgentLayout::of_domain(domain);
-    write_export(out, previous, env, agents, discount, run, nets)
+    let files: Vec<NetFile> = nets
+        .iter()
+        .enumerate()
+        .map(|(i, n)| NetFile::qnet(NetRole::Dec, Some(i), weights_file_name(i), n))
+        .collect();
+    write_files(out, previous, env, agents, discount, run, files)
 }
 
 /// Write the policy directory (agent i's net as `agent-<i>.safetensors`) and remove what an
 /// earlier export there (`previous`) left that the new description no longer names.
-fn write_export(
+fn write_files(
     out: &Path,
     previous: Vec<PathBuf>,
     env: PolicyEnv,
     agents: Vec<AgentLayout>,
     discount: f64,
     run: RunInfo,
-    nets: &[&QNet],
+    files: Vec<NetFile>,
 ) -> Result<Manifest, ExportError> {
-    let files: Vec<NetFile> = nets
-        .iter()
-        .enumerate()
-        .map(|(i, n)| NetFile::qnet(NetRole::Dec, Some(i), weights_file_name(i), n))
-        .collect();
     let manifest = Manifest::write_new(out, env, agents, discount, NetRole::Dec, run, &files)?;
     // An earlier export with more agents, or of format_version 1 (manifest.json), would leave
     // files the new description no longer names.
