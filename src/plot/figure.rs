@@ -77,7 +77,7 @@ pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
     let mut summary = Vec::new();
     for (i, curve) in exp.curves.iter().enumerate() {
         let colour = match curve.method {
-            Some(m) if one_per_method => PALETTE[method_rank(m)],
+            Some(m) if one_per_method => method_colour(m),
             _ => PALETTE[i % PALETTE.len()],
         };
         let runs: Vec<&[(u64, f64)]> = curve.runs.iter().map(|r| r.points.as_slice()).collect();
@@ -177,6 +177,13 @@ fn provenance_mix(exp: &ExperimentData) -> Option<String> {
 
 fn method_rank(m: Method) -> usize {
     Method::ALL.iter().position(|&x| x == m).unwrap_or(0)
+}
+
+/// A method's colour in every figure: its place among all methods, round the palette (the five
+/// ICRA methods and MacroMARL's six never share a figure's default methods, and each set's
+/// colours differ).
+fn method_colour(m: Method) -> Rgb {
+    PALETTE[method_rank(m) % PALETTE.len()]
 }
 
 /// "Our-1 (n = 40 seeds)", or "(n = 3 seeds, 1 unfinished)" for partial curves.
@@ -280,6 +287,21 @@ fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_method_has_a_colour_and_each_papers_methods_differ() {
+        use crate::algos::method::Family;
+        for family in [Family::Value, Family::ActorCritic] {
+            let colours: Vec<Rgb> = Method::ALL
+                .into_iter()
+                .filter(|m| m.family() == family)
+                .map(method_colour)
+                .collect();
+            for (i, c) in colours.iter().enumerate() {
+                assert!(!colours[..i].contains(c), "{family:?}: {colours:?}");
+            }
+        }
+    }
+
     use super::*;
     use crate::envs::EnvSpec;
     use crate::plot::discover::{discover, tests::write_run};
