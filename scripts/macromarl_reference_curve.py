@@ -15,6 +15,9 @@ done around it:
     `macro_marl.algs` imports too) and `pygame` (Overcooked's renderer; never used here);
   * with numpy >= 2, `np.bool8 = np.bool_`: gym 0.26.2's passive env checker, which gym.make wraps
     around every env and which runs on the first step only, still names the alias numpy 2 removed;
+  * gym.make's passive env checker is skipped for environments without an `action_space` (the
+    Warehouse `OSD-*` envs define none; gym 0.21, the reference's, had no such check): the
+    checker only inspects, so the env is the same either way;
   * `torch.set_num_threads(1)` before the script runs (with an explicit non-zero `--seed` this
     makes a run repeatable: two BP 6x6 MacIAC runs, seed 1, 200 episodes, gave identical curves;
     `--seed` 0, the default, leaves the main process unseeded, spec 1.5).
@@ -208,6 +211,15 @@ def main():
 
     if not hasattr(np, "bool8"):  # gym 0.26's env checker (first step only) names np.bool8,
         np.bool8 = np.bool_  # which numpy 2 removed; it is the same type as np.bool_
+    import gym.envs.registration as registration
+
+    checker = registration.PassiveEnvChecker
+
+    def checked(env):
+        # The Warehouse envs have no action_space, which gym 0.26's checker asserts on.
+        return checker(env) if hasattr(env, "action_space") else env
+
+    registration.PassiveEnvChecker = checked
     torch.set_num_threads(1)
 
     os.makedirs(a.out, exist_ok=True)

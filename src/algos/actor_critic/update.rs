@@ -6,8 +6,6 @@
 //! is the one `match` on [`AcCritic`] in [`critic_inputs`] and on the design in
 //! [`actor_advantages`]. Everything else is shared.
 
-use ndarray::Array2;
-
 use super::episode::Episode;
 use super::nets::{AcNets, CriticNet};
 use super::returns::{discount_at, macro_returns, MacroSequence};
@@ -312,13 +310,24 @@ fn critic_inputs(p: &UpdateParams, batch: &[Episode], sq: &[Squeezed]) -> Vec<Cr
 
 /// The rows of `seqs` in the packing's order, as a tape constant.
 fn packed_input(tape: &mut Tape, seqs: &Rows, packing: &SeqPacking) -> Var {
-    let mut x = Array2::<f32>::zeros((packing.total(), seqs.width));
+    // Every array put on the tape comes from its pool (and goes back at reset), so the pool
+    // stays as small as one update's arrays.
+    let mut x = tape.pool().array(packing.total(), seqs.width);
     for (p, &f) in packing.packed_to_flat().iter().enumerate() {
         x.row_mut(p).assign(&ndarray::ArrayView1::from(
             &seqs.data[f * seqs.width..(f + 1) * seqs.width],
         ));
     }
     tape.constant_owned(x)
+}
+
+/// `values` as a tape constant of `width` columns, in a buffer of the tape's pool.
+fn column_constant(tape: &mut Tape, values: &[f32], width: usize) -> Var {
+    let mut a = tape.pool().array(values.len() / width, width);
+    a.as_slice_mut()
+        .expect("a fresh array is contiguous")
+        .copy_from_slice(values);
+    tape.constant_owned(a)
 }
 
 /// A recurrent net's outputs over `seqs`, in flat (sequence-major) row order.
@@ -344,9 +353,7 @@ fn critic_values(tape: &mut Tape, net: &CriticNet, inputs: &Inputs) -> (Var, Bou
         }
         (CriticNet::State(n), Inputs::State(rows)) => {
             let vars = n.bind(tape);
-            let x = Array2::from_shape_vec((rows.total(), rows.width), rows.data.clone())
-                .expect("rows of the state's width");
-            let x = tape.constant_owned(x);
+            let x = column_constant(tape, &rows.data, rows.width);
             (n.forward(tape, &vars, x), BoundCritic::State(vars))
         }
         _ => unreachable!("a critic's inputs match its kind"),
@@ -430,7 +437,7 @@ fn critic_step(
     let k = returns.len();
     let (v, bound) = critic_values(tape, &critic.net, &d.values);
     let values: Vec<f32> = tape.value(v).iter().copied().collect();
-    let g = tape.constant_owned(Array2::from_shape_vec((k, 1), returns.clone()).expect("k x 1"));
+    let g = column_constant(tape, &returns, 1);
     let td = tape.sub(g, v);
     let sq = tape.square(td);
     let total = tape.sum(sq);
@@ -606,10 +613,9 @@ fn actor_step(
     } else {
         let probs = tape.exp(logp);
         let kept = tape.scale(probs, (1.0 - p.eps) as f32);
-        let floor = tape.constant_owned(Array2::from_elem(
-            (k, n_actions),
-            (p.eps / n_actions as f64) as f32,
-        ));
+        let mut floor = tape.pool().array(k, n_actions);
+        floor.fill((p.eps / n_actions as f64) as f32);
+        let floor = tape.constant_owned(floor);
         let mix = tape.add(kept, floor);
         tape.log(mix)
     };
@@ -621,7 +627,7 @@ fn actor_step(
         .zip(&inputs.advantages)
         .map(|(d, a)| d * a)
         .collect();
-    let w = tape.constant_owned(Array2::from_shape_vec((k, 1), weights).expect("k x 1"));
+    let w = column_constant(tape, &weights, 1);
     let weighted = tape.mul(taken, w);
     let total = tape.sum(weighted);
     let loss = tape.scale(total, -1.0 / k as f32);
