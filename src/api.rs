@@ -230,7 +230,7 @@ mod tests {
         let err = cen
             .export(&dir.path().join("cen"), &env, spec.into())
             .unwrap_err();
-        assert!(err.to_string().contains("no decentralized Q-nets"), "{err}");
+        assert!(err.to_string().contains("no decentralized nets"), "{err}");
     }
 
     #[test]

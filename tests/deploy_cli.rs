@@ -267,7 +267,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("no decentralized Q-nets"), "{err}");
+    assert!(err.contains("no decentralized nets"), "{err}");
 
     let run = results.join("tiny/our1/seed-3");
     let policy = dir.path().join("policy");

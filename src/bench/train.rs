@@ -1,11 +1,11 @@
 //! `macdec bench train`: whole training, end to end (acting, env steps, replay, squeezing,
-//! updates, evaluation), single run, one thread, at the paper's settings for the first episodes.
+//! updates, evaluation), single run, one thread, at the papers' settings for the first episodes.
 //!
 //! The reference's figures quoted in the issues were taken the same way (first 200 episodes of
 //! Box Pushing 10x10, all costs included), so the rates compare like for like.
 
 use crate::algos::any_loop::AnyLoop;
-use crate::algos::method::Method;
+use crate::algos::method::{Family, Method};
 use crate::algos::training_loop::{Advance, TrainError};
 use crate::envs::EnvSpec;
 use crate::experiment::paper::paper_defaults;
@@ -34,19 +34,29 @@ impl TrainBench {
     }
 }
 
-/// The configurations benchmarked: every method on BP 10x10 (Our-2 is episode-buffer only, quirk
-/// Q10) and every method on Warehouse.
+/// The configurations benchmarked: every value method on BP 10x10 (Our-2 is episode-buffer only,
+/// quirk Q10) and on Warehouse; every actor-critic method on MacroMARL's Box Pushing 10x10 and
+/// Mac-IAICC on its Warehouse A, at the published settings (issue 28's side-by-side pair is
+/// `bpma10 mac-iaisc`, 32 environments, and `osd-d-v7 mac-iaicc`, 4).
 pub fn suite() -> Vec<(EnvSpec, Method)> {
-    let mut v: Vec<(EnvSpec, Method)> = Method::ALL
-        .into_iter()
+    let value = || {
+        Method::ALL
+            .into_iter()
+            .filter(|m| m.family() == Family::Value)
+    };
+    let mut v: Vec<(EnvSpec, Method)> = value()
         .filter(|&m| !m.requires_episode_buffer())
         .map(|m| (crate::envs::box_pushing::paper_spec(10), m))
         .collect();
+    v.extend(value().map(|m| (crate::envs::warehouse::paper_spec(), m)));
     v.extend(
         Method::ALL
             .into_iter()
-            .map(|m| (crate::envs::warehouse::paper_spec(), m)),
+            .filter(|m| m.family() == Family::ActorCritic)
+            .map(|m| (crate::envs::bp_ma_v0::spec(10, 100), m)),
     );
+    let warehouse_a = EnvSpec::new("OSD-D-v7", &toml::Table::new()).expect("a built-in domain");
+    v.push((warehouse_a, Method::MacIaicc));
     v
 }
 

@@ -24,6 +24,7 @@ mod lstm;
 mod params;
 mod qnet;
 pub mod safetensors_io;
+pub mod sampling;
 mod state_critic;
 mod update;
 

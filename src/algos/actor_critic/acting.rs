@@ -4,42 +4,10 @@
 //! when evaluated the plain pi (P8, sampled, not greedy). Mac-CAC's one actor samples a joint
 //! macro-action among those that keep every busy agent's running macro-action (P4).
 
-use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+use crate::nn::sampling::{mixture, sample_weighted};
 use crate::nn::{GruActor, GruActorState};
-
-/// Sample index a from weights p_a (not necessarily normalized; zero weights never drawn).
-pub fn sample_weighted(weights: &[f64], rng: &mut ChaCha8Rng) -> usize {
-    let total: f64 = weights.iter().sum();
-    let u = rng.gen::<f64>() * total;
-    let mut acc = 0.0;
-    let mut last = 0;
-    for (a, &w) in weights.iter().enumerate() {
-        if w > 0.0 {
-            acc += w;
-            last = a;
-            if u < acc {
-                return a;
-            }
-        }
-    }
-    last
-}
-
-/// The probabilities of the actor's log-probabilities `logp` under exploration weight `eps`
-/// (`None` when evaluated), into `out`.
-pub fn mixture(logp: &[f32], eps: Option<f64>, out: &mut Vec<f64>) {
-    out.clear();
-    let n = logp.len() as f64;
-    match eps {
-        Some(eps) => out.extend(
-            logp.iter()
-                .map(|&l| (1.0 - eps) * f64::from(l).exp() + eps / n),
-        ),
-        None => out.extend(logp.iter().map(|&l| f64::from(l).exp())),
-    }
-}
 
 /// Decentralized actors: each free agent, in index order, samples from its actor on its own
 /// observation; busy agents keep their running macro-action (`running[i]`).
@@ -110,30 +78,59 @@ pub fn act_centralized(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::nn::GruActorConfig;
     use rand::SeedableRng;
 
     #[test]
-    fn sampling_follows_the_weights_and_never_draws_a_zero() {
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let w = [0.0, 3.0, 0.0, 1.0];
-        let mut counts = [0usize; 4];
-        for _ in 0..4000 {
-            counts[sample_weighted(&w, &mut rng)] += 1;
+    fn the_centralized_actor_keeps_busy_agents_on_their_running_macro_actions() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let cfg = GruActorConfig {
+            input: 5,
+            mlp: [8, 8],
+            hidden: 4,
+            output: 12,
+        };
+        let actor = GruActor::new(cfg, &mut rng);
+        let mut state = actor.zero_state();
+        let obs = [0.1, -0.4, 0.7, 0.0, 1.0];
+        let mut actions = [0, 0];
+        let mut seen = [false; 3];
+        for _ in 0..200 {
+            let free = [true, false];
+            act_centralized(
+                &actor,
+                &mut state,
+                &obs,
+                &free,
+                &[9, 2],
+                &[3, 4],
+                Some(0.5),
+                &mut rng,
+                &mut actions,
+            );
+            assert_eq!(actions[1], 2, "a busy agent keeps its macro-action");
+            seen[actions[0]] = true;
         }
-        assert_eq!((counts[0], counts[2]), (0, 0));
-        assert!((2800..3200).contains(&counts[1]), "{counts:?}");
-    }
-
-    #[test]
-    fn the_mixture_is_eps_uniform_plus_the_rest_of_pi() {
-        let logp = [0.5f32.ln(), 0.25f32.ln(), 0.25f32.ln()];
-        let mut p = Vec::new();
-        mixture(&logp, Some(0.3), &mut p);
-        let want = [0.7 * 0.5 + 0.1, 0.7 * 0.25 + 0.1, 0.7 * 0.25 + 0.1];
-        for (a, b) in p.iter().zip(want) {
-            assert!((a - b).abs() < 1e-6);
-        }
-        mixture(&logp, None, &mut p);
-        assert!((p[0] - 0.5).abs() < 1e-6);
+        assert_eq!(
+            seen, [true; 3],
+            "the free agent samples all of its macro-actions"
+        );
+        let before = state.clone();
+        act_centralized(
+            &actor,
+            &mut state,
+            &obs,
+            &[false, false],
+            &[1, 3],
+            &[3, 4],
+            None,
+            &mut rng,
+            &mut actions,
+        );
+        assert_eq!(
+            (actions, &state),
+            ([1, 3], &before),
+            "nobody free: nothing runs"
+        );
     }
 }

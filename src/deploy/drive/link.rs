@@ -242,8 +242,8 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
         Ok(Some(match &mut self.sampler {
             None => greedy_action(&self.q),
             Some(rng) => {
-                crate::algos::actor_critic::acting::mixture(&self.q, None, &mut self.probs);
-                crate::algos::actor_critic::acting::sample_weighted(&self.probs, rng)
+                crate::nn::sampling::mixture(&self.q, None, &mut self.probs);
+                crate::nn::sampling::sample_weighted(&self.probs, rng)
             }
         }))
     }

@@ -1,5 +1,6 @@
-//! A terminal summary of learning curves after `macdec train`: mean greedy return over seeds at
-//! evenly spaced evaluation points, with a bar per point.
+//! A terminal summary of learning curves after `macdec train`: mean evaluation return over seeds
+//! (greedy for the value methods, sampled for the actor-critic ones) at evenly spaced evaluation
+//! points, with a bar per point.
 
 use crate::curve_stats::aggregate;
 use crate::experiment::config::RunSpec;
@@ -34,7 +35,10 @@ pub fn print_curves(results: &Path, runs: &[RunSpec]) -> Result<(), metrics::Met
             .iter()
             .map(|p| p.mean)
             .fold(f64::NEG_INFINITY, f64::max);
-        println!("\n{name}: mean greedy return over {} seed(s)", curves.len());
+        println!(
+            "\n{name}: mean evaluation return (eval_return) over {} seed(s)",
+            curves.len()
+        );
         println!("{:>9}  {:>9}  ", "episode", "return");
         let stride = mean.len().div_ceil(POINTS).max(1);
         let picks = (0..mean.len())
