@@ -8,7 +8,7 @@ use super::stats::{
     run_mean_over_training, smooth, CurvePoint, SMOOTH_HALF_WINDOW,
 };
 use super::summary::CurveSummary;
-use crate::algos::method::Method;
+use crate::algos::method::{Family, Method};
 
 /// An RGB colour.
 pub type Rgb = (u8, u8, u8);
@@ -103,7 +103,20 @@ pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
         None => exp.name.clone(),
     };
     let quantity = if metric == EVAL_RETURN {
-        "the greedy discounted return".to_string()
+        // The value methods evaluate greedily; MacroMARL's actor-critic methods sample (P8).
+        let families: Vec<Family> = exp
+            .curves
+            .iter()
+            .filter_map(|c| c.method.map(Method::family))
+            .collect();
+        let sampled = families.contains(&Family::ActorCritic);
+        let greedy = families.contains(&Family::Value) || families.is_empty();
+        match (greedy, sampled) {
+            (true, false) => "the greedy discounted return",
+            (false, true) => "the discounted return of sampled actions",
+            _ => "the discounted evaluation return (greedy or sampled by method)",
+        }
+        .to_string()
     } else {
         format!("`{metric}`")
     };
@@ -289,7 +302,6 @@ fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>
 mod tests {
     #[test]
     fn every_method_has_a_colour_and_each_papers_methods_differ() {
-        use crate::algos::method::Family;
         for family in [Family::Value, Family::ActorCritic] {
             let colours: Vec<Rgb> = Method::ALL
                 .into_iter()

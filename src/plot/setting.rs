@@ -15,13 +15,13 @@ pub use crate::envs::warehouse::WTD_OPTIMAL;
 pub struct EnvSetting {
     /// The run's domain, or `None` for a domain this binary does not have (`env_name` kept).
     pub env: Result<EnvSpec, String>,
-    /// Evaluation discount (`discount`).
+    /// Evaluation discount (`discount`, or `gamma` for an actor-critic run).
     pub discount: f64,
 }
 
 impl EnvSetting {
     /// Read the setting from a run's `config.toml` text; `Err` says which key is missing or bad.
-    /// Only `env_name` and `discount` are required; the domain's keys are read when present and
+    /// Only `env_name` and `discount` (`gamma`) are required; the domain's keys are read when present and
     /// take the domain's defaults otherwise (`grid_dim` the reference's 10).
     pub fn from_config_toml(text: &str) -> Result<Self, String> {
         let mut table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
@@ -35,11 +35,17 @@ impl EnvSetting {
             Some(v) => return Err(format!("`env_name` is not a name: {v}")),
             None => return Err("no `env_name`".into()),
         };
-        let discount = match table.get("discount") {
+        // The value methods' `discount`, the actor-critic methods' `gamma`.
+        let key = if table.contains_key("gamma") {
+            "gamma"
+        } else {
+            "discount"
+        };
+        let discount = match table.get(key) {
             Some(toml::Value::Float(d)) => *d,
             Some(toml::Value::Integer(d)) => *d as f64,
-            Some(v) => return Err(format!("`discount` is not a number: {v}")),
-            None => return Err("no `discount`".into()),
+            Some(v) => return Err(format!("`{key}` is not a number: {v}")),
+            None => return Err("no `discount` (nor `gamma`)".into()),
         };
         let env = match registry::find(&name) {
             None => Err(name),
@@ -114,6 +120,16 @@ mod tests {
             setting_of(crate::envs::warehouse::paper_spec()).optimal_return(),
             Some(262.0)
         );
+    }
+
+    #[test]
+    fn an_actor_critic_run_reads_its_gamma() {
+        let spec = crate::envs::bp_ma_v0::spec(6, 100);
+        let text = toml::to_string(&RunSettings::paper(spec, Method::MacIaisc)).unwrap();
+        let s = EnvSetting::from_config_toml(&text).unwrap();
+        assert_eq!(s.discount, 0.98);
+        let optimum = s.optimal_return().expect("BP-MA-v0 6x6 has an optimum at gamma 0.98");
+        assert!((optimum - 270.61).abs() < 0.01, "{optimum}");
     }
 
     #[test]
