@@ -7,7 +7,7 @@
 #                                 # Fig 5/6 seeds 10..40 in blocks of 5
 #   scripts/campaign.sh macromarl # MacroMARL's actor-critic campaign (issue 28) into
 #                                 # reproduction/macromarl: Box Pushing 6..14 at 20 seeds, then
-#                                 # Warehouse A and B seeds 0..5
+#                                 # Warehouse A and B seeds 0..5, then their seeds 5..20
 #   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
 #                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
@@ -39,6 +39,11 @@ macromarl_lane() {
     done
     train_macromarl wh_a --seeds 0..5
     train_macromarl wh_b --seeds 0..5
+    # Then the rest of Warehouse A and B's 20 published seeds, five at a time.
+    for first in 5 10 15; do
+        train_macromarl wh_a --seeds "$first..$((first + 5))"
+        train_macromarl wh_b --seeds "$first..$((first + 5))"
+    done
 }
 
 lanes() {
@@ -88,11 +93,10 @@ collect)
     find "$OUT" -maxdepth 2 -name shared_curves.toml -type f -exec git add -f {} +
     ;;
 status)
+    # Curves are <experiment>/<curve>/ and, for MacroMARL, macromarl/<block>/<method>/.
     for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/; do
-        [[ -d $curve && $curve != "$OUT"/macromarl/*/ || $curve == "$OUT"/macromarl/*/*/ ]] || continue
         n=$(find "$curve" -mindepth 2 -maxdepth 2 -name finished | wc -l)
-        [[ $n -gt 0 ]] || continue
-        echo "${curve#"$OUT"/}: $n finished"
+        [[ $n -gt 0 ]] && echo "${curve#"$OUT"/}: $n finished"
     done
     ;;
 *)
