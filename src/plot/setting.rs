@@ -128,7 +128,9 @@ mod tests {
         let text = toml::to_string(&RunSettings::paper(spec, Method::MacIaisc)).unwrap();
         let s = EnvSetting::from_config_toml(&text).unwrap();
         assert_eq!(s.discount, 0.98);
-        let optimum = s.optimal_return().expect("BP-MA-v0 6x6 has an optimum at gamma 0.98");
+        let optimum = s
+            .optimal_return()
+            .expect("BP-MA-v0 6x6 has an optimum at gamma 0.98");
         assert!((optimum - 270.61).abs() < 0.01, "{optimum}");
     }
 

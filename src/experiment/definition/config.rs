@@ -6,7 +6,7 @@
 //! chosen domain and method (spec `algorithms.md` 10): `env_name = "BP_MA"` alone is Figure 4a's
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
-use crate::algos::hyper::{RunConfig, ValueConfig};
+use crate::algos::hyper::{AcConfig, RunConfig, ValueConfig};
 use crate::algos::method::{Family, Method};
 use crate::envs::EnvSpec;
 use crate::experiment::limits;
@@ -647,9 +647,7 @@ pub fn validate(
 ) -> Result<(), (&'static str, String)> {
     match (c, method.family()) {
         (RunConfig::Value(v), Family::Value) => validate_value(v, method, horizon),
-        (RunConfig::ActorCritic(a), Family::ActorCritic) => {
-            crate::algos::actor_critic::config::validate(a, horizon)
-        }
+        (RunConfig::ActorCritic(a), Family::ActorCritic) => validate_actor_critic(a, horizon),
         _ => Err((
             "config",
             format!("{method} needs its own family's keys; this config holds the other family's"),
@@ -663,7 +661,7 @@ fn validate_value(
     method: Method,
     horizon: usize,
 ) -> Result<(), (&'static str, String)> {
-    let positive = [
+    check_positive(&[
         ("env_terminate_step", horizon),
         ("total_epi", c.total_epi),
         ("replay_buffer_size", c.replay_buffer_size),
@@ -681,12 +679,7 @@ fn validate_value(
         ("eval_freq", c.eval_freq),
         ("eval_num_epi", c.eval_num_epi),
         ("checkpoint_freq", c.checkpoint_freq),
-    ];
-    for (key, value) in positive {
-        if value == 0 {
-            return Err((key, "must be > 0, got 0".into()));
-        }
-    }
+    ])?;
     if c.start_train == 0 {
         return Err((
             "start_train",
@@ -705,27 +698,17 @@ fn validate_value(
         ));
     }
     limits::check_sizes(c, horizon)?;
-    let unit = [
+    check_unit(&[
         ("eps_end", c.eps_end),
         ("discount", c.discount),
         ("init_h", c.init_h),
         ("end_h", c.end_h),
-    ];
-    for (key, value) in unit {
-        if !(0.0..=1.0).contains(&value) {
-            return Err((key, format!("must be in [0, 1], got {value}")));
-        }
-    }
+    ])?;
     if c.discount == 0.0 {
         // Evaluation returns and exported policies need a positive discount.
         return Err(("discount", "must be in (0, 1], got 0".into()));
     }
-    if !(c.l_rate > 0.0 && c.l_rate.is_finite()) {
-        return Err((
-            "l_rate",
-            format!("must be a positive number, got {}", c.l_rate),
-        ));
-    }
+    check_rates(&[("l_rate", c.l_rate)])?;
     if method.requires_episode_buffer() && !c.sample_epi {
         // Spec Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
         return Err((
@@ -735,6 +718,58 @@ fn validate_value(
         ));
     }
     Ok(())
+}
+
+/// [`validate`] for an actor-critic method's keys.
+fn validate_actor_critic(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+    check_positive(&[
+        ("env_terminate_step", horizon),
+        ("total_epi", c.total_epi),
+        ("n_env", c.n_env),
+        ("train_freq", c.train_freq),
+        ("c_target_update_freq", c.c_target_update_freq),
+        ("a_rnn_layer_size", c.a_rnn_layer_size),
+        ("c_rnn_layer_size", c.c_rnn_layer_size),
+        ("c_mid_layer_size", c.c_mid_layer_size),
+        ("eval_freq", c.eval_freq),
+        ("eval_num_epi", c.eval_num_epi),
+        ("checkpoint_freq", c.checkpoint_freq),
+    ])?;
+    limits::check_actor_critic_sizes(c, horizon)?;
+    check_unit(&[
+        ("gamma", c.gamma),
+        ("eps_start", c.eps_start),
+        ("eps_end", c.eps_end),
+    ])?;
+    if c.gamma == 0.0 {
+        // Evaluation returns and exported policies need a positive discount.
+        return Err(("gamma", "must be in (0, 1], got 0".into()));
+    }
+    check_rates(&[("a_lr", c.a_lr), ("c_lr", c.c_lr)])
+}
+
+/// Every count named must be at least 1.
+fn check_positive(counts: &[(&'static str, usize)]) -> Result<(), (&'static str, String)> {
+    match counts.iter().find(|(_, v)| *v == 0) {
+        Some((key, _)) => Err((key, "must be > 0, got 0".into())),
+        None => Ok(()),
+    }
+}
+
+/// Every value named must lie in [0, 1].
+fn check_unit(values: &[(&'static str, f64)]) -> Result<(), (&'static str, String)> {
+    match values.iter().find(|(_, v)| !(0.0..=1.0).contains(v)) {
+        Some((key, v)) => Err((key, format!("must be in [0, 1], got {v}"))),
+        None => Ok(()),
+    }
+}
+
+/// Every learning rate named must be a positive number.
+fn check_rates(rates: &[(&'static str, f64)]) -> Result<(), (&'static str, String)> {
+    match rates.iter().find(|(_, lr)| !(*lr > 0.0 && lr.is_finite())) {
+        Some((key, lr)) => Err((key, format!("must be a positive number, got {lr}"))),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -1039,6 +1074,26 @@ mod tests {
         let err = parse(&text, &[]).unwrap_err();
         assert!(matches!(err, ConfigError::TooManyRuns { .. }), "{err}");
         assert!(t0.elapsed().as_secs() < 5);
+    }
+
+    #[test]
+    fn actor_critic_bad_values_name_their_key() {
+        let mut c = AcConfig::reference_defaults();
+        assert!(validate_actor_critic(&c, 100).is_ok());
+        c.a_mlp_layer_size = vec![32];
+        assert_eq!(
+            validate_actor_critic(&c, 100).unwrap_err().0,
+            "a_mlp_layer_size"
+        );
+        c = AcConfig::reference_defaults();
+        c.gamma = 1.5;
+        assert_eq!(validate_actor_critic(&c, 100).unwrap_err().0, "gamma");
+        c = AcConfig::reference_defaults();
+        c.n_env = 0;
+        assert_eq!(validate_actor_critic(&c, 100).unwrap_err().0, "n_env");
+        c = AcConfig::reference_defaults();
+        c.c_lr = f64::NAN;
+        assert_eq!(validate_actor_critic(&c, 100).unwrap_err().0, "c_lr");
     }
 
     #[test]

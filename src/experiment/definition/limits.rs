@@ -5,7 +5,7 @@
 //! process on allocation: a value beyond one is a config error naming the key, found before any
 //! run starts, instead of an out-of-memory abort that takes every parallel run down with it.
 
-use crate::algos::hyper::ValueConfig;
+use crate::algos::hyper::{AcConfig, ValueConfig};
 
 /// Runs one invocation may expand to (methods x sweep points x seeds).
 pub const MAX_RUNS: usize = 100_000;
@@ -34,6 +34,8 @@ pub const MAX_TOTAL_EPI: usize = 100_000_000;
 pub const MAX_EVAL_ROWS: usize = 1_000_000;
 /// Greedy episodes per evaluation, `eval_num_epi` (paper: 1 and 20).
 pub const MAX_EVAL_NUM_EPI: usize = 100_000;
+/// Environments an actor-critic run steps in lockstep, `n_env` (published: at most 48).
+pub use crate::algos::actor_critic::config::MAX_N_ENV;
 
 /// Check a resolved config's sizes against the bounds above, for a domain whose episodes last at
 /// most `horizon` primitive steps. Returns the key and why.
@@ -107,6 +109,61 @@ pub fn check_sizes(c: &ValueConfig, horizon: usize) -> Result<(), (&'static str,
 /// Worker threads for `runs` runs when `requested` were asked for: at most one per run.
 pub fn worker_threads(requested: usize, runs: usize) -> usize {
     requested.min(runs).max(1)
+}
+
+/// Check an actor-critic config's sizes against the bounds above and [`MAX_N_ENV`], for a
+/// domain whose episodes last at most `horizon` primitive steps. Returns the key and why.
+pub fn check_actor_critic_sizes(
+    c: &AcConfig,
+    horizon: usize,
+) -> Result<(), (&'static str, String)> {
+    let simple = [
+        ("env_terminate_step", horizon, MAX_HORIZON),
+        ("total_epi", c.total_epi, MAX_TOTAL_EPI),
+        ("eval_num_epi", c.eval_num_epi, MAX_EVAL_NUM_EPI),
+        ("n_env", c.n_env, MAX_N_ENV),
+        ("train_freq", c.train_freq, MAX_N_ENV * 16),
+        ("n_step_TD", c.n_step_td, MAX_HORIZON),
+        ("a_rnn_layer_size", c.a_rnn_layer_size, MAX_NET_WIDTH),
+        ("c_rnn_layer_size", c.c_rnn_layer_size, MAX_NET_WIDTH),
+        ("c_mid_layer_size", c.c_mid_layer_size, MAX_NET_WIDTH),
+    ];
+    for (key, value, max) in simple {
+        if value > max {
+            return Err((key, format!("must be at most {max}, got {value}")));
+        }
+    }
+    for (key, sizes) in [
+        ("a_mlp_layer_size", &c.a_mlp_layer_size),
+        ("c_mlp_layer_size", &c.c_mlp_layer_size),
+    ] {
+        if sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH) {
+            return Err((
+                key,
+                format!(
+                    "must be two widths [before, after] the recurrent layer, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
+                ),
+            ));
+        }
+    }
+    // One update's batch activations: train_freq episodes x horizon x the widest layer (x3,
+    // the GRU's gates).
+    let widest = [c.a_rnn_layer_size, c.c_rnn_layer_size, c.c_mid_layer_size]
+        .into_iter()
+        .chain(c.a_mlp_layer_size.iter().copied())
+        .chain(c.c_mlp_layer_size.iter().copied())
+        .max()
+        .unwrap_or(1) as u128;
+    let elements = c.train_freq as u128 * horizon as u128 * widest * 3;
+    if elements > MAX_BATCH_ELEMENTS {
+        return Err((
+            "train_freq",
+            format!(
+                "train_freq x env_terminate_step x the widest layer is {elements} activations, beyond {MAX_BATCH_ELEMENTS}"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
