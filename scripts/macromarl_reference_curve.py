@@ -85,15 +85,9 @@ import sys
 import time
 import types
 
-
-def flag(argv, name, default):
-    """The value of `--name=V` or `--name V` in the reference's argv."""
-    for i, a in enumerate(argv):
-        if a.startswith(f"--{name}="):
-            return a.split("=", 1)[1]
-        if a == f"--{name}" and i + 1 < len(argv):
-            return argv[i + 1]
-    return default
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from macromarl_traces import install_pygame_stand_in  # noqa: E402  (one pygame stand-in)
+from reference_curve import flag  # noqa: E402  (one reading of the reference's argv)
 
 
 def stand_ins():
@@ -110,32 +104,7 @@ def stand_ins():
         for name in ["matplotlib", "matplotlib.pyplot"]:
             sys.modules[name] = types.ModuleType(name)
         sys.modules["matplotlib"].pyplot = sys.modules["matplotlib.pyplot"]
-    try:
-        import pygame  # noqa: F401
-    except ImportError:
-
-        class Stand:
-            """Any pygame name: callable, never drawn."""
-
-            def __init__(self, name):
-                self.name = name
-
-            def __call__(self, *args, **kwargs):
-                return Stand(self.name + "()")
-
-            def __getattr__(self, name):
-                return Stand(self.name + "." + name)
-
-        names = {}
-        stand_in = types.ModuleType("pygame")
-
-        def stand(name):
-            if name.startswith("__"):  # module protocol (inspect asks for __file__)
-                raise AttributeError(name)
-            return names.setdefault(name, Stand(name))
-
-        stand_in.__getattr__ = stand
-        sys.modules["pygame"] = stand_in
+    install_pygame_stand_in()
 
 
 def write_curve(out, rows):

@@ -5,6 +5,18 @@ use crate::algos::value::update::UpdateError;
 use crate::algos::value::ReplayError;
 use crate::envs::EnvError;
 
+impl TrainError {
+    /// A non-finite loss or parameter of `method`'s run `seed` at `episode`.
+    pub fn non_finite(method: Method, seed: u64, what: &'static str, episode: u64) -> Self {
+        TrainError::NonFinite {
+            method,
+            seed,
+            what,
+            episode,
+        }
+    }
+}
+
 /// Why training stopped early.
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {

@@ -266,20 +266,6 @@ impl GruActor {
         }
     }
 
-    /// Overwrite with `other`'s values (same sizes): the hard target copy.
-    pub fn copy_from(&mut self, other: &GruActor) {
-        for (d, s) in self.slices_mut().into_iter().zip(other.slices()) {
-            d.copy_from_slice(s);
-        }
-    }
-
-    /// Whether every parameter is finite.
-    pub fn is_finite(&self) -> bool {
-        self.slices()
-            .iter()
-            .all(|s| s.iter().all(|v| v.is_finite()))
-    }
-
     /// Put the parameters on `tape` as trainable leaves.
     pub fn bind(&self, tape: &mut Tape) -> GruActorVars {
         GruActorVars {

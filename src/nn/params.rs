@@ -15,6 +15,21 @@ pub trait Params {
     fn slices(&self) -> Vec<&[f32]>;
     /// The same, mutable.
     fn slices_mut(&mut self) -> Vec<&mut [f32]>;
+
+    /// Overwrite with `other`'s values (the same sizes): a hard target copy, no allocation.
+    /// Panics if a tensor's size differs.
+    fn copy_values_from(&mut self, other: &Self) {
+        for (d, s) in self.slices_mut().into_iter().zip(other.slices()) {
+            d.copy_from_slice(s);
+        }
+    }
+
+    /// Whether every element is finite.
+    fn all_finite(&self) -> bool {
+        self.slices()
+            .iter()
+            .all(|s| s.iter().all(|v| v.is_finite()))
+    }
 }
 
 /// A fully connected layer's parameters (PyTorch `nn.Linear`): weight [out, in], bias [out].

@@ -87,20 +87,6 @@ impl StateCritic {
         out
     }
 
-    /// Overwrite with `other`'s values (same sizes).
-    pub fn copy_from(&mut self, other: &StateCritic) {
-        for (d, s) in self.slices_mut().into_iter().zip(other.slices()) {
-            d.copy_from_slice(s);
-        }
-    }
-
-    /// Whether every parameter is finite.
-    pub fn is_finite(&self) -> bool {
-        self.slices()
-            .iter()
-            .all(|s| s.iter().all(|v| v.is_finite()))
-    }
-
     /// Put the parameters on `tape` as trainable leaves.
     pub fn bind(&self, tape: &mut Tape) -> StateCriticVars {
         StateCriticVars {

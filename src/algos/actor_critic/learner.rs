@@ -158,12 +158,7 @@ impl AcLearner {
     }
 
     fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
-        TrainError::NonFinite {
-            method: self.method,
-            seed: self.seed,
-            what,
-            episode: episodes,
-        }
+        TrainError::non_finite(self.method, self.seed, what, episodes)
     }
 }
 

@@ -19,8 +19,8 @@ impl CriticNet {
     /// Overwrite with `other` (same kind and sizes).
     pub fn copy_from(&mut self, other: &CriticNet) {
         match (self, other) {
-            (CriticNet::History(a), CriticNet::History(b)) => a.copy_from(b),
-            (CriticNet::State(a), CriticNet::State(b)) => a.copy_from(b),
+            (CriticNet::History(a), CriticNet::History(b)) => a.copy_values_from(b),
+            (CriticNet::State(a), CriticNet::State(b)) => a.copy_values_from(b),
             _ => unreachable!("a critic's target is the same kind of net"),
         }
     }
@@ -28,8 +28,8 @@ impl CriticNet {
     /// Whether every parameter is finite.
     pub fn is_finite(&self) -> bool {
         match self {
-            CriticNet::History(n) => n.is_finite(),
-            CriticNet::State(n) => n.is_finite(),
+            CriticNet::History(n) => n.all_finite(),
+            CriticNet::State(n) => n.all_finite(),
         }
     }
 
@@ -198,7 +198,7 @@ impl AcNets {
 
     /// Whether every parameter is finite.
     pub fn is_finite(&self) -> bool {
-        self.actors.iter().all(|a| a.net.is_finite())
+        self.actors.iter().all(|a| a.net.all_finite())
             && self
                 .critics
                 .iter()
