@@ -72,6 +72,7 @@ fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() 
             "overcooked_b",
             "overcooked_c",
             "wh_a",
+            "wh_ablation",
             "wh_b",
             "wh_c",
             "wh_d",
@@ -94,6 +95,9 @@ fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() 
         .actor_critic()
         .unwrap();
     assert_eq!((cac.a_rnn_layer_size, cac.c_target_update_freq), (64, 16));
+    let ablation = load("macromarl/wh_ablation.toml").runs().unwrap();
+    let iac = ablation[0].config.actor_critic().unwrap();
+    assert_eq!((iac.n_env, iac.c_lr), (16, 5e-4));
 }
 
 #[test]
