@@ -182,8 +182,9 @@ fn critic_inputs(p: &UpdateParams, batch: &[Episode], sq: &[Squeezed]) -> Vec<Cr
     let joint = p.obs_sizes.iter().sum::<usize>();
     let state_size = batch.first().map_or(0, |e| e.state_size);
     let g = p.gamma;
-    // The returns' side: an agent's own macro-actions or the team's joint macro-steps.
-    let agent_returns = |i: usize| {
+    // The returns' side: each episode's macro-actions ending at `ends`, with `reward`.
+    let returns_over = |ends: &dyn Fn(&Squeezed) -> &[usize],
+                        reward: &dyn Fn(&Episode, usize) -> f32| {
         let mut d = CriticData {
             lengths: Vec::new(),
             reward: Vec::new(),
@@ -193,29 +194,17 @@ fn critic_inputs(p: &UpdateParams, batch: &[Episode], sq: &[Squeezed]) -> Vec<Cr
             bootstraps: Inputs::State(Rows::new(0)),
         };
         for (e, s) in batch.iter().zip(sq) {
-            let ends = &s.agent_ends[i];
+            let ends = ends(s);
             d.lengths.push(ends.len());
-            d.reward.extend(ends.iter().map(|&t| e.reward(t, i)));
+            d.reward.extend(ends.iter().map(|&t| reward(e, t)));
             d.terminate.extend(ends.iter().map(|&t| e.terminate[t]));
             d.discount.extend(ends.iter().map(|&t| discount_at(g, t)));
         }
         d
     };
-    let joint_returns = || {
-        let mut d = agent_returns(0);
-        d.lengths.clear();
-        d.reward.clear();
-        d.terminate.clear();
-        d.discount.clear();
-        for (e, s) in batch.iter().zip(sq) {
-            let ends = &s.joint_ends;
-            d.lengths.push(ends.len());
-            d.reward.extend(ends.iter().map(|&t| e.joint_reward[t]));
-            d.terminate.extend(ends.iter().map(|&t| e.terminate[t]));
-            d.discount.extend(ends.iter().map(|&t| discount_at(g, t)));
-        }
-        d
-    };
+    // An agent's own macro-actions and rewards, or the team's joint macro-steps and reward.
+    let agent_returns = |i: usize| returns_over(&|s| &s.agent_ends[i], &|e, t| e.reward(t, i));
+    let joint_returns = || returns_over(&|s| &s.joint_ends, &|e, t| e.joint_reward[t]);
     let state_rows = |steps: &dyn Fn(usize) -> Vec<usize>| {
         let mut r = Rows::new(state_size);
         for (b, e) in batch.iter().enumerate() {
