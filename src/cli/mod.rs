@@ -197,7 +197,8 @@ struct Selection {
     /// Experiment TOML (see experiments/); without it, a short built-in Box Pushing 10x10 run.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2.
+    /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2 (ICRA 2020), mac-iac,
+    /// mac-cac, naive-mac-iacc, naive-mac-iasc, mac-iaicc, mac-iaisc (MacroMARL).
     #[arg(long, value_delimiter = ',')]
     methods: Option<Vec<String>>,
     /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.
