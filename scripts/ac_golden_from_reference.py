@@ -2,8 +2,8 @@
 """Golden actor-critic updates from the authors' MacroMARL reference code.
 
 Usage:
-    /tmp/tv/bin/python scripts/ac_golden_from_reference.py --ref /tmp/mm [--out tests/golden_ac]
-                                                          [--cases NAME ...] [--ref-commit SHA]
+    python3 scripts/ac_golden_from_reference.py --ref PATH/TO/MacroMARL [--out tests/golden_ac]
+                                                [--cases NAME ...] [--ref-commit SHA]
 
     --ref is a checkout (or `git archive`) of github.com/yuchen-x/MacroMARL; HEAD f5899cd7 was
     used. Needs Python 3 with torch, numpy, gym (0.26.2 was used; only `gym.Env` and

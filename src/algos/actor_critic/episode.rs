@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::envs::{MacroEnv, StepOutcome};
+use crate::envs::{FirstRecordObs, MacroEnv, StepOutcome};
 
 /// One recorded episode: row t of the per-step fields is primitive step t; `obs` and `state`
 /// have one more row (row t is the observation before step t, row t + 1 the one after it).
@@ -174,6 +174,19 @@ impl EpisodeRecorder {
         self.ret += g.powf(e.steps as f64) * sum / n as f64;
         e.steps += 1;
         self.push_observation(env);
+        // Quirk Q20 (`MacroEnv::first_record_obs`): the runner's first record holds the env's
+        // reset list, which the first step overwrote for the agents that finished in it.
+        let e = &mut self.episode;
+        if e.steps == 1 && env.first_record_obs() == FirstRecordObs::OverwrittenByFirstStep {
+            let mut at = 0;
+            for (i, &ended) in done.iter().enumerate() {
+                let len = env.obs(i).len();
+                if ended {
+                    e.obs[at..at + len].copy_from_slice(env.obs(i));
+                }
+                at += len;
+            }
+        }
     }
 
     /// The episode so far.
@@ -228,5 +241,35 @@ mod tests {
         }
         // The return is the discounted mean reward.
         assert!(rec.discounted_return().is_finite());
+    }
+
+    #[test]
+    fn the_first_record_shows_the_first_steps_observation_only_under_quirk_q20() {
+        use crate::algos::value::recorder::tests::{script, FakeEnv};
+        let mut s = script();
+        s[0].2 = [true, false]; // agent 0 finishes at step 1: its observation becomes 10
+        let first_obs = |first: FirstRecordObs| {
+            let mut rng = EnvRng::seed_from_u64(0);
+            let mut env = FakeEnv::new(s.clone());
+            env.first = first;
+            env.reset(&mut rng);
+            let mut rec = EpisodeRecorder::new(&env, 0.9, false);
+            for _ in 0..2 {
+                let o = env.step(&[0, 0], &mut rng).unwrap();
+                rec.record(&env, o);
+            }
+            let e = rec.episode();
+            (
+                e.obs_row(0).to_vec(),
+                e.obs_row(1).to_vec(),
+                e.obs_row(2).to_vec(),
+            )
+        };
+        let faithful = first_obs(FirstRecordObs::OverwrittenByFirstStep);
+        let fixed = first_obs(FirstRecordObs::Reset);
+        assert_eq!(faithful.0, [10.0, -2.0]);
+        assert_eq!(fixed.0, [-1.0, -2.0]);
+        // Later rows are the same either way.
+        assert_eq!((faithful.1, faithful.2), (fixed.1, fixed.2));
     }
 }

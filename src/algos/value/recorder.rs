@@ -229,14 +229,16 @@ impl Recorder {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::envs::{EnvError, EnvRng};
 
     /// A scripted 2-agent env with 1-float observations: step k returns the k-th scripted
     /// (executed, reward, mac_done, done); a finished agent's observation becomes 10 * k + agent,
-    /// a busy agent's observation is held. Reset observation: [-1, -2].
-    struct FakeEnv {
+    /// a busy agent's observation is held. Reset observation: [-1, -2]. It reports `first` as
+    /// its [`MacroEnv::first_record_obs`].
+    pub(crate) struct FakeEnv {
+        pub(crate) first: FirstRecordObs,
         script: Vec<([usize; 2], f64, [bool; 2], bool)>,
         k: usize,
         obs: [[f32; 1]; 2],
@@ -245,8 +247,9 @@ mod tests {
     }
 
     impl FakeEnv {
-        fn new(script: Vec<([usize; 2], f64, [bool; 2], bool)>) -> Self {
+        pub(crate) fn new(script: Vec<([usize; 2], f64, [bool; 2], bool)>) -> Self {
             Self {
+                first: FirstRecordObs::Reset,
                 script,
                 k: 0,
                 obs: [[-1.0], [-2.0]],
@@ -311,9 +314,12 @@ mod tests {
         fn render_ascii(&self) -> String {
             String::new()
         }
+        fn first_record_obs(&self) -> FirstRecordObs {
+            self.first
+        }
     }
 
-    fn script() -> Vec<([usize; 2], f64, [bool; 2], bool)> {
+    pub(crate) fn script() -> Vec<([usize; 2], f64, [bool; 2], bool)> {
         vec![
             ([1, 2], -1.0, [false, false], false), // step 1: both busy
             ([1, 2], -1.0, [true, false], false),  // step 2: agent 0 finishes (2 steps, -2)
