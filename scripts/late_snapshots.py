@@ -26,8 +26,9 @@ from compare_reference_curves import read_ours  # noqa: E402  (one reader of a r
 
 
 def late(returns):
-    """The last 10% of evaluations (at least one), as the figures' final return takes them."""
-    k = max(1, len(returns) // 10)
+    """The last 10% of evaluations, ceil(n / 10) and at least one, exactly as the figures' final
+    return takes them (macdec's curve_stats::final_count)."""
+    k = max(1, -(-len(returns) // 10))
     return returns[-k:]
 
 

@@ -6,8 +6,116 @@
 use std::collections::BTreeMap;
 
 /// Points on each side of the centre in the paper's smoothing: window 21 = the point plus 10
-/// neighbours on each side (spec 7.2, open question O1).
+/// neighbours on each side (spec 7.2, open question O1). The widest window [`Smoothing::Auto`]
+/// chooses.
 pub const SMOOTH_HALF_WINDOW: usize = 10;
+
+/// [`Smoothing::Auto`]'s half window is the curve's evaluation count divided by this (at most
+/// [`SMOOTH_HALF_WINDOW`]): a curve of fewer than 80 points moves by at most one evaluation
+/// spacing, one of 400 or more (every committed figure) gets the paper's 21 points.
+pub const AUTO_POINTS_PER_HALF_WINDOW: usize = 40;
+
+/// The widest window a user may ask for, in evaluation points or episodes (far beyond any run;
+/// a bound so a typo cannot make the moving average quadratic in a huge number).
+pub const MAX_SMOOTH_WINDOW: u64 = 1_000_001;
+
+/// How a curve is smoothed before it is drawn and read for "95% of optimal first at"
+/// (`macdec plot --smooth`). A centred moving average can move the point where a curve crosses
+/// a level by up to its half window, so short or coarsely evaluated curves need a narrow one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Smoothing {
+    /// Half window = evaluation points / [`AUTO_POINTS_PER_HALF_WINDOW`], at most
+    /// [`SMOOTH_HALF_WINDOW`] (`auto`, the default).
+    #[default]
+    Auto,
+    /// A centred window of this many evaluation points, odd; 1 is no smoothing (`0` and `1`
+    /// on the command line, or `<n>`).
+    Points(u64),
+    /// A centred window spanning about this many training episodes (`<n>ep`): the half window
+    /// is n / 2 divided by the curve's evaluation spacing (its median), rounded down.
+    Episodes(u64),
+}
+
+impl Smoothing {
+    /// No smoothing.
+    pub const NONE: Smoothing = Smoothing::Points(1);
+
+    /// Parse `auto`, `0` (none), an odd number of evaluation points, or `<n>ep` episodes.
+    pub fn parse(text: &str) -> Result<Smoothing, String> {
+        let text = text.trim();
+        if text == "auto" {
+            return Ok(Smoothing::Auto);
+        }
+        let (digits, episodes) = match text.strip_suffix("ep") {
+            Some(d) => (d, true),
+            None => (text, false),
+        };
+        let n: u64 = digits.parse().map_err(|_| {
+            format!(
+                "`{text}` is not a smoothing: give `auto`, `0` (none), an odd number of \
+                 evaluation points such as `21`, or a number of training episodes such as `2000ep`"
+            )
+        })?;
+        if n > MAX_SMOOTH_WINDOW {
+            return Err(format!(
+                "a smoothing window of {n} is beyond the limit {MAX_SMOOTH_WINDOW}"
+            ));
+        }
+        if episodes {
+            return Ok(Smoothing::Episodes(n));
+        }
+        match n {
+            0 | 1 => Ok(Smoothing::NONE),
+            n if n % 2 == 0 => Err(format!(
+                "a centred window has an odd number of points: `{n}` is even (use {} or {})",
+                n - 1,
+                n + 1
+            )),
+            n => Ok(Smoothing::Points(n)),
+        }
+    }
+
+    /// The half window for a curve evaluated at `episodes` (sorted): points on each side of the
+    /// centre that [`smooth`] averages.
+    pub fn half_window(&self, episodes: &[u64]) -> usize {
+        let at_most_len = |h: u64| h.min(episodes.len() as u64) as usize;
+        match *self {
+            Smoothing::Auto => {
+                (episodes.len() / AUTO_POINTS_PER_HALF_WINDOW).min(SMOOTH_HALF_WINDOW)
+            }
+            Smoothing::Points(n) => at_most_len(n.saturating_sub(1) / 2),
+            Smoothing::Episodes(n) => match median_spacing(episodes) {
+                Some(spacing) => at_most_len(n / 2 / spacing),
+                None => 0,
+            },
+        }
+    }
+}
+
+impl std::fmt::Display for Smoothing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Smoothing::Auto => write!(f, "auto"),
+            Smoothing::Points(n) if *n <= 1 => write!(f, "0"),
+            Smoothing::Points(n) => write!(f, "{n}"),
+            Smoothing::Episodes(n) => write!(f, "{n}ep"),
+        }
+    }
+}
+
+/// The median gap between consecutive evaluation episodes (the lower middle of an even count);
+/// `None` for fewer than two points.
+fn median_spacing(episodes: &[u64]) -> Option<u64> {
+    let mut gaps: Vec<u64> = episodes
+        .windows(2)
+        .map(|w| w[1].saturating_sub(w[0]).max(1))
+        .collect();
+    if gaps.is_empty() {
+        return None;
+    }
+    gaps.sort_unstable();
+    Some(gaps[(gaps.len() - 1) / 2])
+}
 
 /// One evaluation point of a curve aggregated over runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,13 +201,19 @@ pub fn smooth(points: &[CurvePoint], half_window: usize) -> Vec<CurvePoint> {
 /// Fraction of a run's last evaluations averaged into its final return.
 pub const FINAL_FRACTION: f64 = 0.1;
 
+/// How many of a run's `n` evaluations are its "last 10%": ceil(n / 10), at least one, in
+/// integers (`scripts/late_snapshots.py` takes the same count).
+pub fn final_count(n: usize) -> usize {
+    n.div_ceil(10).max(1)
+}
+
 /// A run's final return: the mean of its last 10% of evaluations (at least one), which is what
 /// the tables and tests compare (one late evaluation is too noisy on its own).
 pub fn final_return(points: &[(u64, f64)]) -> Option<f64> {
     if points.is_empty() {
         return None;
     }
-    let k = ((points.len() as f64 * FINAL_FRACTION).ceil() as usize).clamp(1, points.len());
+    let k = final_count(points.len());
     let tail = &points[points.len() - k..];
     Some(tail.iter().map(|p| p.1).sum::<f64>() / k as f64)
 }
@@ -162,6 +276,82 @@ mod tests {
         assert_eq!(final_return(&pts), Some(23.0));
         assert_eq!(final_return(&pts[..1]), Some(0.0));
         assert_eq!(final_return(&[]), None);
+    }
+
+    #[test]
+    fn the_last_tenth_rounds_up_and_keeps_one() {
+        let counts: Vec<usize> = [0, 1, 9, 10, 11, 30, 400, 417, 1501, 4001]
+            .iter()
+            .map(|&n| final_count(n))
+            .collect();
+        assert_eq!(counts, vec![1, 1, 1, 1, 2, 3, 40, 42, 151, 401]);
+        // The same as the fraction's ceiling wherever floating point would round it.
+        for n in 1..5000 {
+            assert_eq!(final_count(n), (n as f64 * FINAL_FRACTION).ceil() as usize);
+        }
+    }
+
+    #[test]
+    fn smoothing_parses_auto_none_points_and_episodes() {
+        assert_eq!(Smoothing::parse("auto"), Ok(Smoothing::Auto));
+        assert_eq!(Smoothing::parse("0"), Ok(Smoothing::NONE));
+        assert_eq!(Smoothing::parse("1"), Ok(Smoothing::NONE));
+        assert_eq!(Smoothing::parse("21"), Ok(Smoothing::Points(21)));
+        assert_eq!(Smoothing::parse("2000ep"), Ok(Smoothing::Episodes(2000)));
+        let even = Smoothing::parse("20").unwrap_err();
+        assert!(even.contains("odd") && even.contains("19 or 21"), "{even}");
+        for bad in ["", "-3", "ep", "1.5", "lots", "99999999999999999999"] {
+            assert!(Smoothing::parse(bad).is_err(), "{bad}");
+        }
+        assert!(Smoothing::parse("2000000").unwrap_err().contains("limit"));
+        for s in ["auto", "0", "21", "2000ep"] {
+            assert_eq!(Smoothing::parse(s).unwrap().to_string(), s);
+        }
+    }
+
+    #[test]
+    fn auto_smoothing_keeps_short_curves_within_one_evaluation() {
+        let episodes = |n: u64| (0..n).map(|i| i * 200).collect::<Vec<u64>>();
+        let auto = |n| Smoothing::Auto.half_window(&episodes(n));
+        // The custom-domain example: 16 points, not smoothed at all.
+        assert_eq!(auto(16), 0);
+        assert_eq!(auto(39), 0);
+        assert_eq!(auto(40), 1);
+        assert_eq!(auto(79), 1);
+        // MacroMARL's 400-point runs and the paper's 1501 and 4001 get the paper's 21 points.
+        assert_eq!(auto(400), SMOOTH_HALF_WINDOW);
+        assert_eq!(auto(4001), SMOOTH_HALF_WINDOW);
+        assert_eq!(Smoothing::NONE.half_window(&episodes(100)), 0);
+        assert_eq!(Smoothing::Points(21).half_window(&episodes(100)), 10);
+        assert_eq!(Smoothing::Points(999).half_window(&episodes(5)), 5);
+        // 2000 episodes at a spacing of 200: 5 points each side.
+        assert_eq!(Smoothing::Episodes(2000).half_window(&episodes(100)), 5);
+        assert_eq!(Smoothing::Episodes(2000).half_window(&episodes(1)), 0);
+        // The median spacing ignores one short last gap (a run's final evaluation).
+        let mut e = episodes(10);
+        e.push(1801);
+        assert_eq!(Smoothing::Episodes(1000).half_window(&e), 2);
+    }
+
+    #[test]
+    fn auto_smoothing_moves_a_short_curves_reach_by_at_most_one_evaluation() {
+        // A step from 0 to 10 at every possible point of curves of 2..80 points: the smoothed
+        // curve first reaches 9.5 within one evaluation of the step.
+        for n in 2..80usize {
+            for step in 1..n {
+                let pts: Vec<CurvePoint> = (0..n)
+                    .map(|i| pt(i as u64 * 100, if i >= step { 10.0 } else { 0.0 }))
+                    .collect();
+                let eps: Vec<u64> = pts.iter().map(|p| p.episode).collect();
+                let s = smooth(&pts, Smoothing::Auto.half_window(&eps));
+                let at = first_reaching(&s, 9.5).map_or(n as u64 * 100, |e| e);
+                let true_at = step as u64 * 100;
+                assert!(
+                    at.abs_diff(true_at) <= 100,
+                    "n {n} step {step}: {at} vs {true_at}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -50,18 +50,36 @@ enum Command {
         #[arg(long)]
         verbose: bool,
     },
+    /// Every run's metrics as one long CSV (experiment, method, variant, seed, then the
+    /// metrics columns), for pandas or R.
+    Results {
+        /// Results root: <results>/<experiment>/<curve>/seed-<k>/metrics.csv[.gz] (also one
+        /// level deeper, as in reproduction/macromarl/<block>/...).
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        /// The CSV file to write (atomically); without it, the table goes to stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Draw every experiment's learning curves (PNG + SVG) and summary tables from a results tree.
     Plot {
         /// Results root: <results>/<experiment>/<curve>/seed-<k>/metrics.csv.
         #[arg(long, default_value = "results")]
         results: PathBuf,
-        /// Where the figures and <experiment>_summary.csv files go.
-        #[arg(long, default_value = "plots")]
-        out: PathBuf,
+        /// Where the figures and <experiment>_summary.csv files go (default: the results root,
+        /// as `train` does; only an explicit `--out plots` redraws the committed figures).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// The metrics.csv column to plot: eval_return, or any other (env_steps, updates, a
         /// method family's own such as loss or epsilon); files become <experiment>_<metric>.*.
         #[arg(long, default_value = "eval_return")]
         metric: String,
+        /// Centred moving average before drawing and reading "95% of optimal first at":
+        /// `auto` (half window = evaluation points / 40, at most 10: 21 points on long runs,
+        /// none under 40 points), `0` (none), an odd number of evaluation points (`21`), or
+        /// training episodes (`2000ep`).
+        #[arg(long, default_value = "auto", value_parser = crate::curve_stats::Smoothing::parse)]
+        smooth: crate::curve_stats::Smoothing,
     },
     /// Animate a trained run's greedy policy as a GIF.
     Render {
@@ -490,11 +508,20 @@ fn run() -> Result<()> {
             );
             Ok(())
         }
+        Command::Results { results, out } => tidy_results(&results, out.as_deref()),
         Command::Plot {
             results,
             out,
             metric,
-        } => plot(&results, &out, &metric),
+            smooth,
+        } => {
+            let out = out.unwrap_or_else(|| results.clone());
+            let options = crate::plot::PlotOptions {
+                metric,
+                smoothing: smooth,
+            };
+            plot(&results, &out, &options)
+        }
         Command::Demo { steps, seed } => demo_run(steps, seed),
         Command::Bench {
             what,
@@ -810,8 +837,8 @@ fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
     Ok(())
 }
 
-fn plot(results: &Path, out: &Path, metric: &str) -> Result<()> {
-    let report = crate::plot::plot_results_metric(results, out, metric)
+fn plot(results: &Path, out: &Path, options: &crate::plot::PlotOptions) -> Result<()> {
+    let report = crate::plot::plot_results_with(results, out, options)
         .with_context(|| format!("plotting {} into {}", results.display(), out.display()))?;
     for note in &report.notes {
         eprintln!("{note}");
@@ -826,6 +853,29 @@ fn plot(results: &Path, out: &Path, metric: &str) -> Result<()> {
         );
     }
     print!("{}", report.markdown());
+    Ok(())
+}
+
+fn tidy_results(results: &Path, out: Option<&Path>) -> Result<()> {
+    use crate::experiment::tidy_table::{write_tidy_file, write_tidy_table};
+    let context = || format!("tabulating the runs of {}", results.display());
+    match out {
+        Some(path) => {
+            let (runs, rows) = write_tidy_file(results, path).with_context(context)?;
+            eprintln!("wrote {} ({runs} runs, {rows} rows)", path.display());
+        }
+        None => {
+            let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
+            match write_tidy_table(results, &mut stdout) {
+                // A reader that stops early (`| head`) is not an error.
+                Err(crate::experiment::tidy_table::TidyError::Write { source, .. })
+                    if source.kind() == std::io::ErrorKind::BrokenPipe => {}
+                other => {
+                    other.with_context(context)?;
+                }
+            }
+        }
+    }
     Ok(())
 }
 

@@ -5,7 +5,7 @@
 use super::discover::{CurveData, ExperimentData, EVAL_RETURN};
 use super::stats::{
     aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training,
-    run_mean_over_training, smooth, CurvePoint, SMOOTH_HALF_WINDOW,
+    run_mean_over_training, smooth, CurvePoint, Smoothing,
 };
 use super::summary::CurveSummary;
 use crate::algos::method::{Family, Method};
@@ -59,14 +59,15 @@ const PALETTE: [Rgb; 9] = [
     (188, 189, 34),
 ];
 
-/// Build the figure and summary of one experiment's `eval_return` curves.
+/// Build the figure and summary of one experiment's `eval_return` curves, smoothed by default.
 pub fn build(exp: &ExperimentData) -> Built {
-    build_metric(exp, EVAL_RETURN)
+    build_metric(exp, EVAL_RETURN, Smoothing::Auto)
 }
 
 /// Build the figure and summary of one experiment whose runs were read for the `metric` column
-/// ([`crate::plot::discover::discover_metric`]). Only `eval_return` has an optimal line.
-pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
+/// ([`crate::plot::discover::discover_metric`]), each curve smoothed as `smoothing` says for its
+/// own evaluation points. Only `eval_return` has an optimal line.
+pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) -> Built {
     let mut notes = Vec::new();
     let (optimal, setting_text) = common_setting(exp, &mut notes);
     let optimal = optimal.filter(|_| metric == EVAL_RETURN);
@@ -82,8 +83,16 @@ pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
         };
         let runs: Vec<&[(u64, f64)]> = curve.runs.iter().map(|r| r.points.as_slice()).collect();
         let mean = aggregate(&runs);
-        let points = smooth(&mean, SMOOTH_HALF_WINDOW);
-        summary.push(summarize(curve, &mean, &points, optimal));
+        let episodes: Vec<u64> = mean.iter().map(|p| p.episode).collect();
+        let half_window = smoothing.half_window(&episodes);
+        let points = smooth(&mean, half_window);
+        summary.push(summarize(
+            curve,
+            &mean,
+            &points,
+            optimal,
+            2 * half_window + 1,
+        ));
         series.push(Series {
             label: label(curve),
             colour,
@@ -121,9 +130,8 @@ pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
         format!("`{metric}`")
     };
     let mut caption = format!(
-        "Mean over seeds of {quantity}; band: standard error (ddof 1); \
-         both smoothed by a centred moving average over {} evaluation points.",
-        2 * SMOOTH_HALF_WINDOW + 1
+        "Mean over seeds of {quantity}; band: standard error (ddof 1); {}.",
+        smoothing_caption(&summary)
     );
     if let Some(mix) = provenance_mix(exp) {
         notes.push(format!("{}: {mix}", exp.name));
@@ -144,6 +152,28 @@ pub fn build_metric(exp: &ExperimentData, metric: &str) -> Built {
         },
         summary,
         notes,
+    }
+}
+
+/// How the drawn curves were smoothed, from the summary rows' windows: one window for all,
+/// none, or one per curve.
+fn smoothing_caption(rows: &[CurveSummary]) -> String {
+    let mut windows: Vec<usize> = rows.iter().map(|r| r.smoothing_points).collect();
+    windows.sort_unstable();
+    windows.dedup();
+    match windows.as_slice() {
+        [] | [1] => "not smoothed".to_string(),
+        [w] => format!("both smoothed by a centred moving average over {w} evaluation points"),
+        _ => {
+            let per_curve: Vec<String> = rows
+                .iter()
+                .map(|r| format!("{} {}", r.legend, r.smoothing_points))
+                .collect();
+            format!(
+                "both smoothed by a centred moving average over evaluation points ({})",
+                per_curve.join(", ")
+            )
+        }
     }
 }
 
@@ -215,12 +245,14 @@ fn label(curve: &CurveData) -> String {
 }
 
 /// The row of the table: final returns over the runs that reach the last episode, where the
-/// smoothed mean first reaches 95% of the optimum, the mean over training, and run times.
+/// smoothed mean (a window of `smoothing_points`) first reaches 95% of the optimum, the mean over
+/// training, and run times.
 fn summarize(
     curve: &CurveData,
     mean: &[CurvePoint],
     smoothed: &[CurvePoint],
     optimal: Option<f64>,
+    smoothing_points: usize,
 ) -> CurveSummary {
     let final_episode = mean
         .last()
@@ -255,6 +287,7 @@ fn summarize(
         final_n: final_returns.len(),
         best_mean: mean_and_se(&best).map_or(f64::NAN, |(m, _)| m),
         reach95_episode: optimal.and_then(|o| first_reaching(smoothed, 0.95 * o)),
+        smoothing_points,
         mean_over_training: mean_over_training(mean).unwrap_or(f64::NAN),
         optimal,
         run_minutes: (!finished.is_empty())

@@ -28,8 +28,9 @@ pub struct CurveSummary {
     /// Runs that reach the last evaluation episode, over which the final return is taken
     /// (less than `seeds` when some are unfinished).
     pub final_n: usize,
-    /// The first episode at which the smoothed mean curve reaches 95% of the optimal return
-    /// (empty if it never does or the optimum is unknown).
+    /// The first episode at which the smoothed mean curve (the one drawn, `smoothing_points`
+    /// wide) reaches 95% of the optimal return (empty if it never does or the optimum is
+    /// unknown).
     pub reach95_episode: Option<u64>,
     /// Area under the (unsmoothed) mean curve over its episode span: its average height.
     pub mean_over_training: f64,
@@ -41,6 +42,9 @@ pub struct CurveSummary {
     /// ([`crate::plot::stats::best_return`]): the level of a best-snapshot policy, the kind the
     /// reference saves and its authors ship.
     pub best_mean: f64,
+    /// (After `best_mean`, for the same reason.) The centred moving average's window in
+    /// evaluation points of the drawn curve that `reach95_episode` reads; 1 = not smoothed.
+    pub smoothing_points: usize,
     /// The `final_n` runs' final returns, for the tests between curves.
     #[serde(skip)]
     pub final_returns: Vec<f64>,
@@ -114,7 +118,8 @@ pub fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<(), PlotError>
 /// one-sided Welch p-values between them.
 pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) -> String {
     let mut s = format!(
-        "### {title}\n\n| method | seeds (finished) | final episode | final return (mean ± SE) | best evaluation (mean) | 95% of optimal first at | mean over training | optimal | minutes per run |\n|---|---|---|---|---|---|---|---|---|\n"
+        "### {title}\n\n| method | seeds (finished) | final episode | final return (mean ± SE) | best evaluation (mean) | 95% of optimal first at ({}) | mean over training | optimal | minutes per run |\n|---|---|---|---|---|---|---|---|---|\n",
+        reach_curve(rows)
     );
     for r in rows {
         let optimal = r.optimal.map_or("n/a".into(), format_return);
@@ -158,6 +163,19 @@ pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) ->
         );
     }
     s
+}
+
+/// Which curve the "95% of optimal first at" column reads: the mean over seeds as drawn, with
+/// its smoothing window (one for all rows, or per row in the summary CSV).
+pub fn reach_curve(rows: &[CurveSummary]) -> String {
+    let mut windows: Vec<usize> = rows.iter().map(|r| r.smoothing_points).collect();
+    windows.sort_unstable();
+    windows.dedup();
+    match windows.as_slice() {
+        [] | [1] => "unsmoothed mean".to_string(),
+        [w] => format!("mean smoothed over {w} evaluations"),
+        _ => "smoothed mean, window per curve in the summary CSV".to_string(),
+    }
 }
 
 /// Append one matrix of p-values (row above column) under its heading line.
@@ -224,6 +242,7 @@ mod tests {
             mean_over_training: 55.5,
             optimal: Some(80.71093744250365),
             run_minutes: Some(12.34),
+            smoothing_points: 21,
             final_returns: finals.to_vec(),
             training_means: training.to_vec(),
         }
@@ -300,8 +319,8 @@ mod tests {
         let text = std::fs::read_to_string(&p).unwrap();
         assert_eq!(
             text,
-            "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,reach95_episode,mean_over_training,optimal,run_minutes,best_mean\n\
-             our1,Our-1,3,2,1500,1.0,0.0,1,,55.5,,,81.25\n"
+            "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,reach95_episode,mean_over_training,optimal,run_minutes,best_mean,smoothing_points\n\
+             our1,Our-1,3,2,1500,1.0,0.0,1,,55.5,,,81.25,21\n"
         );
     }
 

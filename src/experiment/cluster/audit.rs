@@ -91,48 +91,9 @@ impl RunAudit {
 /// sorted by path. Shared curves reached through another experiment are listed once, where they
 /// live.
 pub fn finished_runs(results: &Path) -> Result<Vec<PathBuf>, AuditError> {
-    let mut runs = Vec::new();
-    collect_runs(results, RUN_DEPTHS.end, &mut runs)?;
-    runs.sort();
-    Ok(runs)
-}
-
-/// How deep below the results root a run directory may sit.
-const RUN_DEPTHS: std::ops::Range<usize> = 3..5;
-
-fn collect_runs(dir: &Path, levels: usize, runs: &mut Vec<PathBuf>) -> Result<(), AuditError> {
-    if levels == 0 {
-        return Ok(());
-    }
-    let subs = subdirs(dir).map_err(|source| AuditError::ReadTree {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    for sub in subs {
-        let depth = RUN_DEPTHS.end - levels + 1;
-        if RUN_DEPTHS.contains(&depth)
-            && results_tree::is_finished(&sub)
-            && sub.join(CONFIG).is_file()
-        {
-            runs.push(sub);
-        } else {
-            collect_runs(&sub, levels - 1, runs)?;
-        }
-    }
-    Ok(())
-}
-
-fn subdirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
-    let mut dirs = Vec::new();
-    for entry in std::fs::read_dir(dir)? {
-        let entry = entry?;
-        // Real directories only: a symlinked curve is someone else's run, audited where it lives.
-        if entry.file_type()?.is_dir() {
-            dirs.push(entry.path());
-        }
-    }
-    dirs.sort();
-    Ok(dirs)
+    let is_run = |dir: &Path| results_tree::is_finished(dir) && dir.join(CONFIG).is_file();
+    results_tree::find_runs(results, &is_run)
+        .map_err(|(path, source)| AuditError::ReadTree { path, source })
 }
 
 /// `k` of `runs` chosen at random with `seed` (all of them when `k` is at least their number),

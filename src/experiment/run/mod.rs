@@ -1,6 +1,7 @@
 //! Running it and what a run writes: the parallel runner ([`runner`], [`work_queue`]), one run on
 //! disk with resume ([`train_run`]), its files ([`results_tree`] names them; [`checkpoint`],
-//! [`metrics`], [`policy_files`], [`provenance`]) and the terminal summary ([`report`]).
+//! [`metrics`], [`policy_files`], [`provenance`]), the terminal summary ([`report`]) and every
+//! run of a tree as one table ([`tidy_table`]).
 
 pub mod checkpoint;
 pub mod metrics;
@@ -9,5 +10,6 @@ pub mod provenance;
 pub mod report;
 pub mod results_tree;
 pub mod runner;
+pub mod tidy_table;
 pub mod train_run;
 pub mod work_queue;

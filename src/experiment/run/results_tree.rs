@@ -48,6 +48,56 @@ pub fn is_finished(dir: &Path) -> bool {
     dir.join(FINISHED).is_file()
 }
 
+/// How deep below a results root a run directory may sit: `<experiment>/<curve>/seed-<k>` (3),
+/// or one level deeper in a group of experiments such as `macromarl/<block>/<method>/seed-<k>`.
+pub const RUN_DEPTHS: std::ops::Range<usize> = 3..5;
+
+/// Every run directory below `root`: a real directory (links are not followed: a linked curve
+/// is another experiment's run, listed where it lives) at a depth in [`RUN_DEPTHS`] for which
+/// `is_run` holds; a directory that is not a run is searched further down. Sorted by path. An
+/// unreadable directory is the error, with its path.
+pub fn find_runs(
+    root: &Path,
+    is_run: &dyn Fn(&Path) -> bool,
+) -> Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
+    let mut runs = Vec::new();
+    collect_runs(root, 1, is_run, &mut runs)?;
+    runs.sort();
+    Ok(runs)
+}
+
+fn collect_runs(
+    dir: &Path,
+    depth: usize,
+    is_run: &dyn Fn(&Path) -> bool,
+    runs: &mut Vec<PathBuf>,
+) -> Result<(), (PathBuf, std::io::Error)> {
+    if depth >= RUN_DEPTHS.end {
+        return Ok(());
+    }
+    for sub in real_subdirs(dir).map_err(|e| (dir.to_path_buf(), e))? {
+        if RUN_DEPTHS.contains(&depth) && is_run(&sub) {
+            runs.push(sub);
+        } else {
+            collect_runs(&sub, depth + 1, is_run, runs)?;
+        }
+    }
+    Ok(())
+}
+
+/// The subdirectories of `dir` that are directories themselves, not links to one, by name.
+fn real_subdirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut dirs = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        if entry.file_type()?.is_dir() {
+            dirs.push(entry.path());
+        }
+    }
+    dirs.sort();
+    Ok(dirs)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
