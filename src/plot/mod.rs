@@ -1,13 +1,14 @@
 //! Learning-curve figures like the paper's (spec `algorithms.md` 7.2), from a results tree.
 //!
 //! `discover` finds the runs, `stats` turns them into smoothed mean and standard-error curves,
-//! `figure` decides what is drawn, `render` draws it (PNG and SVG), `summary` tabulates the final
+//! `figure` decides what is drawn, `render` draws it (PNG and SVG; `legend` finds its place), `summary` tabulates the final
 //! returns. [`plot_results`] runs the whole pipeline for `macdec plot`.
 
 pub mod discover;
 pub mod error;
 pub mod figure;
 pub mod font;
+pub mod legend;
 pub mod render;
 pub mod setting;
 /// The curve statistics live below both `plot` and `experiment` ([`crate::curve_stats`]), so

@@ -5,7 +5,9 @@
 use super::error::PlotError;
 use super::figure::{Figure, Rgb};
 use super::font::{self, FAMILY};
+use super::legend;
 use super::summary::format_return;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -19,6 +21,9 @@ const AXIS_DESC_PX: u32 = 24;
 const TICK_PX: u32 = 19;
 const LEGEND_PX: u32 = 19;
 const CAPTION_PX: u32 = 16;
+/// The legend's margin around its text and keys, and the width of its key column.
+const LEGEND_MARGIN_PX: u32 = 16;
+const LEGEND_KEY_PX: u32 = 36;
 const OPTIMAL_RED: RGBColor = RGBColor(214, 39, 40);
 
 /// Draw `fig` into a PNG file at `path`.
@@ -189,15 +194,26 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     }
 
     let (xr, yr) = ranges(fig);
+    let build = |yr: std::ops::Range<f64>| {
+        ChartBuilder::on(&main)
+            .margin_left(16)
+            .margin_right(36)
+            .margin_top(8)
+            .x_label_area_size(64)
+            .y_label_area_size(90)
+            .build_cartesian_2d(xr.clone(), yr)
+    };
+    let legend_size = legend_size(fig).map_err(|e| e.to_string())?;
+    let mut chart = build(yr.clone()).map_err(e)?;
+    let (mut legend_at, covered) = occupancy(&chart, fig).best_place(legend_size);
+    if covered > 0 {
+        // Nowhere is free: make room above the data.
+        let area_h = chart.plotting_area().get_pixel_range().1.len() as i32;
+        let top = yr.end + legend::headroom(yr.clone(), area_h, legend_size.1);
+        chart = build(yr.start..top).map_err(e)?;
+        legend_at = occupancy(&chart, fig).best_place(legend_size).0;
+    }
     let (x_lo, x_hi) = (xr.start, xr.end);
-    let mut chart = ChartBuilder::on(&main)
-        .margin_left(16)
-        .margin_right(36)
-        .margin_top(8)
-        .x_label_area_size(64)
-        .y_label_area_size(90)
-        .build_cartesian_2d(xr, yr)
-        .map_err(e)?;
     chart
         .configure_mesh()
         .x_desc("training episodes")
@@ -262,7 +278,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
                     .map(|(a, b)| PathElement::new(vec![(a, opt), (b, opt)], style)),
             )
             .map_err(e)?
-            .label(format!("optimal return {}", format_return(opt)))
+            .label(optimal_label(opt))
             .legend(move |(x, y)| {
                 EmptyElement::at((x, y))
                     + PathElement::new(vec![(0, 0), (12, 0)], style)
@@ -272,15 +288,70 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .margin(16)
-        .legend_area_size(36)
+        .position(SeriesLabelPosition::Coordinate(legend_at.0, legend_at.1))
+        .margin(LEGEND_MARGIN_PX)
+        .legend_area_size(LEGEND_KEY_PX)
         .label_font((FAMILY, LEGEND_PX))
         .background_style(WHITE.mix(0.88))
         .border_style(BLACK.mix(0.35))
         .draw()
         .map_err(e)?;
     Ok(())
+}
+
+/// The legend's size in pixels as plotters lays it out: the labels' text block, the key's
+/// width and the margin around both.
+fn legend_size(fig: &Figure) -> Result<(i32, i32), String> {
+    let font = TextStyle::from((FAMILY, LEGEND_PX).into_font());
+    let mut text = MultiLineText::<_, &str>::new((0, 0), &font);
+    for s in &fig.series {
+        text.push_line(s.label.as_str());
+    }
+    let optimal = fig.optimal.map(optimal_label);
+    if let Some(label) = &optimal {
+        text.push_line(label.as_str());
+    }
+    let (w, h) = text.estimate_dimension().map_err(|e| format!("{e:?}"))?;
+    let margin = LEGEND_MARGIN_PX as i32;
+    Ok((w + LEGEND_KEY_PX as i32 + 2 * margin, h + 2 * margin))
+}
+
+/// The legend text of the optimal line.
+fn optimal_label(opt: f64) -> String {
+    format!("optimal return {}", format_return(opt))
+}
+
+/// The plotting area's pixels that curves, bands and the optimal line are drawn on.
+fn occupancy<DB: DrawingBackend>(
+    chart: &ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    fig: &Figure,
+) -> legend::Occupancy {
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let mut occupied = legend::Occupancy::new(xs.len() as i32, ys.len() as i32);
+    let (y_lo, y_hi) = (ys.start, ys.end);
+    let px = |x: f64, y: f64| {
+        let y = y.clamp(-MAX_AXIS, MAX_AXIS);
+        let (px, py) = chart.backend_coord(&(x, y));
+        (px - xs.start, py.clamp(y_lo - 1, y_hi) - ys.start)
+    };
+    for s in &fig.series {
+        let band: Vec<(i32, i32, i32, i32)> = s
+            .points
+            .iter()
+            .map(|p| {
+                let x = p.episode as f64;
+                let (x_px, mean) = px(x, p.mean);
+                let top = px(x, p.mean + p.se).1;
+                let bottom = px(x, p.mean - p.se).1;
+                (x_px, mean, top, bottom)
+            })
+            .collect();
+        occupied.mark_band(&band);
+    }
+    if let Some(opt) = fig.optimal {
+        occupied.mark_row(px(xs.start as f64, opt).1);
+    }
+    occupied
 }
 
 /// Tick labels without trailing zeros: 80, 2.5, -10.
@@ -418,5 +489,38 @@ mod tests {
             let done = rx.recv_timeout(std::time::Duration::from_secs(60));
             assert_eq!(done, Ok(true), "mean {mean}, se {se}");
         }
+    }
+
+    #[test]
+    fn the_legend_goes_where_no_curve_is() {
+        // Two flat curves along the top and the bottom of the axes: the lower right (the usual
+        // place) holds the low one, the middle right is free.
+        let flat = |label: &str, mean: f64| crate::plot::figure::Series {
+            label: label.into(),
+            colour: (0, 0, 0),
+            points: (0..50)
+                .map(|i| CurvePoint {
+                    episode: i * 100,
+                    mean,
+                    se: 1.0,
+                    n: 2,
+                })
+                .collect(),
+        };
+        let mut fig = figure_of(Vec::new());
+        fig.series = vec![flat("flat low", 0.0), flat("flat high", 100.0)];
+        fig.optimal = None;
+        let svg = render_svg(&fig, Path::new("t.svg")).unwrap();
+        let at = svg
+            .find(">\nflat low\n<")
+            .expect("the legend names the curve");
+        let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+        let y: f64 = tag
+            .split("y=\"")
+            .nth(1)
+            .and_then(|rest| rest.split('"').next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no y in {tag}"));
+        assert!((250.0..450.0).contains(&y), "legend text at y = {y}");
     }
 }
