@@ -110,7 +110,7 @@ golden.json:
       0 last_state->state, 1 obs, 2 mac_start, 3 (avail), 4 action, 5 reward, 6 joint_reward,
       7 state->next_state, 8 next_obs, 9 (avail), 10 terminate, 11 valid, 12 joint_valid,
       13 exp_valid
-  Field meanings (spec 2.2): obs[i] agent i's observation before the step (held while busy);
+  Field meanings (docs/MACROMARL.md §2.2): obs[i] agent i's observation before the step (held while busy);
   mac_start[i] 1 on the first primitive step of agent i's macro-action; action[i] the executed
   macro-action (info['cur_mac']); reward[i] acc_i, agent i's macro-reward discounted inside the
   macro-action, as accumulated so far; joint_reward accJ, the same for the joint macro-action

@@ -22,7 +22,7 @@ instrumented at run time:
   * `gym` and `matplotlib` are not needed by the learners and are replaced by minimal stand-ins
     (the envs only subclass `gym.Env` and read `spaces.Discrete(n).n`).
   * Current torch rejects uint8 masks where torch 1.1 accepted them. Two reference functions are
-    recompiled from their own source with the mask wrapped in `.bool()` (same logic, spec Q23):
+    recompiled from their own source with the mask wrapped in `.bool()` (same logic, docs/ALGORITHMS.md Q23):
     `get_conditional_action`: `condi_a[v] = -1` -> `condi_a[v.bool()] = -1` (masked_fill_ refuses
     uint8), and `get_conditional_argmax`: `.where(mask, ...)` -> `.where(mask.bool(), ...)`
     (uint8 `where` is deprecated). Indexing with uint8 masks still works (with a warning).
@@ -252,7 +252,7 @@ def build_team(ref, domain, method):
         mem_cen, mem_dec = memory(env_cen), memory(env_dec)
         team = ns.team.Team_RNN((env_cen, env_dec), 1, (mem_cen, mem_dec), env_dec.n_agent,
                                 ns.learn.QLearn_squ_dec_cen_0, 6000, **common, **hyper)
-        # The main loop's order: the dec env steps first, then the cen env (spec 4.6).
+        # The main loop's order: the dec env steps first, then the cen env (docs/ALGORITHMS.md §4.6).
         runners, memories = [team.envs_runner_dec, team.envs_runner_cen], [mem_cen, mem_dec]
     team.hysteretic = mth["h"]
     return team, runners, memories

@@ -20,12 +20,12 @@ done around it:
     checker only inspects, so the env is the same either way;
   * `torch.set_num_threads(1)` before the script runs (with an explicit non-zero `--seed` this
     makes a run repeatable: two BP 6x6 MacIAC runs, seed 1, 200 episodes, gave identical curves;
-    `--seed` 0, the default, leaves the main process unseeded, spec 1.5).
+    `--seed` 0, the default, leaves the main process unseeded, docs/MACROMARL.md §1.5).
 The runner forks `--n_env` worker processes (multiprocessing, fork start method).
 
 Outputs in DIR:
   curve.csv    `episode,return`: evaluation k (mean discounted return of 10 *sampled* test
-               episodes, spec 2.5) at episode k * (eval_freq - eval_freq % train_freq), the first
+               episodes, docs/MACROMARL.md §2.5) at episode k * (eval_freq - eval_freq % train_freq), the first
                at episode 0, before training. Written as each evaluation is printed (parsed from
                the reference's own progress line, so a long run can be watched), and rewritten at
                the end from the reference's pickle `performance/<save_dir>/test/test_perform<run_id>

@@ -1,4 +1,4 @@
-//! The statistics behind a learning curve (spec `algorithms.md` 7.2): the mean over runs at each
+//! The statistics behind a learning curve (`docs/ALGORITHMS.md` §7.2): the mean over runs at each
 //! evaluation point, its standard error, and the centred moving average the paper calls
 //! "smoothed by 20 neighbors". Pure functions on numbers; no files, no drawing. Shared by the
 //! figures (`plot`) and the terminal report after training (`experiment::report`), and below both.
@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 /// Points on each side of the centre in the paper's smoothing: window 21 = the point plus 10
-/// neighbours on each side (spec 7.2, open question O1). The widest window [`Smoothing::Auto`]
+/// neighbours on each side (`docs/ALGORITHMS.md` §7.2, open question O1). The widest window [`Smoothing::Auto`]
 /// chooses.
 pub const SMOOTH_HALF_WINDOW: usize = 10;
 
@@ -185,7 +185,7 @@ pub fn moving_average(xs: &[f64], half_window: usize) -> Vec<f64> {
 }
 
 /// The paper's smoothing of a curve: the moving average applied separately to the mean and to
-/// the standard error (spec 7.2). Episodes and counts are kept.
+/// the standard error (`docs/ALGORITHMS.md` §7.2). Episodes and counts are kept.
 pub fn smooth(points: &[CurvePoint], half_window: usize) -> Vec<CurvePoint> {
     let means: Vec<f64> = points.iter().map(|p| p.mean).collect();
     let ses: Vec<f64> = points.iter().map(|p| p.se).collect();

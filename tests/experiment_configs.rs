@@ -79,7 +79,7 @@ fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() 
             "wh_e"
         ]
     );
-    // Spot checks against spec macromarl_hp_table.md.
+    // Spot checks against `docs/MACROMARL.md` §1.4.
     let bp12 = load("macromarl/bp12.toml").runs().unwrap();
     let iac = bp12[0].config.actor_critic().unwrap();
     assert_eq!(

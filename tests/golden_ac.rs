@@ -1,5 +1,5 @@
 //! Differential tests of the actor-critic methods against the authors' reference implementation
-//! (MacroMARL, spec `macromarl.md` 2).
+//! (MacroMARL, `docs/MACROMARL.md` §2).
 //!
 //! Each directory `tests/golden_ac/<case>/` was written by `scripts/ac_golden_from_reference.py`
 //! from the reference's own objects (its runner, `Memory_epi`, controller, nets, Adam and

@@ -218,7 +218,7 @@ fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
 }
 
 /// The discount `macdec import` writes by default ([`EnvSpec::paper_discount`]) is the one the
-/// learner's paper defaults train with: the paper's, Box Pushing 0.98 and Warehouse 1.0 (spec 10).
+/// learner's paper defaults train with: the paper's, Box Pushing 0.98 and Warehouse 1.0 (`docs/ALGORITHMS.md` §10).
 #[test]
 fn deploys_paper_discounts_are_the_learners() {
     use macdec::algos::method::Method;

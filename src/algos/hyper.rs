@@ -1,8 +1,8 @@
 //! Every hyperparameter of a run, concrete, with the papers' values as defaults.
 //!
 //! A run's [`RunConfig`] is its family's own set of keys: the ICRA code's flags for the value
-//! methods ([`ValueConfig`], spec `algorithms.md` 10) and MacroMARL's for the actor-critic methods
-//! ([`AcConfig`], spec `macromarl.md` 1.4). A learner reads only its own struct;
+//! methods ([`ValueConfig`], `docs/ALGORITHMS.md` §10) and MacroMARL's for the actor-critic methods
+//! ([`AcConfig`], `docs/MACROMARL.md` §1.4). A learner reads only its own struct;
 //! `experiment::config` builds them from files, sweeps and `--set` overrides. They name no domain:
 //! the loop is handed a way to build the environment, and a run on disk records its domain beside
 //! these keys (`experiment::run_settings`).
@@ -129,22 +129,22 @@ impl From<AcConfig> for RunConfig {
 pub struct ValueConfig {
     /// Training episodes (Our-2: decentralized-env episodes).
     pub total_epi: usize,
-    /// Replay capacity: windows for the windowed buffer, episodes with `sample_epi` (spec 3).
+    /// Replay capacity: windows for the windowed buffer, episodes with `sample_epi` (`docs/ALGORITHMS.md` §3).
     pub replay_buffer_size: usize,
     /// Whole-episode replay (WTD) instead of fixed-length windows (BP).
     pub sample_epi: bool,
-    /// Hysteresis moves from init_h to end_h over h_stable_at episodes (spec 5.6).
+    /// Hysteresis moves from init_h to end_h over h_stable_at episodes (`docs/ALGORITHMS.md` §5.6).
     pub dynamic_h: bool,
     pub init_h: f64,
     pub end_h: f64,
     pub h_stable_at: usize,
-    /// Linear epsilon decay over eps_l_d_steps episodes (spec 4.1); else the exponential schedule.
+    /// Linear epsilon decay over eps_l_d_steps episodes (`docs/ALGORITHMS.md` §4.1); else the exponential schedule.
     pub eps_l_d: bool,
     pub eps_l_d_steps: usize,
     pub eps_end: f64,
-    /// Carry the exploring nets' hidden state during training episodes (spec 4.4, quirk Q1).
+    /// Carry the exploring nets' hidden state during training episodes (`docs/ALGORITHMS.md` §4.4, quirk Q1).
     pub h_explore: bool,
-    /// Our-1 / Our-1-R explore with the centralized net (spec 4.6).
+    /// Our-1 / Our-1-R explore with the centralized net (`docs/ALGORITHMS.md` §4.6).
     pub cen_explore: bool,
     /// Adam learning rate of every net.
     pub l_rate: f64,

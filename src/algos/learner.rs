@@ -23,7 +23,7 @@ use serde::Serialize;
 /// When the loop trains and syncs targets, in terms of its own counters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Schedule {
-    /// The ICRA main loop (spec `algorithms.md` 6): every main-loop step advances each lane by one
+    /// The ICRA main loop (`docs/ALGORITHMS.md` §6): every main-loop step advances each lane by one
     /// primitive step; a training iteration runs every `train_freq` steps once `start_train`
     /// training episodes are done; targets are hard-copied every `target_update_freq` steps.
     EveryStep {
@@ -33,7 +33,7 @@ pub enum Schedule {
         /// Evaluate before training and every `eval_freq` training episodes.
         eval_freq: u64,
     },
-    /// MacroMARL's collection (spec `macromarl.md` 2.3): every update first resets every lane,
+    /// MacroMARL's collection (`docs/MACROMARL.md` §2.3): every update first resets every lane,
     /// steps them in lockstep until at least `train_freq` episodes have completed (the
     /// unfinished ones are dropped), trains once and counts exactly `train_freq` episodes;
     /// targets are hard-copied when the count is a multiple of `target_update_freq`. An
@@ -49,11 +49,11 @@ pub enum Schedule {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LanePlan {
     /// Whether the lane's finished episodes are training episodes (`total_epi`, `eval_freq` and
-    /// `checkpoint_freq` count them). Our-2's centralized-exploring lane does not count (spec 5.5).
+    /// `checkpoint_freq` count them). Our-2's centralized-exploring lane does not count (`docs/ALGORITHMS.md` §5.5).
     pub counts_episodes: bool,
 }
 
-/// The random streams a learner draws from (one per role, spec `algorithms.md` 8); the loop keeps
+/// The random streams a learner draws from (one per role, `docs/ALGORITHMS.md` §8); the loop keeps
 /// the environments' streams.
 #[derive(Debug, Clone)]
 pub struct LearnerRngs {

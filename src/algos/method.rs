@@ -1,7 +1,7 @@
 //! The methods as small values naming only what their papers vary between them: for the ICRA
-//! 2020 value methods (spec `algorithms.md` 4.6 and 5) which nets exist, who picks the action
+//! 2020 value methods (`docs/ALGORITHMS.md` §4.6 and 5) which nets exist, who picks the action
 //! inside each target, how the training env(s) explore, and whether a loss is hysteretic; for
-//! MacroMARL's actor-critic methods (spec `macromarl.md` 2.7) whose actor acts and what the
+//! MacroMARL's actor-critic methods (`docs/MACROMARL.md` §2.7) whose actor acts and what the
 //! critic sees ([`Method::actor_critic`]).
 
 use crate::algos::value::schedule::HysteresisSchedule;
@@ -13,16 +13,16 @@ use std::str::FromStr;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
-    /// Decentralized hysteretic double DRQN over Mac-CERTs (spec 5.1).
+    /// Decentralized hysteretic double DRQN over Mac-CERTs (`docs/ALGORITHMS.md` §5.1).
     DecHddrqn,
-    /// Centralized double DRQN with the conditional argmax (spec 5.2).
+    /// Centralized double DRQN with the conditional argmax (`docs/ALGORITHMS.md` §5.2).
     CenDdrqn,
     /// MacDec-MADDRQN, "Our-1": decentralized targets pick a* with the centralized net (Eq. 4).
     Our1,
-    /// Our-1 with regular double-Q inside the decentralized targets (ablation, spec 5.4).
+    /// Our-1 with regular double-Q inside the decentralized targets (ablation, `docs/ALGORITHMS.md` §5.4).
     #[serde(rename = "our1-r")]
     Our1R,
-    /// Parallel-MacDec-MADDRQN, "Our-2": separate centralized and decentralized envs (spec 5.5).
+    /// Parallel-MacDec-MADDRQN, "Our-2": separate centralized and decentralized envs (`docs/ALGORITHMS.md` §5.5).
     Our2,
     /// Mac-IAC: independent actors and history critics (MacroMARL's `MacIAC`).
     MacIac,
@@ -60,7 +60,7 @@ pub enum AcActor {
     Centralized,
 }
 
-/// What an actor-critic method's critic sees and whose return it learns (spec 2.7).
+/// What an actor-critic method's critic sees and whose return it learns (`docs/MACROMARL.md` §2.7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AcCritic {
     /// Agent i's own critic on its own observation history, its own macro-rewards (Mac-IAC).
@@ -107,12 +107,12 @@ pub enum DecTargetAction {
     CenCondArgmax,
 }
 
-/// How the training environment(s) pick actions (spec 4.6).
+/// How the training environment(s) pick actions (`docs/ALGORITHMS.md` §4.6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Exploration {
-    /// Each agent epsilon-greedy on its own net (spec 4.2).
+    /// Each agent epsilon-greedy on its own net (`docs/ALGORITHMS.md` §4.2).
     Decentralized,
-    /// Epsilon-greedy on the centralized net with the conditional argmax (spec 4.3).
+    /// Epsilon-greedy on the centralized net with the conditional argmax (`docs/ALGORITHMS.md` §4.3).
     Centralized,
     /// Our-2: a decentralized-exploring env and a centralized-exploring env in lockstep (5.5).
     Parallel,
@@ -145,7 +145,7 @@ impl Method {
     }
 
     /// An actor-critic method's actor and critic (`None` for the value methods): the one place
-    /// the six differ (spec `macromarl.md` 2.7).
+    /// the six differ (`docs/MACROMARL.md` §2.7).
     pub fn actor_critic(self) -> Option<AcDesign> {
         let design = |actor, critic, reference_alg| {
             Some(AcDesign {
@@ -234,7 +234,7 @@ impl Method {
     }
 
     /// Whether the centralized loss uses the hysteretic transform: only Cen-DDRQN's does (spec
-    /// 5.2); Our-1/2's centralized step never applies h (spec 5.3 Step A).
+    /// 5.2); Our-1/2's centralized step never applies h (`docs/ALGORITHMS.md` §5.3 Step A).
     pub fn cen_loss_is_hysteretic(self) -> bool {
         match self {
             Method::CenDdrqn => true,
@@ -245,7 +245,7 @@ impl Method {
     }
 
     /// Whether the decentralized losses use the hysteretic transform with the run's current h
-    /// (spec 5.1, 5.3 Step B). Every method with decentralized nets applies h there; only
+    /// (`docs/ALGORITHMS.md` §5.1, 5.3 Step B). Every method with decentralized nets applies h there; only
     /// Dec-HDDRQN's paper schedule ([`Self::paper_hysteresis`]) moves it away from 1.
     pub fn dec_loss_is_hysteretic(self) -> bool {
         match self {
@@ -256,7 +256,7 @@ impl Method {
         }
     }
 
-    /// The paper's hysteresis schedule end points `(init_h, end_h)` (spec 5.6, 10): Dec-HDDRQN
+    /// The paper's hysteresis schedule end points `(init_h, end_h)` (`docs/ALGORITHMS.md` §5.6, 10): Dec-HDDRQN
     /// moves from 0.2 to 0.4; every other method keeps h = 1 (no hysteresis).
     pub fn paper_hysteresis(self) -> (f64, f64) {
         match self {
@@ -267,7 +267,7 @@ impl Method {
         }
     }
 
-    /// The paper's greedy episodes per evaluation (spec 10): Dec-HDDRQN's code averages 20, the
+    /// The paper's greedy episodes per evaluation (`docs/ALGORITHMS.md` §10): Dec-HDDRQN's code averages 20, the
     /// ICRA code evaluates once.
     pub fn paper_eval_num_epi(self) -> usize {
         match self {
@@ -278,7 +278,7 @@ impl Method {
         }
     }
 
-    /// The paper's `--cen_explore` (spec 4.6, 10): Our-1 and Our-1-R explore centrally; the flag
+    /// The paper's `--cen_explore` (`docs/ALGORITHMS.md` §4.6, 10): Our-1 and Our-1-R explore centrally; the flag
     /// means nothing to the other methods and is off for them.
     pub fn paper_cen_explore(self) -> bool {
         match self {
@@ -314,7 +314,7 @@ impl Method {
         }
     }
 
-    /// The policy the paper evaluates (spec 7.1): Cen-DDRQN acts centrally, all others by agent.
+    /// The policy the paper evaluates (`docs/ALGORITHMS.md` §7.1): Cen-DDRQN acts centrally, all others by agent.
     pub fn evaluated_policy(self) -> EvaluatedPolicy {
         match self {
             Method::CenDdrqn => EvaluatedPolicy::Centralized,
@@ -328,7 +328,7 @@ impl Method {
 
     /// Whether the decentralized batch comes from an env of its own, so the centralized a*
     /// selection for the decentralized targets must squeeze that batch jointly instead of reusing
-    /// the centralized step's view (Our-2, spec 5.5).
+    /// the centralized step's view (Our-2, `docs/ALGORITHMS.md` §5.5).
     pub fn dec_batch_is_separate(self) -> bool {
         match self {
             Method::Our2 => true,
@@ -339,7 +339,7 @@ impl Method {
     }
 
     /// Whether the method needs the whole-episode replay (`sample_epi = true`): the reference's
-    /// windowed path for Our-2 crashes (spec Q10), so Our-2 stays episode-based.
+    /// windowed path for Our-2 crashes (`docs/ALGORITHMS.md` Q10), so Our-2 stays episode-based.
     pub fn requires_episode_buffer(self) -> bool {
         match self {
             Method::Our2 => true,
@@ -355,7 +355,7 @@ impl Method {
 /// [`Method::dec_loss_is_hysteretic`]; the paper's end points are [`Method::paper_hysteresis`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HysteresisRule {
-    /// Follow the schedule (spec 5.6); otherwise h = 1 - epsilon (the reference's fallback).
+    /// Follow the schedule (`docs/ALGORITHMS.md` §5.6); otherwise h = 1 - epsilon (the reference's fallback).
     pub dynamic: bool,
     pub init_h: f64,
     pub end_h: f64,

@@ -1,4 +1,4 @@
-//! The one training loop every method family runs (spec `algorithms.md` 6 for its schedule):
+//! The one training loop every method family runs (`docs/ALGORITHMS.md` §6 for its schedule):
 //! step the training lanes, count episodes and steps, train and sync targets when the learner's
 //! [`Schedule`] says, evaluate before training and every `eval_freq` training episodes.
 //!
@@ -12,7 +12,7 @@ use crate::envs::{EnvError, EnvRng, MacroEnv};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-/// Independent random streams of one run (one per role, spec 8).
+/// Independent random streams of one run (one per role, `docs/ALGORITHMS.md` §8).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunRngs {
     pub init: ChaCha8Rng,
@@ -271,7 +271,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         }
     }
 
-    /// One update of MacroMARL's loop (spec `macromarl.md` 2.3): evaluate when due, reset every
+    /// One update of MacroMARL's loop (`docs/MACROMARL.md` §2.3): evaluate when due, reset every
     /// lane, step them in lockstep until `train_freq` episodes completed, train, count exactly
     /// `train_freq` episodes, sync targets when due.
     fn batch_iteration(
@@ -306,7 +306,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         Ok(())
     }
 
-    /// One main-loop iteration (spec 6) of the [`Schedule::EveryStep`] schedule. Returns
+    /// One main-loop iteration (`docs/ALGORITHMS.md` §6) of the [`Schedule::EveryStep`] schedule. Returns
     /// whether a training episode finished.
     fn main_loop_iteration(
         &mut self,
@@ -358,7 +358,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         Ok(lane.counts_episodes)
     }
 
-    /// Evaluate the learner's policy (spec 7.1), appended to the curve.
+    /// Evaluate the learner's policy (`docs/ALGORITHMS.md` §7.1), appended to the curve.
     fn evaluate(&mut self) -> Result<(), TrainError> {
         let eval_return = match self.learner.schedule() {
             Schedule::EveryStep { .. } => self

@@ -48,7 +48,7 @@ const fn shape(
     }
 }
 
-/// The paper's nets (spec `algorithms.md` 10) and the PyTorch script's two shapes.
+/// The paper's nets (`docs/ALGORITHMS.md` §10) and the PyTorch script's two shapes.
 pub const SHAPES: [NetShape; 6] = [
     shape("bp10x10-dec", [5, 32, 32, 8], 128, 15, None),
     shape("bp10x10-cen", [10, 32, 64, 64], 128, 15, None),

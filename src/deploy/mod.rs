@@ -37,7 +37,7 @@ pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};
 pub use server::{serve_tcp, spawn_server, Limits, RobotServer};
 
 /// One agent's decentralized policy with its recurrent state, as a robot runs it: the agent's own
-/// macro-observation in, one Q-value per macro-action out (spec `algorithms.md` 4.2, greedy).
+/// macro-observation in, one Q-value per macro-action out (`docs/ALGORITHMS.md` §4.2, greedy).
 ///
 /// The hidden state lives inside the value, so a robot keeps it across messages and each TCP
 /// connection gets its own (a fresh value from a factory).

@@ -2,7 +2,7 @@
 //! and MacroMARL's (`bp_ma_v0`, the Warehouse A-E of `osd`, `overcooked`), each in its folder and
 //! listed once in [`built_in`].
 //!
-//! All follow the references' step contract (spec `algorithms.md` 1.1): an agent picks a new
+//! All follow the references' step contract (`docs/ALGORITHMS.md` §1.1): an agent picks a new
 //! macro-action only when its previous one finished; the value passed for a busy agent is ignored;
 //! the executed macro-actions, the held macro-observations, one shared team reward, the episode-done
 //! flag and the per-agent macro-action-done flags come back from every primitive step.
@@ -31,7 +31,7 @@ pub use domain::Domain;
 pub use spec::EnvSpec;
 
 /// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the
-/// caller, so a checkpoint can save it and a run derives it from its seed (spec `algorithms.md` 8).
+/// caller, so a checkpoint can save it and a run derives it from its seed (`docs/ALGORITHMS.md` §8).
 pub type EnvRng = ChaCha8Rng;
 
 /// Why an environment refused its input. Messages name the offending value and the allowed range.
@@ -146,7 +146,7 @@ pub enum FirstRecordObs {
 ///   horizon cut sets [`StepOutcome::truncated`] where the domain's reference bootstraps from it
 ///   (MacroMARL's domains); the ICRA domains treat it as terminal (quirk Q7). At `done`, every agent's
 ///   macro-action counts as ended for its final transition only if `mac_done` says so; an
-///   unfinished one is dropped by the learners (spec Q6). After `done`, [`Self::step`] is
+///   unfinished one is dropped by the learners (`docs/ALGORITHMS.md` Q6). After `done`, [`Self::step`] is
 ///   [`EnvError::EpisodeOver`] until [`Self::reset`].
 /// - **Randomness** comes only from the `rng` passed in, so a run is reproducible from its seed
 ///   and a checkpoint can hold the stream. A domain that draws nothing should say so through

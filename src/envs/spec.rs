@@ -122,7 +122,7 @@ impl EnvSpec {
     }
 
     /// The discount per primitive step the paper trains and evaluates this setting under (Box
-    /// Pushing 0.98, Warehouse 1.0; spec 10), the one its known optimum is stated for; `None`
+    /// Pushing 0.98, Warehouse 1.0; `docs/ALGORITHMS.md` §10), the one its known optimum is stated for; `None`
     /// for a domain no paper trained on.
     pub fn paper_discount(&self) -> Option<f64> {
         match self.paper_settings().get("discount")? {

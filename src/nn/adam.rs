@@ -1,5 +1,5 @@
 //! Adam with PyTorch's semantics (`torch.optim.Adam`, single-tensor path): betas (0.9, 0.999),
-//! eps 1e-8, bias correction, no weight decay, no AMSGrad, no gradient clipping (spec 2.4).
+//! eps 1e-8, bias correction, no weight decay, no AMSGrad, no gradient clipping (`docs/ALGORITHMS.md` §2.4).
 
 use serde::{Deserialize, Serialize};
 

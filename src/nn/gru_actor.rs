@@ -1,4 +1,4 @@
-//! MacroMARL's recurrent actor (spec `macromarl.md` 2.4, `cores/pg_based/mac_iac/models.py:
+//! MacroMARL's recurrent actor (`docs/MACROMARL.md` §2.4, `cores/pg_based/mac_iac/models.py:
 //! Actor`): the authors' trained actors run here, greedy or sampled, and the actor-critic
 //! learners train it. Its history critic (`models.py: Critic`) is the same layers with one output
 //! and no log_softmax, so it is this type too ([`GruActor::forward`] gives fc4's output).
@@ -241,7 +241,7 @@ pub struct GruActorVars {
 }
 
 impl GruActor {
-    /// A freshly initialized net (spec 2.4): Xavier-uniform with the leaky-ReLU gain on fc1..fc3,
+    /// A freshly initialized net (`docs/ALGORITHMS.md` §2.4): Xavier-uniform with the leaky-ReLU gain on fc1..fc3,
     /// gain 1 on fc4, zero Linear biases, PyTorch's GRU default; drawn in module order.
     pub fn new(cfg: GruActorConfig, rng: &mut ChaCha8Rng) -> Self {
         let ([m0, m1], h) = (cfg.mlp, cfg.hidden);

@@ -1,4 +1,4 @@
-//! Weight initialization as the reference does it (spec `algorithms.md` 2.2), drawn from the
+//! Weight initialization as the reference does it (`docs/ALGORITHMS.md` §2.2), drawn from the
 //! caller's seeded stream.
 
 use ndarray::{Array1, Array2};

@@ -10,7 +10,7 @@ use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::{Activation, Tape, Var};
 
 impl LinearParams {
-    /// Xavier-uniform weight with `gain`, zero bias: the reference's `Linear` helper (spec 2.2).
+    /// Xavier-uniform weight with `gain`, zero bias: the reference's `Linear` helper (`docs/ALGORITHMS.md` §2.2).
     pub fn xavier(input: usize, output: usize, gain: f64, rng: &mut ChaCha8Rng) -> Self {
         let mut p = LinearParams::zeros(input, output);
         p.weight = xavier_uniform(output, input, gain, rng);

@@ -1,10 +1,10 @@
-//! The TD loss every learner minimizes (spec `algorithms.md` 5), built on the tape.
+//! The TD loss every learner minimizes (`docs/ALGORITHMS.md` §5), built on the tape.
 
 use ndarray::{ArrayView1, Axis};
 
 use crate::autograd::{Tape, Var};
 
-/// mean_k ( max(h d_k, d_k) )^2 with d_k = y_k - Q[k, a_k] (spec 5, quirk Q4); h = 1 gives the
+/// mean_k ( max(h d_k, d_k) )^2 with d_k = y_k - Q[k, a_k] (`docs/ALGORITHMS.md` §5, quirk Q4); h = 1 gives the
 /// plain MSE. q: [K, n_actions] on the tape, `actions` and the constant targets `y`: K entries.
 /// The transform max(h d, d) for h <= 1 is a leaky ReLU with slope h.
 /// Panics if the lengths differ from q's rows or an action is out of range.

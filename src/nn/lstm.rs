@@ -48,7 +48,7 @@ impl LstmParams {
     }
 }
 
-/// An LSTM's recurrent state (h, c), zero at the start of each episode (spec 2.3), plus the
+/// An LSTM's recurrent state (h, c), zero at the start of each episode (`docs/ALGORITHMS.md` §2.3), plus the
 /// scratch the acting forward writes into so that acting never allocates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LstmState {

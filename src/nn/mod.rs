@@ -1,6 +1,6 @@
 //! Layers, the reference's recurrent Q-net, Adam, and weight files, on top of `autograd`.
 //!
-//! - [`QNet`]: fc1 -> fc2 -> LSTM -> fc3 -> fc4 with leaky ReLU (spec `algorithms.md` 2.1),
+//! - [`QNet`]: fc1 -> fc2 -> LSTM -> fc3 -> fc4 with leaky ReLU (`docs/ALGORITHMS.md` §2.1),
 //!   run on a tape over a batch of sequences (training), without a tape (targets), or one step
 //!   at a time with an [`LstmState`] (acting).
 //! - [`GruParams`]: a one-layer GRU as PyTorch's `nn.GRU` (gate order, init, state_dict
@@ -8,7 +8,7 @@
 //!   with a [`GruState`] (acting).
 //! - [`GruActor`]: MacroMARL's actor fc1 -> fc2 -> GRU -> fc3 -> fc4 -> log_softmax (and its
 //!   history critic), for acting and training; [`StateCritic`]: its MLP critic on the state.
-//! - [`Adam`]: PyTorch's Adam (spec 2.4); [`Updater::td_step`]: one full TD gradient step.
+//! - [`Adam`]: PyTorch's Adam (`docs/ALGORITHMS.md` §2.4); [`Updater::td_step`]: one full TD gradient step.
 //! - `safetensors_io`: weight files with PyTorch's state_dict names.
 
 mod acting_net;

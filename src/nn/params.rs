@@ -82,7 +82,7 @@ impl<const GATES: usize> RecurrentParams<GATES> {
     }
 
     /// PyTorch's default: every weight and both biases U(-1/sqrt(H), 1/sqrt(H)), drawn in the
-    /// order weight_ih, weight_hh, bias_ih, bias_hh (the module's parameter order; spec 2.2).
+    /// order weight_ih, weight_hh, bias_ih, bias_hh (the module's parameter order; `docs/ALGORITHMS.md` §2.2).
     pub fn pytorch_default(input: usize, hidden: usize, rng: &mut ChaCha8Rng) -> Self {
         let k = 1.0 / (hidden as f32).sqrt();
         RecurrentParams {

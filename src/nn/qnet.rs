@@ -1,4 +1,4 @@
-//! The reference's recurrent Q-net (spec `algorithms.md` 2.1), used for every decentralized and
+//! The reference's recurrent Q-net (`docs/ALGORITHMS.md` §2.1), used for every decentralized and
 //! centralized net of every method:
 //!
 //! ```text
@@ -166,7 +166,7 @@ impl QNetParams {
         }
     }
 
-    /// The reference's initialization (spec 2.2): Xavier-uniform with the leaky-ReLU gain on
+    /// The reference's initialization (`docs/ALGORITHMS.md` §2.2): Xavier-uniform with the leaky-ReLU gain on
     /// fc1..fc3, gain 1 on fc4, zero Linear biases, PyTorch's LSTM default; drawn in module
     /// order fc1, fc2, lstm, fc3, fc4.
     pub fn init(cfg: QNetConfig, rng: &mut ChaCha8Rng) -> Self {
@@ -274,7 +274,7 @@ impl QNetVars {
 }
 
 impl QNet {
-    /// A freshly initialized net (spec 2.2), drawn from `rng`.
+    /// A freshly initialized net (`docs/ALGORITHMS.md` §2.2), drawn from `rng`.
     pub fn new(cfg: QNetConfig, rng: &mut ChaCha8Rng) -> Self {
         QNet {
             params: QNetParams::init(cfg, rng),
@@ -439,7 +439,7 @@ impl QNet {
     }
 
     /// One acting step: Q-values for input x given the carried state, which advances
-    /// (spec 2.3). No tape, no allocation after the state's first use. The slice lives in
+    /// (`docs/ALGORITHMS.md` §2.3). No tape, no allocation after the state's first use. The slice lives in
     /// `state`'s scratch. Panics if x or the state do not match the net's sizes.
     pub fn act_step<'s>(&self, x: &[f32], state: &'s mut LstmState) -> &'s [f32] {
         let cfg = self.config();

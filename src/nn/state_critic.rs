@@ -1,4 +1,4 @@
-//! MacroMARL's state critic (`cores/pg_based/mac_niasc/models.py: Critic`, spec `macromarl.md`
+//! MacroMARL's state critic (`cores/pg_based/mac_niasc/models.py: Critic`, `docs/MACROMARL.md`
 //! 2.4): a plain MLP on the global state `get_state()`,
 //!
 //! ```text

@@ -34,7 +34,7 @@ impl Updater {
         }
     }
 
-    /// One Adam step on mean_k (max(h d_k, d_k))^2, d_k = y_k - Q(h_k, a_k) (spec 5; h = 1 is
+    /// One Adam step on mean_k (max(h d_k, d_k))^2, d_k = y_k - Q(h_k, a_k) (`docs/ALGORITHMS.md` §5; h = 1 is
     /// the plain MSE). Returns the loss before the step. The tape is reset afterwards, so
     /// nothing accumulates across updates.
     pub fn td_step(&mut self, net: &mut QNet, adam: &mut Adam, batch: &TdBatch, h: f32) -> f32 {

@@ -19,7 +19,7 @@ pub struct Series {
     /// Legend text, e.g. "Our-1 (n = 40 seeds)".
     pub label: String,
     pub colour: Rgb,
-    /// Smoothed mean and standard error per evaluation point (spec 7.2).
+    /// Smoothed mean and standard error per evaluation point (`docs/ALGORITHMS.md` §7.2).
     pub points: Vec<CurvePoint>,
 }
 

@@ -1,4 +1,4 @@
-//! Learning-curve figures like the paper's (spec `algorithms.md` 7.2), from a results tree.
+//! Learning-curve figures like the paper's (`docs/ALGORITHMS.md` §7.2), from a results tree.
 //!
 //! `discover` finds the runs, `stats` turns them into smoothed mean and standard-error curves,
 //! `figure` decides what is drawn, `render` draws it (PNG and SVG; `legend` finds its place), `summary` tabulates the final

@@ -1,5 +1,5 @@
 //! What a figure needs to know about the domain of its runs: a readable description for the title
-//! and the optimal return for the red dash-dot line (spec `algorithms.md` 7.2).
+//! and the optimal return for the red dash-dot line (`docs/ALGORITHMS.md` §7.2).
 //!
 //! Read from each run's `config.toml` key by key rather than as a whole run config, so an older
 //! results tree still plots after the config gains a field, and a run of a domain this binary

@@ -148,7 +148,7 @@ pub struct Manifest {
     pub env: PolicyEnv,
     /// Discount per primitive step of the reported (evaluation) return (quirks Q5, Q13).
     pub discount: f64,
-    /// The nets the paper evaluates for the method (spec 7.1): the decentralized ones, or the
+    /// The nets the paper evaluates for the method (`docs/ALGORITHMS.md` §7.1): the decentralized ones, or the
     /// centralized one for Cen-DDRQN.
     pub evaluated: NetRole,
     /// Every agent's layout, in agent order.

@@ -1,5 +1,5 @@
 //! The status bar under each picture: step, undiscounted team return so far, and the macro-action
-//! each agent executed in the last step (spec `algorithms.md` 1.1: what `executed` reports).
+//! each agent executed in the last step (`docs/ALGORITHMS.md` §1.1: what `executed` reports).
 //!
 //! Its layout depends only on the environment (agent labels and the longest action name of each
 //! agent), never on the state, so every frame of an episode has the same height.

@@ -74,7 +74,7 @@ fn wtd() -> AnyEnv {
     crate::envs::warehouse::spec(150, 0.0).build().unwrap()
 }
 
-/// Warehouse scenario S2 (spec section 14): each free agent takes its queue's next action, then
+/// Warehouse scenario S2 (`docs/WAREHOUSE.md` §14): each free agent takes its queue's next action, then
 /// Go-to-WS / Wait. Reaches the optimum 262 at step 38.
 fn wtd_s2() -> impl FnMut(&AnyEnv, &mut [usize]) {
     let queues: [&[usize]; 3] = [&[2, 2, 0], &[2, 0, 2, 0], &[3, 2, 4, 1, 5, 2]];
@@ -94,7 +94,7 @@ fn bp10_optimal_episode_gives_twelve_frames_that_round_trip_through_the_gif() {
     let mut env = bp10();
     let mut rng = EnvRng::seed_from_u64(0);
     let frames = record_episode(&mut env, &mut rng, bp_optimal).unwrap();
-    // T* = 11 steps (spec 11): reset frame plus one per step.
+    // T* = 11 steps (`docs/BOX_PUSHING.md` §11): reset frame plus one per step.
     assert_eq!(frames.len(), 12);
     assert_eq!(
         frames.iter().map(|f| f.t).collect::<Vec<_>>(),
@@ -161,7 +161,11 @@ fn bp30_frames_are_361_pixels_wide() {
     let mut env = crate::envs::box_pushing::spec(30, 200).build().unwrap();
     let mut rng = EnvRng::seed_from_u64(0);
     let frames = record_episode(&mut env, &mut rng, bp_optimal).unwrap();
-    assert_eq!(frames.len(), 42, "T* = 41 on 30x30 (spec 11)");
+    assert_eq!(
+        frames.len(),
+        42,
+        "T* = 41 on 30x30 (`docs/BOX_PUSHING.md` §11)"
+    );
     assert_eq!(frames[0].image.width(), 361);
 }
 
@@ -198,7 +202,7 @@ fn wtd_scripted_optimum_ends_at_step_38_with_return_262() {
     let frames = record_episode(&mut env, &mut rng, wtd_s2()).unwrap();
     assert_eq!(frames.len(), 39);
     assert_eq!(frames[38].team_return, 262.0);
-    // Step 18 (spec S2 events): Turtlebot 1 delivered tool 0 and the human moved on to work
+    // Step 18 (`docs/WAREHOUSE.md` S2 events): Turtlebot 1 delivered tool 0 and the human moved on to work
     // step 1, so the first square of the work-step bar is dark.
     let img = &frames[18].image;
     let (bar_x, _) = warehouse::to_px([5.15, 0.0]);

@@ -1,4 +1,4 @@
-//! How actor-critic policies pick macro-actions (spec `macromarl.md` 2.5, `controller.py:
+//! How actor-critic policies pick macro-actions (`docs/MACROMARL.md` §2.5, `controller.py:
 //! select_action`): free agents sample from their actor's distribution with the GRU state
 //! carried (P13); while training the distribution is the eps-mixture (1 - eps) pi + eps / |A|,
 //! when evaluated the plain pi (P8, sampled, not greedy). Mac-CAC's one actor samples a joint

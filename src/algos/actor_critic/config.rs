@@ -1,5 +1,5 @@
 //! The actor-critic methods' hyperparameters, under MacroMARL's flag names
-//! (`scripts/pg_based_main.py`; spec `macromarl.md` 1.4), with the reference's argparse defaults
+//! (`scripts/pg_based_main.py`; `docs/MACROMARL.md` §1.4), with the reference's argparse defaults
 //! where no published experiment sets a key. A domain's published values per method live in its
 //! folder ([`crate::envs::Domain::actor_critic_settings`]).
 
@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AcConfig {
-    /// Training episodes; `epi_count` advances by `train_freq` per update (spec 2.3).
+    /// Training episodes; `epi_count` advances by `train_freq` per update (`docs/MACROMARL.md` §2.3).
     pub total_epi: usize,
     /// Discount per primitive step, inside macro-actions too (P6).
     pub gamma: f64,
@@ -22,7 +22,7 @@ pub struct AcConfig {
     pub train_freq: usize,
     /// Episodes between hard copies of the critics into their targets (P10).
     pub c_target_update_freq: usize,
-    /// Macro-steps of the SMDP n-step return; 0 and 1 are the one-step return (spec 2.6).
+    /// Macro-steps of the SMDP n-step return; 0 and 1 are the one-step return (`docs/MACROMARL.md` §2.6).
     #[serde(rename = "n_step_TD")]
     pub n_step_td: usize,
     /// The exploration mixture's weight moves linearly from eps_start to eps_end over
@@ -105,7 +105,7 @@ impl AcConfig {
 /// Environments one run may step in lockstep (published: at most 48).
 pub const MAX_N_ENV: usize = 4096;
 
-/// One published experiment block's settings (a row of spec `macromarl_hp_table.md`), as
+/// One published experiment block's settings (a row of `docs/MACROMARL.md` §1.4), as
 /// config keys. Widths are (a_rnn, c_rnn, c_mlp).
 #[allow(clippy::too_many_arguments)]
 pub fn published_row(

@@ -1,4 +1,4 @@
-//! What MacroMARL's runner worker records per primitive step (spec `macromarl.md` 2.2,
+//! What MacroMARL's runner worker records per primitive step (`docs/MACROMARL.md` §2.2,
 //! `cores/pg_based/mac_niacc/envs_runner.py: worker`), one episode per training lane.
 //!
 //! Per agent, the macro-reward is discounted inside the macro-action (P6): it restarts at the

@@ -1,4 +1,4 @@
-//! The actor-critic family as the training loop drives it (spec `macromarl.md` 2): n_env lanes
+//! The actor-critic family as the training loop drives it (`docs/MACROMARL.md` §2): n_env lanes
 //! stepped in lockstep, an on-policy batch of the last `train_freq` completed episodes, one
 //! update per batch, sampled evaluation on n_env environments. Where the six methods differ,
 //! [`Method::actor_critic`]'s design decides.

@@ -1,4 +1,4 @@
-//! The nets of an actor-critic method (spec `macromarl.md` 2.4, 2.7): its actors, its critics
+//! The nets of an actor-critic method (`docs/MACROMARL.md` §2.4, 2.7): its actors, its critics
 //! and their targets, each with its own Adam (`a_lr` for actors, `c_lr` for critics).
 
 use rand_chacha::ChaCha8Rng;
@@ -105,7 +105,7 @@ pub enum NetsError {
 }
 
 impl AcNets {
-    /// Fresh nets for `design` (targets start as copies, spec 2.4), drawn from `rng` in the
+    /// Fresh nets for `design` (targets start as copies, `docs/MACROMARL.md` §2.4), drawn from `rng` in the
     /// order actors, then critics.
     pub fn new(
         design: AcDesign,

@@ -1,4 +1,4 @@
-//! The macro-level returns every actor-critic learner trains its critic on (spec `macromarl.md`
+//! The macro-level returns every actor-critic learner trains its critic on (`docs/MACROMARL.md`
 //! 2.6, `learner.py: _get_bootstrap_return`), in f32 with the reference's operation order.
 //!
 //! A squeezed sequence is one agent's (or the team's) macro-actions in an episode, k = 0..L-1,

@@ -1,4 +1,4 @@
-//! Which primitive steps of an episode each learner trains on (spec `macromarl.md` 2.6, 2.7):
+//! Which primitive steps of an episode each learner trains on (`docs/MACROMARL.md` §2.6, 2.7):
 //! the squeezes of the reference's learners, as step indices.
 //!
 //! - An agent's macro-actions are the steps its macro-action ended at (`valid`); one still

@@ -1,4 +1,4 @@
-//! One training update of an actor-critic method on its batch of episodes (spec `macromarl.md`
+//! One training update of an actor-critic method on its batch of episodes (`docs/MACROMARL.md`
 //! 2.6, 2.7; the reference's `learner.train`): squeeze, returns from the target critics, one
 //! critic step, advantages from the updated critics (P7), one actor step.
 //!
@@ -167,7 +167,7 @@ fn shifted_positions(boot: &Rows) -> Vec<usize> {
         .collect()
 }
 
-/// Each critic's data (spec 2.7): the one place the critics differ.
+/// Each critic's data (`docs/MACROMARL.md` §2.7): the one place the critics differ.
 fn critic_inputs(p: &UpdateParams, batch: &[Episode], sq: &[Squeezed]) -> Vec<CriticData> {
     let n = p.obs_sizes.len();
     let offsets: Vec<usize> = p

@@ -1,4 +1,4 @@
-//! Choosing macro-actions: decentralized and centralized epsilon-greedy (spec `algorithms.md` 4.2,
+//! Choosing macro-actions: decentralized and centralized epsilon-greedy (`docs/ALGORITHMS.md` §4.2,
 //! 4.3), and the greedy policies evaluation and deployment run (epsilon = 0, state carried).
 
 use crate::algos::value::cond_argmax::{cond_argmax, unravel};
@@ -14,7 +14,7 @@ pub struct Explore<'a> {
     pub rng: &'a mut ChaCha8Rng,
     pub epsilon: f64,
     /// Keep the advanced hidden state (`h_explore`); without it every query starts from the
-    /// episode-start zero state (spec 4.4, quirk Q1).
+    /// episode-start zero state (`docs/ALGORITHMS.md` §4.4, quirk Q1).
     pub carry_state: bool,
 }
 
@@ -38,7 +38,7 @@ impl ActScratch {
     }
 }
 
-/// Decentralized selection (spec 4.2): each free agent, in index order, queries its own net on its
+/// Decentralized selection (`docs/ALGORITHMS.md` §4.2): each free agent, in index order, queries its own net on its
 /// own observation; busy agents keep `actions[i]` (ignored by the env) and draw nothing.
 pub fn select_dec<E: MacroEnv + ?Sized>(
     env: &E,
@@ -72,7 +72,7 @@ pub fn select_dec<E: MacroEnv + ?Sized>(
     }
 }
 
-/// Centralized selection with the conditional argmax (spec 4.3): if any agent is free, query the
+/// Centralized selection with the conditional argmax (`docs/ALGORITHMS.md` §4.3): if any agent is free, query the
 /// centralized net on the joint observation; the greedy joint action keeps busy agents' ongoing
 /// macro-actions (read from the env's executed actions); a random joint action is uniform
 /// over all joint actions (quirk Q11). No agent free: nothing is queried or drawn.

@@ -1,4 +1,4 @@
-//! A sampled batch of sequences, as both replay buffers hand it out (spec `algorithms.md` 3): a
+//! A sampled batch of sequences, as both replay buffers hand it out (`docs/ALGORITHMS.md` §3): a
 //! sequence is a contiguous run of one stored episode's records, never its padding.
 
 use std::ops::Range;
@@ -37,6 +37,6 @@ impl Sequence<'_> {
 pub struct Batch<'a> {
     pub sequences: Vec<Sequence<'a>>,
     /// T of the reference's padded `B x T` batch: trace_len (windows) or the longest sampled
-    /// episode (episodes, spec 3.2).
+    /// episode (episodes, `docs/ALGORITHMS.md` §3.2).
     pub padded_len: usize,
 }

@@ -56,7 +56,7 @@ pub fn unravel(index: usize, n_actions: &[usize], out: &mut [usize]) {
     }
 }
 
-/// Agent `agent`'s component of joint index `index` (what Our-1 Step C needs, spec 5.3).
+/// Agent `agent`'s component of joint index `index` (what Our-1 Step C needs, `docs/ALGORITHMS.md` §5.3).
 pub fn unravel_component(index: usize, n_actions: &[usize], agent: usize) -> usize {
     let stride: usize = n_actions[agent + 1..].iter().product();
     (index / stride) % n_actions[agent]

@@ -1,4 +1,4 @@
-//! `ReplayMemory_epi` (spec `algorithms.md` 3.2, `--sample_epi`, Warehouse): a FIFO of whole
+//! `ReplayMemory_epi` (`docs/ALGORITHMS.md` §3.2, `--sample_epi`, Warehouse): a FIFO of whole
 //! episodes; a batch is `batch_size` episodes drawn with replacement, padded (in the reference) to
 //! the longest one, T = that length.
 

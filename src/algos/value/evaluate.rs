@@ -1,4 +1,4 @@
-//! Greedy evaluation (spec `algorithms.md` 7.1): the learned policies on a separate env copy, no
+//! Greedy evaluation (`docs/ALGORITHMS.md` §7.1): the learned policies on a separate env copy, no
 //! exploration, hidden state carried through the episode, return discounted per primitive step.
 
 use crate::algos::value::acting::{select_cen, select_dec, ActScratch};
@@ -72,7 +72,7 @@ impl<'a> GreedyActor<'a> {
 }
 
 /// Mean greedy return over `episodes` episodes. When the env draws no random numbers the
-/// episodes are identical (spec 7.1), so one is run and its return used for all.
+/// episodes are identical (`docs/ALGORITHMS.md` §7.1), so one is run and its return used for all.
 pub fn evaluate<E: MacroEnv + ?Sized>(
     env: &mut E,
     policy: GreedyPolicy<'_>,

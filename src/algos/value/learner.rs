@@ -1,5 +1,5 @@
 //! The value-based family as the training loop drives it: the five ICRA methods' nets,
-//! exploration, replay, training iteration and evaluated policy (spec `algorithms.md` 4-7).
+//! exploration, replay, training iteration and evaluated policy (`docs/ALGORITHMS.md` §4-7).
 //! Where the methods differ, [`Method`]'s exhaustive `match`es decide.
 
 use crate::algos::hyper::{RunConfig, ValueConfig};
@@ -85,7 +85,7 @@ impl ValueLearner {
     }
 
     /// The lanes' explorations: the method's, with Our-2's parallel exploration split into a
-    /// decentralized lane and a centralized one (spec 4.6, 5.5).
+    /// decentralized lane and a centralized one (`docs/ALGORITHMS.md` §4.6, 5.5).
     fn lane_explorations(&self) -> Vec<Exploration> {
         match self.method.exploration(self.c().cen_explore) {
             Exploration::Parallel => vec![Exploration::Decentralized, Exploration::Centralized],
@@ -269,7 +269,7 @@ impl Learner for ValueLearner {
         Ok(())
     }
 
-    /// One training iteration on batches from the lanes' buffers (spec 6): the first lane's
+    /// One training iteration on batches from the lanes' buffers (`docs/ALGORITHMS.md` §6): the first lane's
     /// for the decentralized nets, Our-2's centralized lane's for the centralized net; h moves
     /// along its schedule before, epsilon after, as the reference does.
     fn train_iteration(&mut self, lanes: &[&ValueLane], episodes: u64) -> Result<(), TrainError> {
@@ -318,7 +318,7 @@ impl Learner for ValueLearner {
                 .map(|s| s.at(e))
                 .unwrap_or(c.eps_end)
         } else {
-            // The reference's exponential schedule (spec 4.1), unused by the paper's runs.
+            // The reference's exponential schedule (`docs/ALGORITHMS.md` §4.1), unused by the paper's runs.
             c.eps_end + (1.0 - c.eps_end) * (-((e / 8.0).floor()) / 2000.0).exp()
         };
         Ok(())

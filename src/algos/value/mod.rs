@@ -1,14 +1,14 @@
-//! The value-based family (ICRA 2020, spec `algorithms.md`): the five macro-action Q-learning
+//! The value-based family (ICRA 2020, `docs/ALGORITHMS.md`): the five macro-action Q-learning
 //! methods. [`learner::ValueLearner`] is the family's [`crate::algos::learner::Learner`]; the
 //! rest is its machinery, in data-flow order.
 //!
 //! Flow: [`recorder::Recorder`] turns every primitive step into a [`record::Episode`] row (spec
 //! 1.2); a finished episode goes into a [`replay::ReplayBuffer`] (windows for Box Pushing, whole
-//! episodes for Warehouse, spec 3.1/3.2); a sampled [`replay::Batch`] is squeezed by [`squeeze`]
-//! into each agent's macro-level sequences and the joint one (spec 3.3); [`update`] computes the
+//! episodes for Warehouse, `docs/ALGORITHMS.md` §3.1/3.2); a sampled [`replay::Batch`] is squeezed by [`squeeze`]
+//! into each agent's macro-level sequences and the joint one (`docs/ALGORITHMS.md` §3.3); [`update`] computes the
 //! targets and takes the Adam steps; [`cond_argmax`] picks joint actions under the conditioning
-//! of busy agents (spec 4.5); [`acting`] and [`evaluate`] turn Q-values into actions; [`schedule`]
-//! gives epsilon and the hysteresis value from the episode count (spec 4.1, 5.6).
+//! of busy agents (`docs/ALGORITHMS.md` §4.5); [`acting`] and [`evaluate`] turn Q-values into actions; [`schedule`]
+//! gives epsilon and the hysteresis value from the episode count (`docs/ALGORITHMS.md` §4.1, 5.6).
 
 pub mod acting;
 pub mod batch;

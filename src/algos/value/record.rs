@@ -1,7 +1,7 @@
-//! The per-primitive-step record of spec `algorithms.md` 1.2 and the episode that stores them.
+//! The per-primitive-step record of `docs/ALGORITHMS.md` §1.2 and the episode that stores them.
 //!
 //! One record per primitive step, also when nobody finished: squeezing happens at training time
-//! (spec 3.3). An [`Episode`] keeps its records in flat columns (one `Vec` per field, row `t` at
+//! (`docs/ALGORITHMS.md` §3.3). An [`Episode`] keeps its records in flat columns (one `Vec` per field, row `t` at
 //! `t * width`), so a buffer of a thousand 150-step episodes is a handful of allocations.
 
 use std::ops::Range;
@@ -13,8 +13,8 @@ use crate::envs::MacroEnv;
 
 /// The shapes every record of a run shares: each agent's observation size and action count.
 ///
-/// The joint observation is the agents' observations concatenated in agent order (spec 1, "Joint
-/// observation"); joint actions are the C-order ravel of the agents' actions (spec 2.1).
+/// The joint observation is the agents' observations concatenated in agent order (`docs/ALGORITHMS.md` §1, "Joint
+/// observation"); joint actions are the C-order ravel of the agents' actions (`docs/ALGORITHMS.md` §2.1).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "LayoutSizes")]
 pub struct Layout {
@@ -101,7 +101,7 @@ impl Layout {
 
 /// One record, borrowed: what [`Episode::push`] takes and [`Episode::record`] gives back.
 ///
-/// Field meanings (spec 1.2): `obs` = the joint macro-observation held before the step,
+/// Field meanings (`docs/ALGORITHMS.md` §1.2): `obs` = the joint macro-observation held before the step,
 /// `executed[i]` = the macro-action agent i ran in this step, `acc_id[i]` = agent i's undiscounted
 /// macro-reward so far, `acc_joint` = the joint one, `next_obs` = the joint observation after the
 /// step, `done` = episode over, `valid[i]` = v_i (agent i's macro-action finished in this step).
@@ -117,7 +117,7 @@ pub struct RecordRef<'a> {
 }
 
 impl RecordRef<'_> {
-    /// vj = max_i v_i: some agent finished in this step (the joint view keeps these, spec 3.3).
+    /// vj = max_i v_i: some agent finished in this step (the joint view keeps these, `docs/ALGORITHMS.md` §3.3).
     pub fn vj(&self) -> bool {
         self.valid.iter().any(|&v| v)
     }

@@ -1,4 +1,4 @@
-//! The runner worker's bookkeeping (spec `algorithms.md` 1.2): macro-reward accumulators and the
+//! The runner worker's bookkeeping (`docs/ALGORITHMS.md` §1.2): macro-reward accumulators and the
 //! episode being recorded, one record per primitive step.
 //!
 //! Per step, exactly as the reference worker:
@@ -60,7 +60,7 @@ impl Recorder {
     }
 
     /// Start an episode from the joint reset observation [D]: accumulators to 0, all agents
-    /// "just finished" (spec 1.2 state after reset). Drops any unfinished episode.
+    /// "just finished" (`docs/ALGORITHMS.md` §1.2 state after reset). Drops any unfinished episode.
     pub fn begin(&mut self, reset_joint_obs: &[f32]) -> Result<(), ReplayError> {
         if reset_joint_obs.len() != self.last_obs.len() {
             return Err(ReplayError::WrongLength {
@@ -146,7 +146,7 @@ impl Recorder {
         };
         self.last_joint_valid = valid.iter().any(|&v| v);
 
-        // spec Q20: the first record may see the post-step observations of agents that finished.
+        // `docs/ALGORITHMS.md` Q20: the first record may see the post-step observations of agents that finished.
         if self.episode.is_empty() && self.first_obs == FirstRecordObs::OverwrittenByFirstStep {
             for (i, &v) in valid.iter().enumerate() {
                 if v {

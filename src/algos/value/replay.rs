@@ -1,10 +1,10 @@
 //! What a replay buffer hands to the learner: a batch of sequences of primitive-step records
-//! (spec `algorithms.md` 3), and the one buffer type the trainer holds, whichever kind it is.
+//! (`docs/ALGORITHMS.md` §3), and the one buffer type the trainer holds, whichever kind it is.
 //!
 //! A sequence is a contiguous run of one stored episode's records; the zero-padding records of the
 //! reference (left padding of the first windows, right padding to the window length or to the
 //! batch's longest episode) are never materialised, because squeezing removes every one of them
-//! (spec 3: all v_i = 0). Their count is kept for information only.
+//! (`docs/ALGORITHMS.md` §3: all v_i = 0). Their count is kept for information only.
 
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -16,8 +16,8 @@ use super::ReplayError;
 
 pub use super::batch::{Batch, Sequence};
 
-/// The replay of one training environment: windows (spec 3.1, Box Pushing) or whole episodes
-/// (spec 3.2, `sample_epi`, Warehouse).
+/// The replay of one training environment: windows (`docs/ALGORITHMS.md` §3.1, Box Pushing) or whole episodes
+/// (`docs/ALGORITHMS.md` §3.2, `sample_epi`, Warehouse).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub enum ReplayBuffer {
     Windows(WindowBuffer),

@@ -13,7 +13,7 @@ pub enum ScheduleError {
     OutOfUnitRange { name: &'static str, value: f64 },
 }
 
-/// Linear epsilon decay (`--eps_l_d`, spec 4.1): from 1.0 to `eps_end` over `eps_l_d_steps`
+/// Linear epsilon decay (`--eps_l_d`, `docs/ALGORITHMS.md` §4.1): from 1.0 to `eps_end` over `eps_l_d_steps`
 /// episodes, then constant: `1 + min(E / eps_l_d_steps, 1) * (eps_end - 1)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EpsilonSchedule {
@@ -43,13 +43,13 @@ impl EpsilonSchedule {
     }
 
     /// Epsilon after `episodes` completed episodes. Before the first training iteration the
-    /// trainer keeps the start value 1.0 (spec 4.1).
+    /// trainer keeps the start value 1.0 (`docs/ALGORITHMS.md` §4.1).
     pub fn at(&self, episodes: f64) -> f64 {
         1.0 + (episodes / self.eps_l_d_steps).min(1.0) * (self.eps_end - 1.0)
     }
 }
 
-/// Hysteresis value (`--dynamic_h`, spec 5.6):
+/// Hysteresis value (`--dynamic_h`, `docs/ALGORITHMS.md` §5.6):
 /// `min(end_h, init_h + (end_h - init_h) * E / h_stable_at)`; h = init_h before the first update.
 /// With init_h = end_h = 1 (every method but Dec-HDDRQN) it is 1 throughout.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -1,4 +1,4 @@
-//! Squeezing (spec `algorithms.md` 3.3): from a sampled batch of primitive-step sequences to each
+//! Squeezing (`docs/ALGORITHMS.md` §3.3): from a sampled batch of primitive-step sequences to each
 //! agent's macro-level sequences (records with v_i = 1, the Mac-CERTs) and to the joint ones
 //! (records with vj = 1, the Mac-JERTs), as padded inputs plus flat per-record vectors.
 //!
@@ -53,7 +53,7 @@ pub struct JointView {
     pub executed: Vec<usize>,
     /// v_i: [K * N].
     pub valid: Vec<bool>,
-    /// Conditioning for the target's conditional argmax (spec 4.5): `-1` if v_i (agent i chooses
+    /// Conditioning for the target's conditional argmax (`docs/ALGORITHMS.md` §4.5): `-1` if v_i (agent i chooses
     /// anew) else `executed_i` (agent i keeps running it): [K * N].
     pub cond: Vec<i32>,
 }
@@ -67,7 +67,7 @@ impl AgentView {
     pub fn n_records(&self) -> usize {
         self.actions.len()
     }
-    /// True when no sampled sequence has a record of this agent (spec Q9: nothing to learn).
+    /// True when no sampled sequence has a record of this agent (`docs/ALGORITHMS.md` Q9: nothing to learn).
     pub fn is_empty(&self) -> bool {
         self.actions.is_empty()
     }
@@ -82,7 +82,7 @@ impl JointView {
     pub fn n_records(&self) -> usize {
         self.joint_actions.len()
     }
-    /// True when no sampled sequence has a record with vj = 1 (spec Q9).
+    /// True when no sampled sequence has a record with vj = 1 (`docs/ALGORITHMS.md` Q9).
     pub fn is_empty(&self) -> bool {
         self.joint_actions.is_empty()
     }
@@ -108,7 +108,7 @@ pub fn squeeze_agent(
 }
 
 /// [`squeeze_agent`] keeping only the sequences with at least `min_records` kept records
-/// (`sub_trace_len`, spec 3.3; values below 1 act as 1).
+/// (`sub_trace_len`, `docs/ALGORITHMS.md` §3.3; values below 1 act as 1).
 pub fn squeeze_agent_min(
     batch: &Batch<'_>,
     layout: &Layout,
@@ -234,7 +234,7 @@ pub fn squeeze_joint(batch: &Batch<'_>, layout: &Layout) -> Result<JointView, Re
 }
 
 /// The joint-view rows k with v_i = 1, in order. They pair one-to-one, in order, with agent i's
-/// squeezed records of the same batch (spec 5.3 Step C): a record with v_i = 1 has vj = 1, and
+/// squeezed records of the same batch (`docs/ALGORITHMS.md` §5.3 Step C): a record with v_i = 1 has vj = 1, and
 /// both views walk the sequences and records in the same order. Panics if `agent >= n_agents`.
 pub fn joint_rows_of_agent(joint: &JointView, agent: usize) -> Vec<usize> {
     assert!(agent < joint.n_agents, "agent {agent} out of range");

@@ -1,4 +1,4 @@
-//! One training iteration of any of the five methods (spec `algorithms.md` 5 and 12).
+//! One training iteration of any of the five methods (`docs/ALGORITHMS.md` §5 and 12).
 //!
 //! Every method runs the same steps; the [`Method`] value decides which of them exist:
 //! A, the centralized TD step (Cen-DDRQN, Our-1, Our-1-R, Our-2); B, the conditional joint argmax
@@ -41,7 +41,7 @@ impl Clone for Nets {
 }
 
 impl Nets {
-    /// Target = policy at the start (spec 2.2).
+    /// Target = policy at the start (`docs/ALGORITHMS.md` §2.2).
     pub fn new(policy: QNet, l_rate: f64) -> Self {
         let adam = Adam::new(AdamConfig::with_lr(l_rate), &policy.params);
         Nets {
@@ -52,7 +52,7 @@ impl Nets {
         }
     }
 
-    /// Hard target update (spec 2.4).
+    /// Hard target update (`docs/ALGORITHMS.md` §2.4).
     pub fn sync_target(&mut self) {
         self.target.copy_from(&self.policy);
     }
@@ -80,12 +80,12 @@ impl Nets {
 pub struct IterationParams {
     pub method: Method,
     pub discount: f32,
-    /// Current hysteresis h (spec 5.6), applied where the method says.
+    /// Current hysteresis h (`docs/ALGORITHMS.md` §5.6), applied where the method says.
     pub h: f32,
     /// Quirk Q9: an empty agent view skips every decentralized step of this iteration.
     pub early_return_skips_all: bool,
     /// `sub_trace_len`: an agent's sequence with fewer kept records is dropped from its view
-    /// (spec 3.3; the paper's 1 drops only sequences without any).
+    /// (`docs/ALGORITHMS.md` §3.3; the paper's 1 drops only sequences without any).
     pub sub_trace_len: usize,
 }
 
@@ -125,7 +125,7 @@ pub struct NetTrace {
 }
 
 /// One training iteration. `dec_batch` feeds the decentralized nets; `cen_batch` the centralized
-/// net (the same batch except in Our-2, spec 5.5).
+/// net (the same batch except in Our-2, `docs/ALGORITHMS.md` §5.5).
 pub fn train_iteration(
     p: IterationParams,
     layout: &Layout,
@@ -267,7 +267,7 @@ fn run_iteration(
     Ok(loss)
 }
 
-/// Centralized double-Q targets (spec 5.2): a*_k is the conditional argmax of the online net's
+/// Centralized double-Q targets (`docs/ALGORITHMS.md` §5.2): a*_k is the conditional argmax of the online net's
 /// next Q-values under the record's conditioning, evaluated by the target net.
 pub fn cen_targets(
     joint: &JointView,
@@ -342,7 +342,7 @@ pub fn row_argmax(q: &Array2<f32>) -> Vec<usize> {
 }
 
 /// One Adam step on `nets.policy` for loss = mean_k (max(h d_k, d_k))^2, d_k = y_k - Q(h_k, a_k)
-/// (spec 5, quirk Q4: the hysteretic transform is a leaky ReLU of slope h before squaring, and
+/// (`docs/ALGORITHMS.md` §5, quirk Q4: the hysteretic transform is a leaky ReLU of slope h before squaring, and
 /// the mean runs over all kept records of the batch, quirk Q17). Returns the loss.
 fn step_nets(
     nets: &mut Nets,

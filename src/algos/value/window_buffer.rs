@@ -1,4 +1,4 @@
-//! `ReplayMemory_rand` (spec `algorithms.md` 3.1, quirk Q16): a FIFO of fixed-length windows.
+//! `ReplayMemory_rand` (`docs/ALGORITHMS.md` §3.1, quirk Q16): a FIFO of fixed-length windows.
 //!
 //! An episode of L records contributes the L + trace_len - 1 windows `cache[s .. s + trace_len]`
 //! of `cache = [zero] * (trace_len - 1) + records`, right-padded with zeros: the first trace_len - 1

@@ -18,7 +18,7 @@ pub enum Activation {
 }
 
 impl Activation {
-    /// The Q-net's hidden activation: PyTorch's `F.leaky_relu` default slope (spec 2.1).
+    /// The Q-net's hidden activation: PyTorch's `F.leaky_relu` default slope (`docs/ALGORITHMS.md` §2.1).
     pub const LEAKY_001: Activation = Activation::LeakyRelu(0.01);
 
     #[inline(always)]

@@ -1,5 +1,5 @@
 //! The LSTM over a packed batch of sequences (forward and backward), PyTorch's equations and gate
-//! order (spec `algorithms.md` 2.1):
+//! order (`docs/ALGORITHMS.md` §2.1):
 //!
 //! ```text
 //! [i f g o] = x W_ih^T + b_ih + h_prev W_hh^T + b_hh

@@ -61,7 +61,7 @@ impl Tape {
     }
 
     /// y = x for x > 0, slope * x otherwise. PyTorch's layers use slope 0.01; the hysteretic TD
-    /// transform max(h d, d) of spec `algorithms.md` 5 is exactly this op with slope h (h <= 1).
+    /// transform max(h d, d) of `docs/ALGORITHMS.md` §5 is exactly this op with slope h (h <= 1).
     pub fn leaky_relu(&mut self, x: Var, slope: f32) -> Var {
         let mut y = self.copy_of(x);
         y.mapv_inplace(|v| if v > 0.0 { v } else { slope * v });
@@ -372,7 +372,7 @@ mod tests {
 
     #[test]
     fn leaky_relu_with_slope_h_is_the_hysteretic_transform() {
-        // spec 5: max(h d, d) for h <= 1
+        // `docs/ALGORITHMS.md` §5: max(h d, d) for h <= 1
         let mut t = crate::autograd::Tape::new();
         let d = t.constant(ndarray::arr2(&[[-2.0f32, 0.5, 0.0, 3.0]]).view());
         let y = t.leaky_relu(d, 0.2);

@@ -38,7 +38,7 @@ pub(crate) struct LstmNode {
 
 impl Tape {
     /// h for every valid position of every sequence, each unrolled from a zero state
-    /// (spec `algorithms.md` 2.3). x: [K, in] in flat (sequence, time) order with
+    /// (`docs/ALGORITHMS.md` §2.3). x: [K, in] in flat (sequence, time) order with
     /// K = packing.total(); result [K, H] in the same order. Reorders rows around
     /// [`Tape::lstm_packed`] (the Q-net stays in packed order throughout and calls
     /// `lstm_packed` itself, saving the two gathers).
@@ -49,7 +49,7 @@ impl Tape {
     }
 
     /// The LSTM over packed sequences: h for every valid position of every sequence, each
-    /// unrolled from a zero state (spec `algorithms.md` 2.3), with x: [K, in] and the result
+    /// unrolled from a zero state (`docs/ALGORITHMS.md` §2.3), with x: [K, in] and the result
     /// [K, H] in packed order (see [`SeqPacking`]), where every step reads and writes contiguous
     /// rows. Panics on inconsistent shapes.
     pub fn lstm_packed(&mut self, x: Var, w: LstmVars, packing: &SeqPacking) -> Var {

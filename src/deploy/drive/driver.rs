@@ -1,6 +1,6 @@
 //! Decentralized execution of a domain: the environment runs here, and each agent's macro-action
 //! comes from its own robot, which sees only that agent's macro-observation (issue 7). The loop
-//! is the greedy evaluation episode of spec `algorithms.md` 7.1 with the policy calls replaced by
+//! is the greedy evaluation episode of `docs/ALGORITHMS.md` §7.1 with the policy calls replaced by
 //! messages, so over any transport it must give the same returns and trajectories as in-process
 //! greedy evaluation of the same policy with the same seeds.
 

@@ -1,6 +1,6 @@
 //! `macdec import --reference macromarl`: a policy directory from MacroMARL's trained actors
 //! (`visualization/policy_nns/*/agent_state_dict*.pt`, converted by
-//! `scripts/torch_to_safetensors.py`), one `Actor.state_dict()` per agent (spec `macromarl.md`
+//! `scripts/torch_to_safetensors.py`), one `Actor.state_dict()` per agent (`docs/MACROMARL.md`
 //! 2.4, 4). Each file must be exactly the actor's twelve tensors, F32 and finite, with its input
 //! and output sizes the domain agent's and the same widths as agent 0's; the directory is written
 //! by [`Manifest::write_policy`] as for any other policy, its nets of kind `actor`.

@@ -8,7 +8,7 @@
 //!   robot must pick its next macro-action: the policy reads `obs`, advances its hidden state and
 //!   replies `{"action": k, "name": "...", "q": [..]}` (greedy, ties to the lowest index, quirk
 //!   Q14). When false the running macro-action continues, the state is untouched (the policy only
-//!   reads observations at macro-action boundaries, spec `algorithms.md` 4.2), and the reply is
+//!   reads observations at macro-action boundaries, `docs/ALGORITHMS.md` §4.2), and the reply is
 //!   `{"ok": "continue"}`.
 //! - `{"type": "info"}`: reply `{"agent": i, "manifest": {..}}` (the policy's manifest).
 //!

@@ -1,6 +1,6 @@
-//! The eight macro-actions of each robot (spec `box_pushing.md` section 3).
+//! The eight macro-actions of each robot (`docs/BOX_PUSHING.md` §3).
 
-/// Reference names, indexed by macro-action (spec 3). Kept as the reference spells them so a
+/// Reference names, indexed by macro-action (`docs/BOX_PUSHING.md` §3). Kept as the reference spells them so a
 /// replay can be diffed against it.
 pub const ACTION_NAMES: [&str; 8] = [
     "GT_SB0", "GT_SB1", "GT_BB0", "GT_BB1", "Push", "T_L", "T_R", "Stay",
@@ -9,10 +9,10 @@ pub const ACTION_NAMES: [&str; 8] = [
 /// Number of macro-actions per robot.
 pub const N_ACTIONS: usize = 8;
 
-/// Index of Push, the action the joint big-box check looks for (spec 4 step 3).
+/// Index of Push, the action the joint big-box check looks for (`docs/BOX_PUSHING.md` §4 step 3).
 pub const PUSH: usize = 4;
 
-/// A robot's macro-action. Indices 0..3 navigate to waypoint W0..W3 (spec 5.1).
+/// A robot's macro-action. Indices 0..3 navigate to waypoint W0..W3 (`docs/BOX_PUSHING.md` §5.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum MacroAction {
     /// Move to waypoint `k` (0..=3), the cell below small box 0 / small box 1 / the big box's

@@ -1,6 +1,6 @@
 //! Box Pushing as configs, runs and policy files know it: `env_name = "BP_MA"` (alias
 //! `box-pushing`), its keys `grid_dim` and `env_terminate_step` (the reference's names), the
-//! paper's settings for it (spec `algorithms.md` 10.1, 10.2) and its tagged form in policy and
+//! paper's settings for it (`docs/ALGORITHMS.md` §10.1, 10.2) and its tagged form in policy and
 //! replay files, `{"env": "box-pushing", "grid": 10, "horizon": 100}`.
 
 use super::{BoxPushing, Rules};
@@ -21,7 +21,7 @@ pub const DEFAULT_GRID_DIM: usize = 10;
 pub struct BoxPushingDomain;
 
 /// The paper's horizon for a grid: 100 steps below 30 x 30 (Figure 4a's 10 x 10), 200 from
-/// 30 x 30 on (Figure 4b) (spec `algorithms.md` 10.1, 10.2).
+/// 30 x 30 on (Figure 4b) (`docs/ALGORITHMS.md` §10.1, 10.2).
 pub(super) fn paper_horizon(grid: usize) -> usize {
     if grid >= 30 {
         200
@@ -86,7 +86,7 @@ impl Domain for BoxPushingDomain {
     }
 
     /// Figure 4's settings differ by grid only in the window length (10 x 10: 15, 30 x 30: 45,
-    /// also the training period); both discount by 0.98 (spec 10.1, 10.2).
+    /// also the training period); both discount by 0.98 (`docs/ALGORITHMS.md` §10.1, 10.2).
     fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
         let grid = key_usize(keys, "grid_dim").unwrap_or(DEFAULT_GRID_DIM);
         let trace_len: i64 = if grid >= 30 { 45 } else { 15 };

@@ -1,6 +1,6 @@
 //! One Box Pushing frame: the grid with the goal row (yellow, at the top as in the paper's figure),
 //! faint waypoints, the two small boxes, the 1 x 2 big box and both robots with a heading marker,
-//! for the status bar below it (spec `box_pushing.md` sections 1-2 for what is where).
+//! for the status bar below it (`docs/BOX_PUSHING.md` §1-2 for what is where).
 
 use super::geometry::{Cell, Heading};
 use super::BoxPushing;
@@ -128,7 +128,7 @@ pub fn draw(env: &BoxPushing) -> Picture {
     );
 
     // Robots: a disc in the robot's colour with a dark rim and a dark "hand" toward its heading.
-    // Two robots on one cell (allowed, spec Q4) are drawn smaller, side by side.
+    // Two robots on one cell (allowed, `docs/BOX_PUSHING.md` Q4) are drawn smaller, side by side.
     let shared = env.robot(0).cell == env.robot(1).cell;
     for i in 0..2 {
         let robot = env.robot(i);

@@ -1,11 +1,11 @@
-//! Cells and headings of the Box Pushing grid (spec `box_pushing.md` section 1).
+//! Cells and headings of the Box Pushing grid (`docs/BOX_PUSHING.md` §1).
 //!
 //! The reference works in continuous coordinates whose reachable values are all exact
 //! half-integers, so integer cells reproduce its float equality tests exactly: col = x - 0.5 and
 //! row = y - 0.5. Row 0 is the bottom row; rows grow to the north.
 
 /// A grid cell `(col, row)`. Signed, because the Q2 "teleport" joint push may lift a robot above
-/// the top row (spec Q2), and a front cell may lie outside the grid.
+/// the top row (`docs/BOX_PUSHING.md` Q2), and a front cell may lie outside the grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Cell {
     pub col: i32,
@@ -31,21 +31,21 @@ impl Cell {
         Self::new(self.col - dc, self.row - dr)
     }
 
-    /// Manhattan distance in cells, the navigation planner's score (spec 5.1).
+    /// Manhattan distance in cells, the navigation planner's score (`docs/BOX_PUSHING.md` §5.1).
     #[inline]
     pub fn manhattan(self, other: Cell) -> i32 {
         (self.col - other.col).abs() + (self.row - other.row).abs()
     }
 
-    /// Outside an `n` x `n` grid (spec 1: col or row below 0 or at least `n`).
+    /// Outside an `n` x `n` grid (`docs/BOX_PUSHING.md` §1: col or row below 0 or at least `n`).
     #[inline]
     pub fn is_outside(self, n: i32) -> bool {
         self.col < 0 || self.row < 0 || self.col >= n || self.row >= n
     }
 }
 
-/// A robot heading, in the reference's direction order (spec 1): 0 north, 1 east, 2 south,
-/// 3 west. The index also orders the planner's tie-break (spec 5.1).
+/// A robot heading, in the reference's direction order (`docs/BOX_PUSHING.md` §1): 0 north, 1 east, 2 south,
+/// 3 west. The index also orders the planner's tie-break (`docs/BOX_PUSHING.md` §5.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[repr(u8)]
 pub enum Heading {

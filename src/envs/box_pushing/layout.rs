@@ -1,10 +1,10 @@
-//! The deterministic start configuration and waypoints (spec `box_pushing.md` section 2).
+//! The deterministic start configuration and waypoints (`docs/BOX_PUSHING.md` §2).
 
 use super::geometry::{Cell, Heading};
 
 /// Where everything starts on an N x N grid, and the four fixed waypoints.
 ///
-/// For N >= 8 these are the reference's formulas (spec 2), written with N for both axes: the
+/// For N >= 8 these are the reference's formulas (`docs/BOX_PUSHING.md` §2), written with N for both axes: the
 /// reference computes several x positions from ylen (Q9), which only matters on non-square grids,
 /// and those are not supported. MacroMARL's `box_pushing_MA.py` adds fixed layouts for N = 6
 /// (robots and small boxes in the outer columns) and for smaller grids (the 4 x 4 one, robots in
@@ -21,7 +21,7 @@ pub struct GridLayout {
     /// Left cell of the 1 x 2 big box; (N/2-1, N/2) from N = 8 on. It also covers the cell east
     /// of it.
     pub big_box_left: Cell,
-    /// W0..W3, each the cell below its box; W_k is the target of macro-action k (spec 2, 3).
+    /// W0..W3, each the cell below its box; W_k is the target of macro-action k (`docs/BOX_PUSHING.md` §2, 3).
     pub waypoints: [Cell; 4],
 }
 
@@ -54,7 +54,7 @@ impl GridLayout {
         }
     }
 
-    /// The goal row (the top row, spec 1).
+    /// The goal row (the top row, `docs/BOX_PUSHING.md` §1).
     #[inline]
     pub fn goal_row(&self) -> i32 {
         self.n - 1

@@ -1,5 +1,5 @@
 //! Box Pushing, the macro-action version used for the paper's Box Pushing figures, exact to
-//! `shared/spec/box_pushing.md` (the reference's `BoxPushing_harder`).
+//! `docs/BOX_PUSHING.md` (the reference's `BoxPushing_harder`).
 //!
 //! Two robots on an N x N grid push boxes north into the top row: a small box alone is worth +10,
 //! the big box +100 but needs both robots to push together. Every step costs -0.1; pushing into a
@@ -40,7 +40,7 @@ use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
 pub const N_AGENTS: usize = 2;
 
 /// Smallest grid side of the ICRA paper's Box Pushing: the spec's general layout formulas need
-/// N >= 8 (spec 2). MacroMARL's rules go down to 4 ([`Rules::min_grid`]).
+/// N >= 8 (`docs/BOX_PUSHING.md` §2). MacroMARL's rules go down to 4 ([`Rules::min_grid`]).
 pub const MIN_GRID: usize = Rules::ICRA.min_grid;
 
 /// Length of the global state ([`MacroEnv::write_state`]): per robot x, y and a one-hot heading,
@@ -63,8 +63,8 @@ pub struct DeliveryStats {
     pub big_box: u64,
 }
 
-/// The Box Pushing environment (spec `box_pushing.md`). Deterministic: the RNG passed to
-/// [`MacroEnv::reset`] / [`MacroEnv::step`] is never drawn from (spec 9; random initialisation,
+/// The Box Pushing environment (`docs/BOX_PUSHING.md`). Deterministic: the RNG passed to
+/// [`MacroEnv::reset`] / [`MacroEnv::step`] is never drawn from (`docs/BOX_PUSHING.md` §9; random initialisation,
 /// unused by the paper, is not provided).
 ///
 /// Constructed in the reset state, so `step` may be called at once.
@@ -75,7 +75,7 @@ pub struct BoxPushing {
     rules: Rules,
     robots: [Robot; N_AGENTS],
     boxes: Boxes,
-    /// The joint big-box push latch (spec 4 step 3, 5.4): once on, it stays on until reset.
+    /// The joint big-box push latch (`docs/BOX_PUSHING.md` §4 step 3, 5.4): once on, it stays on until reset.
     joint_push: bool,
     /// Primitive steps since reset.
     t: usize,
@@ -94,14 +94,16 @@ impl BoxPushing {
         if grid < min {
             return Err(EnvError::InvalidParameter {
                 name: "grid",
-                reason: format!("must be at least {min} (spec section 2 layout), got {grid}"),
+                reason: format!(
+                    "must be at least {min} (`docs/BOX_PUSHING.md` §2 layout), got {grid}"
+                ),
             });
         }
         if !grid.is_multiple_of(2) {
             return Err(EnvError::InvalidParameter {
                 name: "grid",
                 reason: format!(
-                    "must be even (an odd grid puts the big box off the cell centres, spec Q9), got {grid}"
+                    "must be even (an odd grid puts the big box off the cell centres, `docs/BOX_PUSHING.md` Q9), got {grid}"
                 ),
             });
         }
@@ -129,7 +131,7 @@ impl BoxPushing {
     /// An N x N Box Pushing environment under `rules`, with an episode horizon in primitive steps.
     ///
     /// `grid` must be even and at least `rules.min_grid`: the spec's layout formulas need N >= 8
-    /// (spec 2; MacroMARL adds fixed 4 x 4 and 6 x 6 layouts) and an odd N puts the big box and
+    /// (`docs/BOX_PUSHING.md` §2; MacroMARL adds fixed 4 x 4 and 6 x 6 layouts) and an odd N puts the big box and
     /// its waypoints off the cell centres, where they can never be reached or seen (quirk Q9).
     /// `horizon` must be at least 1.
     pub fn with_rules(grid: usize, horizon: usize, rules: Rules) -> Result<Self, EnvError> {
@@ -177,7 +179,7 @@ impl BoxPushing {
         &self.boxes
     }
 
-    /// Whether the joint big-box push is under way (spec 5.4).
+    /// Whether the joint big-box push is under way (`docs/BOX_PUSHING.md` §5.4).
     pub fn joint_push_active(&self) -> bool {
         self.joint_push
     }
@@ -192,7 +194,7 @@ impl BoxPushing {
         self.stats
     }
 
-    /// Back to the start configuration (spec 2). Statistics persist (Q14).
+    /// Back to the start configuration (`docs/BOX_PUSHING.md` §2). Statistics persist (Q14).
     fn reset_state(&mut self) {
         self.robots = start_robots(&self.layout);
         self.boxes = start_boxes(&self.layout);
@@ -218,7 +220,7 @@ impl BoxPushing {
     }
 }
 
-/// Both robots at their start cells, free, remembering no waypoint (spec 2).
+/// Both robots at their start cells, free, remembering no waypoint (`docs/BOX_PUSHING.md` §2).
 fn start_robots(layout: &GridLayout) -> [Robot; N_AGENTS] {
     layout
         .robot_starts
@@ -293,7 +295,7 @@ impl MacroEnv for BoxPushing {
     }
 
     /// Known at gamma 0.98 for the ICRA paper's two settings (10x10 horizon 100, 30x30 horizon
-    /// 200) and for MacroMARL's published rewards on grids 6 to 14 (spec `macromarl.md` 3.1), where
+    /// 200) and for MacroMARL's published rewards on grids 6 to 14 (`docs/MACROMARL.md` §3.1), where
     /// the best plan is the scripted one: each robot to its big-box waypoint, then the joint push.
     fn optimal_return(&self, discount: f64) -> Option<f64> {
         if discount != 0.98 {

@@ -1,11 +1,11 @@
-//! Move-to-waypoint: the reference's one-step greedy planner (spec `box_pushing.md` 5.1).
+//! Move-to-waypoint: the reference's one-step greedy planner (`docs/BOX_PUSHING.md` §5.1).
 
 use super::geometry::{Cell, Heading};
 use super::state::{Boxes, Robot};
 
 /// Turn cost of heading to `d` from `h`, as a rank: 0 straight on, 1 to the side (cost 0.1),
 /// 2 behind (cost 0.2). Distances are integers and costs are below 1, so comparing
-/// `(distance, rank)` lexicographically equals the reference's float score (spec 5.1 (b)).
+/// `(distance, rank)` lexicographically equals the reference's float score (`docs/BOX_PUSHING.md` §5.1 (b)).
 #[inline]
 fn turn_rank(h: Heading, d: Heading) -> i32 {
     if d == h {
@@ -40,7 +40,7 @@ fn choose_direction(robot: &Robot, target: Cell, boxes: &Boxes) -> Heading {
     best
 }
 
-/// One primitive step of Move-to-waypoint `k` whose cell is `target` (spec 5.1). Sets
+/// One primitive step of Move-to-waypoint `k` whose cell is `target` (`docs/BOX_PUSHING.md` §5.1). Sets
 /// `robot.finished` and the remembered waypoint on arrival facing north. Never moves boxes and
 /// never gives rewards.
 #[inline]
@@ -94,7 +94,7 @@ mod tests {
 
     #[test]
     fn travel_times_from_the_start_match_the_spec_table() {
-        // Spec 5.1: robot 0 to W0..W3 takes N/2-1, 3N/2-4, N-3, N-2 steps; robot 1 mirrored.
+        // `docs/BOX_PUSHING.md` §5.1: robot 0 to W0..W3 takes N/2-1, 3N/2-4, N-3, N-2 steps; robot 1 mirrored.
         for n in [8, 10, 12, 30] {
             let l = GridLayout::new(n);
             let r0 = [n / 2 - 1, 3 * n / 2 - 4, n - 3, n - 2];
@@ -119,7 +119,7 @@ mod tests {
 
     #[test]
     fn robot_zero_to_w2_moves_east_three_times_turns_then_goes_north() {
-        // Spec 5.1 example on 10x10.
+        // `docs/BOX_PUSHING.md` §5.1 example on 10x10.
         let l = GridLayout::new(10);
         let b = boxes(&l);
         let mut r = Robot::at_start(Cell::new(1, 1), Heading::East);
@@ -147,7 +147,7 @@ mod tests {
 
     #[test]
     fn detour_around_small_box_one_takes_fourteen_steps() {
-        // Spec 5.1 detour example (scenario S14's last leg): from (9,9) facing north to W1.
+        // `docs/BOX_PUSHING.md` §5.1 detour example (scenario S14's last leg): from (9,9) facing north to W1.
         let l = GridLayout::new(10);
         let b = boxes(&l);
         let mut r = Robot::at_start(Cell::new(9, 9), Heading::North);
@@ -201,7 +201,7 @@ mod tests {
 
     #[test]
     fn every_free_cell_and_heading_reaches_every_waypoint() {
-        // Spec 5.1: exhaustive for N = 10 and 30, worst case 14 steps over the Manhattan distance.
+        // `docs/BOX_PUSHING.md` §5.1: exhaustive for N = 10 and 30, worst case 14 steps over the Manhattan distance.
         let mut worst = 0;
         for n in [10, 30] {
             let l = GridLayout::new(n);

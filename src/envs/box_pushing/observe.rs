@@ -1,11 +1,11 @@
-//! Macro-observations: what a robot sees in its front cell (spec `box_pushing.md` section 6).
+//! Macro-observations: what a robot sees in its front cell (`docs/BOX_PUSHING.md` §6).
 
 use super::state::{Boxes, Robot};
 
 /// Values per robot observation.
 pub const OBS_SIZE: usize = 5;
 
-/// Element names in layout order (spec 6).
+/// Element names in layout order (`docs/BOX_PUSHING.md` §6).
 pub const OBS_NAMES: [&str; OBS_SIZE] = ["small_box", "big_box", "empty", "wall", "teammate"];
 
 /// The observation every robot gets at reset, whatever is in front (quirk Q8).
@@ -50,7 +50,7 @@ mod tests {
 
     #[test]
     fn spec_examples_are_one_hot() {
-        // Spec 6 examples on 10x10; the teammate is parked far away.
+        // `docs/BOX_PUSHING.md` §6 examples on 10x10; the teammate is parked far away.
         let b = start_boxes();
         let away = at(0, 0, Heading::North);
         let n = Heading::North;

@@ -13,7 +13,7 @@ use super::state::Robot;
 use super::BoxPushing;
 use crate::envs::{EnvRng, MacroEnv};
 
-/// Every team reward that can occur, as bit-exact f64 sums in the spec's order (spec 4). The spec
+/// Every team reward that can occur, as bit-exact f64 sums in the spec's order (`docs/BOX_PUSHING.md` §4). The spec
 /// lists the first six; 4.9 = (-0.1 - 5) + 10 also follows from its rules (one robot delivers a
 /// small box while the other takes a -5 penalty in the same step) and random episodes reach it.
 const REWARDS: [f64; 7] = [-0.1, -5.1, -10.1, 9.9, 19.9, 99.9, 4.9];
@@ -194,7 +194,7 @@ fn random_episodes_keep_every_invariant() {
     // Multi-bit observations (Q13) are too rare for random play; observe.rs tests one directly.
 }
 
-/// A literal model of spec sections 4-6 in the reference's continuous coordinates (cell centres on
+/// A literal model of `docs/BOX_PUSHING.md` §4-6 in the reference's continuous coordinates (cell centres on
 /// half-integers, the big box by its centre x), with the reference's float comparisons. Written
 /// independently of the integer implementation to cross-check it.
 mod float_model {

@@ -1,10 +1,10 @@
-//! Push by a single robot (spec `box_pushing.md` 5.2). The joint big-box push is in `step.rs`.
+//! Push by a single robot (`docs/BOX_PUSHING.md` §5.2). The joint big-box push is in `step.rs`.
 
 use super::geometry::Heading;
 use super::state::{Boxes, Robot};
 
 /// Whether the robot stands on a boundary cell facing out of an `n` x `n` grid: facing north in
-/// row n-1, east in column n-1, south in row 0 or west in column 0 (spec 5.2 (a), (c)). Exact
+/// row n-1, east in column n-1, south in row 0 or west in column 0 (`docs/BOX_PUSHING.md` §5.2 (a), (c)). Exact
 /// equality as in the reference: a robot lifted above the grid by Q2 is not "on the edge".
 /// The reference uses xlen for (a) and ylen for (c) east tests (Q9); on square grids both are n.
 #[inline]
@@ -18,7 +18,7 @@ pub fn facing_out_from_edge(robot: &Robot, n: i32) -> bool {
 }
 
 /// One primitive step of Push by one robot on an `n` x `n` grid with goal row `n - 1`, where a hit
-/// costs `hit` ([`super::Rules::penalty`]: -5 in the ICRA paper, spec 7). Returns the robot's penalty, summed from 0.0
+/// costs `hit` ([`super::Rules::penalty`]: -5 in the ICRA paper, `docs/BOX_PUSHING.md` §7). Returns the robot's penalty, summed from 0.0
 /// in box order as the reference does (0.0 or one `hit`; two would need a robot standing inside
 /// a box).
 #[inline]

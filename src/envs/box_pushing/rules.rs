@@ -23,7 +23,7 @@ pub struct Rules {
 }
 
 impl Rules {
-    /// The ICRA paper's Box Pushing (spec `box_pushing.md` 7).
+    /// The ICRA paper's Box Pushing (`docs/BOX_PUSHING.md` §7).
     pub const ICRA: Rules = Rules {
         big_box_reward: 100.0,
         small_box_reward: 10.0,
@@ -32,7 +32,7 @@ impl Rules {
         min_grid: 8,
     };
 
-    /// MacroMARL's `BP-MA-v0` with its published rewards (spec `macromarl.md` 3.1).
+    /// MacroMARL's `BP-MA-v0` with its published rewards (`docs/MACROMARL.md` §3.1).
     pub const MACROMARL: Rules = Rules {
         big_box_reward: 300.0,
         small_box_reward: 20.0,

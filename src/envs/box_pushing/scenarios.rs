@@ -1,4 +1,4 @@
-//! The hand-checkable scenarios of spec `box_pushing.md` section 14 (values from the reference),
+//! The hand-checkable scenarios of `docs/BOX_PUSHING.md` §14 (values from the reference),
 //! the S9 macro-rewards of section 10, the optimum of section 11, and input errors.
 
 use rand::SeedableRng;
@@ -60,7 +60,7 @@ fn new_env(n: usize) -> BoxPushing {
     BoxPushing::new(n, horizon).unwrap()
 }
 
-/// Run queues of macro-actions (spec 14 conventions): a free robot takes its next queue entry, or
+/// Run queues of macro-actions (`docs/BOX_PUSHING.md` §14 conventions): a free robot takes its next queue entry, or
 /// Stay when the queue is empty; a busy robot passes [`BUSY`]. Stops at done or `max_steps`.
 /// `trace[k]` is step k+1.
 fn run_queues_on(env: &mut BoxPushing, queues: [&[usize]; 2], max_steps: usize) -> Vec<Rec> {
@@ -98,7 +98,7 @@ fn run_queues(n: usize, queues: [&[usize]; 2], max_steps: usize) -> Vec<Rec> {
     run_queues_on(&mut new_env(n), queues, max_steps)
 }
 
-/// Evaluation return G = sum_k gamma^k r_{k+1} (spec 8).
+/// Evaluation return G = sum_k gamma^k r_{k+1} (`docs/BOX_PUSHING.md` §8).
 fn discounted(trace: &[Rec]) -> f64 {
     let mut g = 0.0;
     let mut discount = 1.0;
@@ -121,7 +121,7 @@ fn flag_steps(trace: &[Rec], i: usize) -> Vec<usize> {
         .collect()
 }
 
-/// The runner's macro-rewards (spec 10): per robot, (step, r^c) at each of its flags, and the
+/// The runner's macro-rewards (`docs/BOX_PUSHING.md` §10): per robot, (step, r^c) at each of its flags, and the
 /// joint (step, r^c) at each step where any flag is set.
 #[allow(clippy::type_complexity)]
 fn macro_rewards(trace: &[Rec]) -> ([Vec<(usize, f64)>; 2], Vec<(usize, f64)>) {
@@ -526,7 +526,7 @@ fn s18_small_box_on_30x30() {
     assert_close(discounted(&trace), 3.635556144546821);
 }
 
-/// The optimal joint policy of spec 11 as a state-feedback rule: each robot goes to its big-box
+/// The optimal joint policy of `docs/BOX_PUSHING.md` §11 as a state-feedback rule: each robot goes to its big-box
 /// waypoint (robot 0 to W2, robot 1 to W3), then pushes.
 fn optimal_policy(env: &BoxPushing, agent: usize) -> usize {
     if env.robot(agent).waypoint.is_none() {
@@ -570,7 +570,7 @@ fn optimal_policy_reproduces_g_star() {
 
 #[test]
 fn optimal_policy_takes_three_halves_n_minus_four_steps_on_any_grid() {
-    // Spec 11: T* = 3N/2 - 4 and G* = -0.1 (1 - g^(T*-1)) / (1 - g) + 99.9 g^(T*-1).
+    // `docs/BOX_PUSHING.md` §11: T* = 3N/2 - 4 and G* = -0.1 (1 - g^(T*-1)) / (1 - g) + 99.9 g^(T*-1).
     for n in [8usize, 12, 16, 20, 40] {
         let (g, t) = optimal_return(n, 10 * n);
         let t_star = 3 * n / 2 - 4;

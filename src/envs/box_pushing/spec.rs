@@ -18,7 +18,7 @@ pub fn spec(grid: usize, horizon: usize) -> EnvSpec {
 }
 
 /// Box Pushing at the paper's horizon for its grid (100 steps below 30 x 30, 200 from 30 x 30
-/// on; spec 10.1, 10.2).
+/// on; `docs/ALGORITHMS.md` §10.1, 10.2).
 pub fn paper_spec(grid: usize) -> EnvSpec {
     spec(grid, paper_horizon(grid))
 }

@@ -1,4 +1,4 @@
-//! The mutable world: robots and boxes (spec `box_pushing.md` sections 2 and 4).
+//! The mutable world: robots and boxes (`docs/BOX_PUSHING.md` §2 and 4).
 
 use super::actions::MacroAction;
 use super::geometry::{Cell, Heading};
@@ -19,7 +19,7 @@ pub struct Robot {
 }
 
 impl Robot {
-    /// A free robot with no history, as after reset (spec 2, "Internal state at reset").
+    /// A free robot with no history, as after reset (`docs/BOX_PUSHING.md` §2, "Internal state at reset").
     pub fn at_start(cell: Cell, heading: Heading) -> Self {
         Self {
             cell,
@@ -57,7 +57,7 @@ impl Boxes {
         }
     }
 
-    /// Whether `cell` is a navigation obstacle (spec 5.1 (b), quirk Q3): its row is small box 0's
+    /// Whether `cell` is a navigation obstacle (`docs/BOX_PUSHING.md` §5.1 (b), quirk Q3): its row is small box 0's
     /// current row and its column is one of the four box columns. Nothing else blocks.
     #[inline]
     pub fn blocks_navigation(&self, cell: Cell) -> bool {

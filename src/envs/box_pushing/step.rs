@@ -1,4 +1,4 @@
-//! One environment step in the reference's exact order (spec `box_pushing.md` section 4).
+//! One environment step in the reference's exact order (`docs/BOX_PUSHING.md` §4).
 
 use super::actions::{MacroAction, N_ACTIONS, PUSH};
 use super::geometry::Heading;
@@ -10,10 +10,10 @@ use super::state::{Boxes, Robot};
 use super::{BoxPushing, N_AGENTS};
 use crate::envs::{EnvError, StepOutcome};
 
-/// The time penalty every step starts from (spec 7).
+/// The time penalty every step starts from (`docs/BOX_PUSHING.md` §7).
 pub const STEP_REWARD: f64 = -0.1;
 
-/// One primitive step of macro-action `m` for one robot (spec 5). Returns its penalty.
+/// One primitive step of macro-action `m` for one robot (`docs/BOX_PUSHING.md` §5). Returns its penalty.
 #[inline]
 fn execute(
     robot: &mut Robot,
@@ -45,7 +45,7 @@ fn execute(
     }
 }
 
-/// Whether this step starts the joint big-box push (spec 4 step 3): both robots pass Push, both
+/// Whether this step starts the joint big-box push (`docs/BOX_PUSHING.md` §4 step 3): both robots pass Push, both
 /// are free, both face north, and their remembered waypoints are W2 and W3 in either order.
 /// Positions are not checked (quirk Q2).
 #[inline]
@@ -112,7 +112,7 @@ impl BoxPushing {
                 reward += penalty;
             }
         } else {
-            // 5. Joint push: both robots and the big box rise one row, no checks (spec 5.4).
+            // 5. Joint push: both robots and the big box rise one row, no checks (`docs/BOX_PUSHING.md` §5.4).
             for robot in &mut self.robots {
                 robot.current = Some(MacroAction::Push);
                 robot.finished = false;
@@ -152,7 +152,7 @@ impl BoxPushing {
         }
         reward += bonus;
 
-        // 7. Fresh observations for robots that finished, held ones for the others (spec 6).
+        // 7. Fresh observations for robots that finished, held ones for the others (`docs/BOX_PUSHING.md` §6).
         for agent in 0..N_AGENTS {
             if self.robots[agent].finished {
                 let mate = &self.robots[1 - agent];

@@ -1,5 +1,5 @@
 //! MacroMARL's published actor-critic settings on Box Pushing (`experiments/BoxPushing/mac_*.sh`,
-//! spec `macromarl_hp_table.md`): one row per grid and method, 40 000 episodes, gamma 0.98,
+//! `docs/MACROMARL.md` §1.4): one row per grid and method, 40 000 episodes, gamma 0.98,
 //! widths 32. The published Naive Mac-IACC and Mac-IAICC runs use the state critics
 //! (`NaiveMacIASC`, `MacIAISC`); their history-critic variants take the same rows.
 

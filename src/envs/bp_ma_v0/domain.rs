@@ -208,7 +208,7 @@ mod tests {
 
     #[test]
     fn the_optimum_is_the_spec_table_at_published_rewards_only() {
-        // spec macromarl.md 3.1: the scripted plan's discounted return, gamma 0.98.
+        // `docs/MACROMARL.md` §3.1: the scripted plan's discounted return, gamma 0.98.
         for (grid, optimum) in [
             (6, 270.6055),
             (8, 259.6915),

@@ -1,4 +1,4 @@
-//! `BP-MA-v0`: Box Pushing as MacroMARL configures it (spec `macromarl.md` 3.1).
+//! `BP-MA-v0`: Box Pushing as MacroMARL configures it (`docs/MACROMARL.md` §3.1).
 //!
 //! The dynamics are the ICRA paper's ([`super::box_pushing`]; MacroMARL's core file only adds
 //! the `penalty` parameter), under [`super::box_pushing::Rules::MACROMARL`]: rewards 300 / 20 /

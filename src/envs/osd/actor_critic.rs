@@ -1,9 +1,9 @@
 //! MacroMARL's published actor-critic settings on Warehouse A-E
-//! (`experiments/Warehouse/mac_*.sh`, spec `macromarl_hp_table.md`): gamma 1, 40 000 episodes
+//! (`experiments/Warehouse/mac_*.sh`, `docs/MACROMARL.md` §1.4): gamma 1, 40 000 episodes
 //! on A and B, 80 000 on C and D, 100 000 on E. Warehouse A, B and the ablation are all
 //! `OSD-D-v7` and differ in the humans' speeds: B's ([18, 15, 15, 15] and [48, 18, 15, 15]) and
 //! the ablation's ([18, 18, 18, 18] for both humans) select their rows, any other A's.
-//! Where the reference's scripts disagree with each other (spec 5.2: Warehouse C's Naive
+//! Where the reference's scripts disagree with each other (`docs/MACROMARL.md` §5.2: Warehouse C's Naive
 //! Mac-IACC and Mac-IAICC ran on `OSD-T-v1`, Naive Mac-IACC's "Warehouse B" used A's speeds), the
 //! rows are each script's own: a config that wants the other reading sets its keys.
 

@@ -1,7 +1,7 @@
 //! What distinguishes MacroMARL's four Warehouse environments from one another: the rooms'
 //! waypoints, the robots' start points, how many humans and Turtlebots there are, which Fetch
 //! (`AgentFetch_v4` passes to 2 Turtlebots, `_v5` to 3), and the few places where one reference
-//! file's code differs from the others'. Everything else is the same code (spec 3.2), which lives
+//! file's code differs from the others'. Everything else is the same code (`docs/MACROMARL.md` §3.2), which lives
 //! once in this folder.
 //!
 //! Coordinates are metres, as `BeliefWayPoint` and `createAgents` of each class set them.

@@ -4,7 +4,7 @@
 //!
 //! Turtlebots carry tools from a table in the tool room to humans working in their own areas; a
 //! Fetch arm finds the tools and passes them over. Each human needs tools 0, 1, 2 in order; the
-//! episode is terminal when every human got its third tool (spec `macromarl.md` 3.2). The four
+//! episode is terminal when every human got its third tool (`docs/MACROMARL.md` §3.2). The four
 //! reference classes share their logic, so one generic environment [`Osd`] serves them, the
 //! const parameter picking its [`Layout`] (their differences, all in `layout.rs`).
 //!
@@ -12,11 +12,11 @@
 //! bootstraps), except in OSD-F-v0, whose env itself is terminal at `terminate_step`.
 //!
 //! **Optimum: unknown** ([`MacroEnv::optimal_return`] is `None`). Every delivery is worth at
-//! most 100 and every step costs 1, so a return is at most 300 x humans - steps (spec 3.2). Lower
+//! most 100 and every step costs 1, so a return is at most 300 x humans - steps (`docs/MACROMARL.md` §3.2). Lower
 //! bounds at the published settings (undiscounted): the scripted team of `scenarios.rs` gets
 //! A 533 in 67 steps (the bound for that length), C 797 in 103, D 760 in 100, E 1051 in 129;
 //! the reference's shipped learned policies get C 801 in 99, D 781 in 99, E 1050 in 130
-//! (spec section 4).
+//! (`docs/MACROMARL.md` §4).
 //!
 //! The published settings draw nothing; with `TB_move_noisy` or `fetch_manip_noisy` set, steps
 //! draw from the caller's [`EnvRng`] (same distributions as the reference, not its numbers).

@@ -289,7 +289,7 @@ fn the_scripted_team_serves_every_human_and_ends_terminal() {
         let (t, ret, out) = run_scripted(&mut env);
         assert!(out.terminal(), "{}: cut at {t}", Osd::<V>::layout().gym_id);
         assert!(env.humans().iter().all(|h| h.cur_step >= 2 && h.obtained));
-        // The upper bound of spec 3.2: 300 per human minus one per step.
+        // The upper bound of `docs/MACROMARL.md` §3.2: 300 per human minus one per step.
         assert!(ret <= 300.0 * env.humans().len() as f64 - t as f64);
         (t, ret)
     }
@@ -300,7 +300,7 @@ fn the_scripted_team_serves_every_human_and_ends_terminal() {
         check(OsdF0::published(300).unwrap()),
     ];
     // Lower bounds on the optimum (the shipped learned policies reach C 801 in 99 steps, D 781
-    // in 99, E 1050 in 130; spec section 4). A and C meet the upper bound 300 N - steps.
+    // in 99, E 1050 in 130; `docs/MACROMARL.md` §4). A and C meet the upper bound 300 N - steps.
     assert_eq!(
         results,
         [(67, 533.0), (103, 797.0), (100, 760.0), (129, 1051.0)]

@@ -1,5 +1,5 @@
 //! MacroMARL's published actor-critic settings on Overcooked maps A-C
-//! (`experiments/Overcooked/mac_*.sh`, spec `macromarl_hp_table.md`): gamma 0.99, eps to 0.05
+//! (`experiments/Overcooked/mac_*.sh`, `docs/MACROMARL.md` §1.4): gamma 0.99, eps to 0.05
 //! over 20 000 episodes, 100 000 episodes (120 000 on map B). The critics of Mac-CAC, Naive
 //! Mac-IACC and Mac-IAICC are wider (MLP [128, 64], GRU 64).
 

@@ -12,7 +12,7 @@ use crate::envs::EnvError;
 
 /// The agent count when `n_agent` is not given: the paper's 3.
 ///
-/// The reference's bug (spec `macromarl.md` 5.2 item 1): MacroMARL's scripts never pass
+/// The reference's bug (`docs/MACROMARL.md` §5.2 item 1): MacroMARL's scripts never pass
 /// `n_agent` (their `--n_agent=3` goes nowhere), so as published they train **2** agents (the
 /// environment's own default, [`REFERENCE_N_AGENT`]), while the paper, its figures and the
 /// shipped policies use **3**. macdec defaults to the paper's kitchen; `n_agent = 2` gives what

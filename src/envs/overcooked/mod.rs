@@ -1,6 +1,6 @@
 //! Overcooked, the macro-action version MacroMARL trains on (`Overcooked-MA-v1` from
 //! gym-macro-overcooked behind MacroMARL's `MacEnvWrapper`), exact to the reference code
-//! (spec `macromarl.md` 3.3; where the spec and the code disagree, the code).
+//! (`docs/MACROMARL.md` §3.3; where the spec and the code disagree, the code).
 //!
 //! Agents in a 7 x 7 (or 9 x 9) kitchen fetch a tomato, a lettuce and an onion, chop each
 //! three times on a cutting board, gather them on a plate and deliver the task's salad. Every
@@ -12,7 +12,7 @@
 //! Two engine quirks need no code: `_checkMacroActionDone`'s "go to counter" branch tests a
 //! name with a trailing space and never fires (see [`macro_actions::ended_after_step`]), and
 //! `_checkCollision` reads `info['collision']`, which the primitive step leaves empty, so
-//! collisions never end a macro-action (spec 3.3, 5.2).
+//! collisions never end a macro-action (`docs/MACROMARL.md` §3.3, 5.2).
 //!
 //! The module follows the reference's layers: [`layout`] (maps), [`world`] (items), `step`
 //! (the primitive step), [`astar`] (navigation with Python's heap order), [`macro_actions`]
@@ -63,7 +63,7 @@ pub struct OvercookedParams {
 }
 
 impl Default for OvercookedParams {
-    /// The paper's kitchen: map A, the full salad, 3 agents, horizon 200 (spec 3, table).
+    /// The paper's kitchen: map A, the full salad, 3 agents, horizon 200 (`docs/MACROMARL.md` §3, table).
     fn default() -> Self {
         OvercookedParams {
             side: 7,

@@ -1,6 +1,6 @@
 //! Warehouse Tool Delivery as configs, runs and policy files know it: `env_name = "OSD_S_4"`
 //! (alias `warehouse`), its keys `env_terminate_step` and `tb_m_noisy` (the reference's names),
-//! Figure 5's settings (spec `algorithms.md` 10.3) and its tagged form in policy and replay
+//! Figure 5's settings (`docs/ALGORITHMS.md` §10.3) and its tagged form in policy and replay
 //! files, `{"env": "warehouse", "horizon": 150, "tb_m_noisy": 0.0}`.
 
 use super::{Warehouse, WarehouseParams};
@@ -74,7 +74,7 @@ impl Domain for WarehouseDomain {
         Warehouse::new(params(keys)?).map_err(key_of)
     }
 
-    /// Figure 5's commands differ from Box Pushing's only in these keys (spec 10.3).
+    /// Figure 5's commands differ from Box Pushing's only in these keys (`docs/ALGORITHMS.md` §10.3).
     fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
         key_table([
             ("total_epi", 40000.into()),

@@ -17,7 +17,7 @@ pub const PX_PER_M: f64 = 60.0;
 const WORLD_W_M: f64 = 7.0;
 pub(crate) const WORLD_H_M: f64 = 5.0;
 
-/// Where the human stands in the workshop (the dynamics have no human position; spec section 1).
+/// Where the human stands in the workshop (the dynamics have no human position; `docs/WAREHOUSE.md` §1).
 const HUMAN_POS: [f64; 2] = [6.5, 3.9];
 /// Centres of the two staging slots on the table, first-to-pass first.
 const STAGING: [[f64; 2]; 2] = [[1.75, 2.4], [1.75, 2.05]];
@@ -150,7 +150,7 @@ fn draw_human(c: &mut Canvas, env: &Warehouse) {
 fn draw_turtlebots(c: &mut Canvas, env: &Warehouse) {
     let r = TB_RADIUS_M * PX_PER_M;
     let pos = [0, 1].map(|i| to_px(env.turtlebot(i).pos));
-    // Turtlebots may share a point (spec section 1): draw them side by side.
+    // Turtlebots may share a point (`docs/WAREHOUSE.md` §1): draw them side by side.
     let close = (pos[0].0 - pos[1].0).hypot(pos[0].1 - pos[1].1) < r;
     for (i, &(mut x, y)) in pos.iter().enumerate() {
         if close {

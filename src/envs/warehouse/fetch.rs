@@ -1,10 +1,10 @@
-//! The Fetch's primitive step (spec section 6): search tools into a two-slot staging area and pass
+//! The Fetch's primitive step (`docs/WAREHOUSE.md` §6): search tools into a two-slot staging area and pass
 //! them to a Turtlebot waiting at the table.
 
 use super::params::N_TOOLS;
 use super::turtlebot::{TbAction, Turtlebot};
 
-/// Fetch macro-actions (spec section 3). Index 0 Wait, 1..=2 Pass to Turtlebot 0/1, 3..=5 Search.
+/// Fetch macro-actions (`docs/WAREHOUSE.md` §3). Index 0 Wait, 1..=2 Pass to Turtlebot 0/1, 3..=5 Search.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum FetchAction {
     /// Wait-M: one step.
@@ -57,7 +57,7 @@ impl FetchDynamics {
     }
 }
 
-/// State of `AgentFetch_v4` (spec section 4).
+/// State of `AgentFetch_v4` (`docs/WAREHOUSE.md` §4).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Fetch {
     /// Current macro-action; None before the first step.
@@ -99,7 +99,7 @@ impl Fetch {
         &self.staging[..self.n_staged]
     }
 
-    /// One primitive step (spec section 6). `a` is used only when the Fetch is free. The
+    /// One primitive step (`docs/WAREHOUSE.md` §6). `a` is used only when the Fetch is free. The
     /// Turtlebots have already moved this step. Returns the step's reward (0 or -10).
     pub fn step(&mut self, a: FetchAction, dyn_: &FetchDynamics, tbs: &mut [Turtlebot; 2]) -> f64 {
         self.tl -= 1.0;
@@ -122,7 +122,7 @@ impl Fetch {
         rew
     }
 
-    /// Start `a` (spec section 6 step 3). A Pass is doomed from the start if its Turtlebot is not
+    /// Start `a` (`docs/WAREHOUSE.md` §6 step 3). A Pass is doomed from the start if its Turtlebot is not
     /// at the table or has not waited at least one step (Q6).
     fn start(&mut self, a: FetchAction, dyn_: &FetchDynamics, tbs: &[Turtlebot; 2]) {
         self.cur = Some(a);

@@ -1,7 +1,7 @@
-//! The human in the workshop (spec section 4 "Human", section 8 step 7). Not an agent: it works
+//! The human in the workshop (`docs/WAREHOUSE.md` §4 "Human", section 8 step 7). Not an agent: it works
 //! through `n_objs + 1` steps of fixed duration and needs tool k to leave work step k.
 
-/// State of `AgentHuman` (spec section 4).
+/// State of `AgentHuman` (`docs/WAREHOUSE.md` §4).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Human {
     /// Current work step, 0..=n_objs.
@@ -28,7 +28,7 @@ impl Human {
         }
     }
 
-    /// One primitive step of the human (spec section 8 step 7): count down, and move on once the
+    /// One primitive step of the human (`docs/WAREHOUSE.md` §8 step 7): count down, and move on once the
     /// time is up and the needed tool is there. `n_work_steps` = n_objs + 1.
     pub fn update(&mut self, step_duration: f64, n_work_steps: usize) {
         if self.finished {

@@ -1,11 +1,11 @@
 //! Warehouse Tool Delivery (WTD), the reference's `ObjSearchDelivery_v4` ("OSD_S_4"), exact to
-//! spec `warehouse.md`.
+//! `docs/WAREHOUSE.md`.
 //!
 //! Two Turtlebots fetch tools from a table in the tool room and carry them to a human working in
 //! the workshop; a Fetch arm searches the tools and passes them over. The human needs tool k to
 //! leave work step k; the third correct delivery ends the episode (best return 262 at H = 150).
 //!
-//! One step's order (spec section 8, quirk Q14) lives in `step.rs`; each robot's rules in its own
+//! One step's order (`docs/WAREHOUSE.md` §8, quirk Q14) lives in `step.rs`; each robot's rules in its own
 //! file. At the paper's settings nothing is random; with `tb_move_noisy > 0` travel steps draw
 //! normals from the caller's [`EnvRng`].
 
@@ -152,7 +152,7 @@ impl Warehouse {
         [0, 1].map(|i| Turtlebot::new(TURTLEBOT_STARTS[i], WAYPOINTS[i]))
     }
 
-    /// Rebuild robots and human as at reset (spec section 4); draws nothing.
+    /// Rebuild robots and human as at reset (`docs/WAREHOUSE.md` §4); draws nothing.
     fn reset_state(&mut self) {
         self.tbs = Self::fresh_turtlebots();
         self.fetch = Fetch::default();
@@ -200,7 +200,7 @@ impl MacroEnv for Warehouse {
         self.params.terminate_step
     }
 
-    /// Reset consumes no random draws (spec section 4).
+    /// Reset consumes no random draws (`docs/WAREHOUSE.md` §4).
     fn reset(&mut self, _rng: &mut EnvRng) {
         self.reset_state();
     }
@@ -209,9 +209,9 @@ impl MacroEnv for Warehouse {
         self.step_checked(actions, rng)
     }
 
-    /// The held observation. Note (spec Q10): the reference's `reset()` list is the env's own
+    /// The held observation. Note (`docs/WAREHOUSE.md` Q10): the reference's `reset()` list is the env's own
     /// held list and is overwritten by the first step; here the caller copies what it keeps, and a
-    /// runner replicating that aliasing does so itself (algorithms spec Q20).
+    /// runner replicating that aliasing does so itself (algorithms `docs/WAREHOUSE.md` Q20).
     fn obs(&self, agent: usize) -> &[f32] {
         match agent {
             0 | 1 => &self.obs_tb[agent],

@@ -1,4 +1,4 @@
-//! Macro-observations (spec section 7): what each agent sees when its macro-action finishes.
+//! Macro-observations (`docs/WAREHOUSE.md` §7): what each agent sees when its macro-action finishes.
 //!
 //! Turtlebot (13): location one-hot [workshop, tool-room wait, table, none] | human work step
 //! one-hot (only at the workshop) | basket counts | Fetch's `ready` (only away from the workshop).
@@ -20,7 +20,7 @@ const READY_AT: usize = 11;
 /// Index of the "none" location (no waypoint reached yet).
 const LOC_NONE: usize = 3;
 
-/// A Turtlebot's observation at reset: location none, everything else zero (spec section 7).
+/// A Turtlebot's observation at reset: location none, everything else zero (`docs/WAREHOUSE.md` §7).
 pub fn turtlebot_reset_obs() -> [f32; TB_OBS] {
     let mut o = [0.0; TB_OBS];
     o[LOC_AT + LOC_NONE] = 1.0;

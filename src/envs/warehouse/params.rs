@@ -1,4 +1,4 @@
-//! Constructor parameters of Warehouse Tool Delivery (spec `warehouse.md` section 2) and the fixed
+//! Constructor parameters of Warehouse Tool Delivery (`docs/WAREHOUSE.md` §2) and the fixed
 //! geometry of the world (section 1).
 
 use serde::{Deserialize, Serialize};
@@ -6,17 +6,17 @@ use serde::{Deserialize, Serialize};
 use crate::envs::EnvError;
 
 /// Number of tool types. The observation layout (13/13/4) and the Fetch's 6 actions depend on it,
-/// so only the paper's value is supported (spec section 2: only the paper values are in scope).
+/// so only the paper's value is supported (`docs/WAREHOUSE.md` §2: only the paper values are in scope).
 pub const N_TOOLS: usize = 3;
 
-/// Turtlebot waypoint targets by macro-action index / location code (spec section 1):
+/// Turtlebot waypoint targets by macro-action index / location code (`docs/WAREHOUSE.md` §1):
 /// workshop, tool-room wait point, own table spot. Indexed `[robot][code]`, each `(x, y)` in m.
 pub const WAYPOINTS: [[[f64; 2]; 3]; 2] = [
     [[6.0, 3.0], [2.5, 3.5], [0.8, 3.0]],
     [[6.0, 3.0], [2.5, 3.5], [1.2, 3.0]],
 ];
 
-/// Turtlebot positions at every reset (spec section 1).
+/// Turtlebot positions at every reset (`docs/WAREHOUSE.md` §1).
 pub const TURTLEBOT_STARTS: [[f64; 2]; 2] = [[3.0, 1.5], [3.0, 2.5]];
 
 /// The Fetch's fixed position (it never moves; only the renderer uses it).
@@ -29,9 +29,9 @@ pub const FETCH_POS: [f64; 2] = [0.9, 1.8];
 pub struct WarehouseParams {
     /// Number of tool types; also fixes the human's task length (n_objs + 1 work steps). Only 3.
     pub n_objs: usize,
-    /// Copies of each tool the Fetch can ever find in one episode (spec Q7 with 1).
+    /// Copies of each tool the Fetch can ever find in one episode (`docs/WAREHOUSE.md` Q7 with 1).
     pub n_each_obj: usize,
-    /// Horizon H in primitive steps; `done` is raised at step H (spec Q2).
+    /// Horizon H in primitive steps; `done` is raised at step H (`docs/WAREHOUSE.md` Q2).
     #[serde(alias = "horizon")]
     pub terminate_step: usize,
     /// Duration of each of the human's work steps, in primitive steps.
@@ -75,7 +75,7 @@ impl WarehouseParams {
         }
     }
 
-    /// Get-Tool's wait limit W = pass + search durations (spec section 2; 10 in the paper).
+    /// Get-Tool's wait limit W = pass + search durations (`docs/WAREHOUSE.md` §2; 10 in the paper).
     pub fn get_tool_wait(&self) -> f64 {
         f64::from(self.fetch_pass_obj_tc) + f64::from(self.fetch_look_for_obj_tc)
     }

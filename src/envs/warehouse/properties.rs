@@ -11,7 +11,7 @@ use super::testkit::{SimplePolicy, BUSY};
 use super::{Warehouse, WarehouseParams, WAYPOINTS};
 use crate::envs::{EnvRng, MacroEnv};
 
-/// The per-step rewards that can occur (spec section 10).
+/// The per-step rewards that can occur (`docs/WAREHOUSE.md` §10).
 const REWARDS: [f64; 4] = [-1.0, 99.0, -11.0, 89.0];
 
 /// Joint action: the simple policy, each free agent's choice replaced by a uniform one with

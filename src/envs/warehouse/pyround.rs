@@ -1,4 +1,4 @@
-//! Python's `round(x, 2)` for f64, bit for bit (spec section 5 step 1, quirk Q3).
+//! Python's `round(x, 2)` for f64, bit for bit (`docs/WAREHOUSE.md` §5 step 1, quirk Q3).
 //!
 //! CPython rounds the *exact* binary value of `x` to the nearest multiple of 0.01 (ties to even,
 //! which only happens when `x` is exactly `k/100 + 1/200`, e.g. 0.125) and returns the f64 nearest

@@ -1,4 +1,4 @@
-//! Spec section 14: every scenario (values from the reference) and the S2 optimum, as tests.
+//! `docs/WAREHOUSE.md` §14: every scenario (values from the reference) and the S2 optimum, as tests.
 
 // Trajectories are indexed by step number t, as in the spec's tables.
 #![allow(clippy::needless_range_loop)]
@@ -41,7 +41,7 @@ fn s1_reset_observations_and_human() {
     assert_eq!(env.t(), 0);
 }
 
-/// S2's event table (spec section 14): step, executed, r, mac_done, T0/T1/Fetch obs after the
+/// S2's event table (`docs/WAREHOUSE.md` §14): step, executed, r, mac_done, T0/T1/Fetch obs after the
 /// step (None = held from before), human step.
 type Event = (
     usize,

@@ -18,7 +18,7 @@ pub fn spec(horizon: usize, tb_m_noisy: f64) -> EnvSpec {
     .expect("a valid Warehouse horizon and noise")
 }
 
-/// Warehouse as in Figure 5: horizon 150, no movement noise (spec 10.3).
+/// Warehouse as in Figure 5: horizon 150, no movement noise (`docs/ALGORITHMS.md` §10.3).
 pub fn paper_spec() -> EnvSpec {
     let p = WarehouseParams::default();
     spec(p.terminate_step, p.tb_move_noisy)

@@ -1,4 +1,4 @@
-//! One primitive step of the whole domain, in the reference's exact order (spec section 8, Q14):
+//! One primitive step of the whole domain, in the reference's exact order (`docs/WAREHOUSE.md` §8, Q14):
 //! Turtlebot 0, Turtlebot 1, Fetch, done flags, termination test, human, observations.
 
 use super::fetch::FetchAction;
@@ -23,7 +23,7 @@ impl Warehouse {
                 got: actions.len(),
             });
         }
-        // Only free agents' values are used (busy ones are ignored, spec section 3); the
+        // Only free agents' values are used (busy ones are ignored, `docs/WAREHOUSE.md` §3); the
         // reference's negative-index acceptance (Q11) is rejected like any out-of-range value.
         for agent in 0..N_AGENTS {
             let free = match agent {
@@ -41,7 +41,7 @@ impl Warehouse {
         Ok(self.step_unchecked(actions, rng))
     }
 
-    /// Spec section 8 steps 1-9 on validated input.
+    /// `docs/WAREHOUSE.md` §8 steps 1-9 on validated input.
     fn step_unchecked(&mut self, actions: &[usize], rng: &mut EnvRng) -> StepOutcome {
         let mut r = -1.0;
         self.count += 1;

@@ -1,4 +1,4 @@
-//! Test helpers: the spec harness's `queues` mode (spec section 14 conventions), a recorded
+//! Test helpers: the spec harness's `queues` mode (`docs/WAREHOUSE.md` §14 conventions), a recorded
 //! trajectory, observation strings, and the spec's simple closed-loop policy.
 
 use rand::SeedableRng;

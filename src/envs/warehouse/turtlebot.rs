@@ -1,4 +1,4 @@
-//! A Turtlebot's primitive step (spec section 5): drive toward the macro-action's waypoint, wait
+//! A Turtlebot's primitive step (`docs/WAREHOUSE.md` §5): drive toward the macro-action's waypoint, wait
 //! at the table for Get-Tool, deliver at the workshop for Go-to-WS.
 
 use rand::Rng;
@@ -8,7 +8,7 @@ use super::human::Human;
 use super::pyround::round2;
 use crate::envs::EnvRng;
 
-/// Turtlebot macro-actions (spec section 3); the index is also the target waypoint's code.
+/// Turtlebot macro-actions (`docs/WAREHOUSE.md` §3); the index is also the target waypoint's code.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TbAction {
     /// Go-to-WS: drive to the workshop waypoint (code 0) and offer the basket.
@@ -33,11 +33,11 @@ pub struct TbDynamics {
     /// Late deliveries are worth 20 instead of 100.
     pub delay_delivery_penalty: bool,
     /// Movement noise; `None` when the std is 0. The reference draws normal(0, 0) = +0.0 even
-    /// then, which changes nothing, so with zero noise no draws are made at all (spec section 9).
+    /// then, which changes nothing, so with zero noise no draws are made at all (`docs/WAREHOUSE.md` §9).
     pub noise: Option<Normal<f64>>,
 }
 
-/// State of `AgentTurtlebot_v4` (spec section 4).
+/// State of `AgentTurtlebot_v4` (`docs/WAREHOUSE.md` §4).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Turtlebot {
     /// Position (x, y) in m.
@@ -51,7 +51,7 @@ pub struct Turtlebot {
     /// Whether the current macro-action finished (true at reset: free).
     pub done: bool,
     /// Signed "time left": remaining distance minus speed while travelling, 0 on arrival,
-    /// minus the waiting steps at the table (spec section 4).
+    /// minus the waiting steps at the table (`docs/WAREHOUSE.md` §4).
     pub tl: f64,
     /// Tool counts carried.
     pub basket: [f64; 3],
@@ -76,7 +76,7 @@ impl Turtlebot {
         self.pos == self.targets[TbAction::GetTool as usize]
     }
 
-    /// One primitive step of macro-action `a` (spec section 5). Returns the step's reward
+    /// One primitive step of macro-action `a` (`docs/WAREHOUSE.md` §5). Returns the step's reward
     /// (0, or the delivery bonus). Draws two normals (x then y) only on a travel step with noise.
     pub fn step(
         &mut self,
@@ -129,7 +129,7 @@ impl Turtlebot {
         self.deliver(a, dyn_, human)
     }
 
-    /// Delivery check (spec section 5 step 4): Go-to-WS with the workshop as last waypoint hands
+    /// Delivery check (`docs/WAREHOUSE.md` §5 step 4): Go-to-WS with the workshop as last waypoint hands
     /// over the human's needed tool if carried. Other tools stay in the basket (Q8).
     fn deliver(&mut self, a: TbAction, dyn_: &TbDynamics, human: &mut Human) -> f64 {
         if a != TbAction::GoWorkshop || self.loc != Some(0) {
@@ -183,7 +183,7 @@ mod tests {
     #[test]
     fn leg_durations_match_the_spec_table() {
         use TbAction::*;
-        // Spec section 5 "Leg durations": rows = start, columns = WS, TR, table, for T0 then T1.
+        // `docs/WAREHOUSE.md` §5 "Leg durations": rows = start, columns = WS, TR, table, for T0 then T1.
         // The table spot row's "0 (waits at once)" is checked in the Get-Tool tests below.
         let ws = WAYPOINTS[0][0];
         let tr = WAYPOINTS[0][1];
@@ -213,7 +213,7 @@ mod tests {
 
     #[test]
     fn t1_table_to_workshop_needs_the_rounding() {
-        // Spec section 5 example: tl after each move, then arrival at step 8 (Q3).
+        // `docs/WAREHOUSE.md` §5 example: tl after each move, then arrival at step 8 (Q3).
         let mut tb = Turtlebot::new(WAYPOINTS[1][2], WAYPOINTS[1]);
         let mut h = Human::new(18.0);
         let mut rng = EnvRng::seed_from_u64(0);

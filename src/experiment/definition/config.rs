@@ -3,7 +3,7 @@
 //!
 //! Keys are the reference's command-line flag names (`total_epi`, `trace_len`, `l_rate`, ...), so a
 //! reference command translates key for key. Every key has the paper's value as its default for the
-//! chosen domain and method (spec `algorithms.md` 10): `env_name = "BP_MA"` alone is Figure 4a's
+//! chosen domain and method (`docs/ALGORITHMS.md` §10): `env_name = "BP_MA"` alone is Figure 4a's
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
 use crate::algos::hyper::{AcConfig, RunConfig, ValueConfig};
@@ -710,10 +710,10 @@ fn validate_value(
     }
     check_rates(&[("l_rate", c.l_rate)])?;
     if method.requires_episode_buffer() && !c.sample_epi {
-        // Spec Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
+        // `docs/ALGORITHMS.md` Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
         return Err((
             "sample_epi",
-            "our2 needs the episode buffer (sample_epi = true), as in the reference (spec Q10)"
+            "our2 needs the episode buffer (sample_epi = true), as in the reference (`docs/ALGORITHMS.md` Q10)"
                 .into(),
         ));
     }

@@ -3,13 +3,13 @@
 //! "OSD_S_4"` alone Figure 5's, and `env_name = "BP-MA-v0"` with `mac-iac` MacroMARL's published
 //! Box Pushing block.
 //!
-//! Value methods (spec `algorithms.md` 10), three layers: the ICRA paper's common settings (its
+//! Value methods (`docs/ALGORITHMS.md` §10), three layers: the ICRA paper's common settings (its
 //! Box Pushing 10 x 10 runs), the method's own values (hysteresis, centralized exploration,
 //! evaluation episodes), and the keys the domain's paper setting changes
 //! ([`crate::envs::Domain::paper_settings`], in the domain's folder). A domain no paper trained
 //! on gets the first two.
 //!
-//! Actor-critic methods (spec `macromarl.md` 1.4): the reference's argparse defaults, then the
+//! Actor-critic methods (`docs/MACROMARL.md` §1.4): the reference's argparse defaults, then the
 //! domain's published row for the method ([`crate::envs::Domain::actor_critic_settings`]). A
 //! domain MacroMARL did not publish on keeps the defaults, with the discount of its paper
 //! setting when it has one.
@@ -19,7 +19,7 @@ use crate::algos::method::{Family, Method};
 use crate::envs::EnvSpec;
 use serde::Deserialize;
 
-/// The ICRA paper's common settings for `method` (its Box Pushing 10 x 10 runs, spec 10.1).
+/// The ICRA paper's common settings for `method` (its Box Pushing 10 x 10 runs, `docs/ALGORITHMS.md` §10.1).
 pub fn base_settings(method: Method) -> ValueConfig {
     let (init_h, end_h) = method.paper_hysteresis();
     ValueConfig {
@@ -93,7 +93,7 @@ pub fn actor_critic_defaults(env: &EnvSpec, method: Method) -> AcConfig {
     })
 }
 
-/// The ICRA paper's settings for value `method` on `env` (spec `algorithms.md` 10), before user
+/// The ICRA paper's settings for value `method` on `env` (`docs/ALGORITHMS.md` §10), before user
 /// keys: [`base_settings`] with the domain's paper keys over them.
 pub fn value_paper_defaults(env: &EnvSpec, method: Method) -> ValueConfig {
     let mut table = toml::Table::try_from(base_settings(method)).expect("a table");

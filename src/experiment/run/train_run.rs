@@ -224,7 +224,7 @@ fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
     }
 }
 
-/// The per-role random streams of a run (spec 8: one generator per role from the seed).
+/// The per-role random streams of a run (`docs/ALGORITHMS.md` §8: one generator per role from the seed).
 pub fn run_rngs(seed: u64) -> RunRngs {
     RunRngs {
         init: stream(seed, Role::Init),
