@@ -18,7 +18,7 @@ use crate::autograd::kernels::gru::forward_cells;
 use crate::autograd::{GruVars, SeqPacking, Tape, Var};
 
 /// A one-layer `nn.GRU`'s state_dict names: weight_ih [3H, in], weight_hh [3H, H], bias_ih
-/// [3H], bias_hh [3H]. (Inside a module they get its prefix, e.g. `gru.weight_ih_l0`.)
+/// \[3H\], bias_hh \[3H\]. (Inside a module they get its prefix, e.g. `gru.weight_ih_l0`.)
 pub const GRU_TENSOR_NAMES: [&str; 4] =
     ["weight_ih_l0", "weight_hh_l0", "bias_ih_l0", "bias_hh_l0"];
 
@@ -142,7 +142,7 @@ impl GruState {
         self.h.fill(0.0);
     }
 
-    /// The hidden state h: [H].
+    /// The hidden state h: \[H\].
     pub fn h(&self) -> &[f32] {
         &self.h
     }

@@ -102,7 +102,7 @@ impl GruActorState {
         self.gru.reset();
     }
 
-    /// The GRU's hidden state h: [H].
+    /// The GRU's hidden state h: \[H\].
     pub fn h(&self) -> &[f32] {
         self.gru.h()
     }

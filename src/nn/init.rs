@@ -26,7 +26,7 @@ pub fn uniform2(rows: usize, cols: usize, bound: f32, rng: &mut ChaCha8Rng) -> A
     Array2::from_shape_simple_fn((rows, cols), || d.sample(rng))
 }
 
-/// [n] from U(-bound, bound).
+/// \[n\] from U(-bound, bound).
 pub fn uniform1(n: usize, bound: f32, rng: &mut ChaCha8Rng) -> Array1<f32> {
     let d = Uniform::new(-bound, bound);
     Array1::from_shape_simple_fn(n, || d.sample(rng))

@@ -32,7 +32,7 @@ pub trait Params {
     }
 }
 
-/// A fully connected layer's parameters (PyTorch `nn.Linear`): weight [out, in], bias [out].
+/// A fully connected layer's parameters (PyTorch `nn.Linear`): weight [out, in], bias \[out\].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LinearParams {
     pub weight: Array2<f32>,
@@ -63,11 +63,11 @@ pub struct RecurrentParams<const GATES: usize> {
 }
 
 /// A one-layer LSTM's parameters (PyTorch `nn.LSTM`, gate order i, f, g, o):
-/// weight_ih [4H, in], weight_hh [4H, H], bias_ih [4H], bias_hh [4H].
+/// weight_ih [4H, in], weight_hh [4H, H], bias_ih \[4H\], bias_hh \[4H\].
 pub type LstmParams = RecurrentParams<4>;
 
 /// A one-layer GRU's parameters (PyTorch `nn.GRU`, gate order r, z, n):
-/// weight_ih [3H, in], weight_hh [3H, H], bias_ih [3H], bias_hh [3H].
+/// weight_ih [3H, in], weight_hh [3H, H], bias_ih \[3H\], bias_hh \[3H\].
 pub type GruParams = RecurrentParams<3>;
 
 impl<const GATES: usize> RecurrentParams<GATES> {

@@ -3,8 +3,8 @@
 //! critic step, advantages from the updated critics (P7), one actor step.
 //!
 //! The six methods differ in what their critics see and which advantage each actor takes; that
-//! is the one `match` on [`AcCritic`] in [`critic_inputs`] and on the design in
-//! [`actor_advantages`]. Everything else is shared.
+//! is the one `match` on [`AcCritic`] in `critic_inputs` and on the design in
+//! `actor_advantages`. Everything else is shared.
 
 use super::episode::Episode;
 use super::nets::{AcNets, CriticNet};

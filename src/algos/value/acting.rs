@@ -19,7 +19,7 @@ pub struct Explore<'a> {
 }
 
 /// Index of the first maximal value (quirk Q14: ties go to the lowest index): the crate's one
-/// rule, [`crate::nn::argmax`].
+/// rule, [`crate::nn::argmax()`].
 pub use crate::nn::argmax;
 
 /// Scratch space for one acting lane, so selection allocates nothing per step.

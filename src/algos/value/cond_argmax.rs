@@ -46,7 +46,7 @@ pub fn ravel(actions: &[usize], n_actions: &[usize]) -> usize {
     })
 }
 
-/// Inverse of [`ravel`]: writes each agent's action of joint index `index` into `out` [N].
+/// Inverse of [`ravel`]: writes each agent's action of joint index `index` into `out` \[N\].
 pub fn unravel(index: usize, n_actions: &[usize], out: &mut [usize]) {
     debug_assert_eq!(out.len(), n_actions.len());
     let mut rest = index;
@@ -62,7 +62,7 @@ pub fn unravel_component(index: usize, n_actions: &[usize], agent: usize) -> usi
     (index / stride) % n_actions[agent]
 }
 
-/// The conditional argmax of one joint Q vector `q` [A] under `cond` [N] (-1 = free).
+/// The conditional argmax of one joint Q vector `q` \[A\] under `cond` \[N\] (-1 = free).
 ///
 /// Among allowed joint actions, returns the first (in C-order) maximal one; NaN entries never win
 /// a comparison, so an all-NaN row returns the first allowed index.

@@ -297,19 +297,19 @@ impl Episode {
             valid: self.valid(t),
         }
     }
-    /// Joint observation before step `t`, [D].
+    /// Joint observation before step `t`, \[D\].
     pub fn obs(&self, t: usize) -> &[f32] {
         &self.obs[t * self.joint_obs_size..(t + 1) * self.joint_obs_size]
     }
-    /// Joint observation after step `t`, [D].
+    /// Joint observation after step `t`, \[D\].
     pub fn next_obs(&self, t: usize) -> &[f32] {
         &self.next_obs[t * self.joint_obs_size..(t + 1) * self.joint_obs_size]
     }
-    /// Executed macro-actions at step `t`, [N].
+    /// Executed macro-actions at step `t`, \[N\].
     pub fn executed(&self, t: usize) -> &[usize] {
         &self.executed[t * self.n_agents..(t + 1) * self.n_agents]
     }
-    /// Per-agent macro-reward accumulators at step `t`, [N].
+    /// Per-agent macro-reward accumulators at step `t`, \[N\].
     pub fn acc_id(&self, t: usize) -> &[f32] {
         &self.acc_id[t * self.n_agents..(t + 1) * self.n_agents]
     }
@@ -321,7 +321,7 @@ impl Episode {
     pub fn done(&self, t: usize) -> bool {
         self.done[t]
     }
-    /// v_i of step `t` for every agent, [N].
+    /// v_i of step `t` for every agent, \[N\].
     pub fn valid(&self, t: usize) -> &[bool] {
         &self.valid[t * self.n_agents..(t + 1) * self.n_agents]
     }

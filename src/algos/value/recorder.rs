@@ -59,7 +59,7 @@ impl Recorder {
         }
     }
 
-    /// Start an episode from the joint reset observation [D]: accumulators to 0, all agents
+    /// Start an episode from the joint reset observation \[D\]: accumulators to 0, all agents
     /// "just finished" (`docs/ALGORITHMS.md` §1.2 state after reset). Drops any unfinished episode.
     pub fn begin(&mut self, reset_joint_obs: &[f32]) -> Result<(), ReplayError> {
         if reset_joint_obs.len() != self.last_obs.len() {
@@ -92,8 +92,8 @@ impl Recorder {
         result
     }
 
-    /// Record one primitive step: `executed` [N], `next_joint_obs` [D], the step's `outcome`
-    /// (team reward, episode over, truncated) and v [N]. The record's `done` is the terminal
+    /// Record one primitive step: `executed` \[N\], `next_joint_obs` \[D\], the step's `outcome`
+    /// (team reward, episode over, truncated) and v \[N\]. The record's `done` is the terminal
     /// flag the targets mask with: true at a terminal step, false at a horizon cut the domain
     /// truncates (MacroMARL's domains), so the target bootstraps there. Returns the finished
     /// episode when the episode is over (and then expects [`Self::begin`] before the next step).

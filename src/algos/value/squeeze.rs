@@ -22,13 +22,13 @@ pub struct AgentView {
     pub inputs: Array3<f32>,
     /// z'_i per kept record (the next-history unroll, quirk Q3): [S, T_max, d_i].
     pub next_inputs: Array3<f32>,
-    /// Kept records per kept sequence: [S], each >= 1.
+    /// Kept records per kept sequence: \[S\], each >= 1.
     pub lengths: Vec<usize>,
-    /// m_i (executed macro-action): [K].
+    /// m_i (executed macro-action): \[K\].
     pub actions: Vec<usize>,
-    /// r^c_i (acc_id[i]): [K].
+    /// r^c_i (acc_id\[i\]): \[K\].
     pub rewards: Vec<f32>,
-    /// done as 0.0 / 1.0: [K].
+    /// done as 0.0 / 1.0: \[K\].
     pub dones: Vec<f32>,
 }
 
@@ -41,13 +41,13 @@ pub struct JointView {
     pub inputs: Array3<f32>,
     /// z' per kept record: [S, T_max, D].
     pub next_inputs: Array3<f32>,
-    /// Kept records per kept sequence: [S], each >= 1.
+    /// Kept records per kept sequence: \[S\], each >= 1.
     pub lengths: Vec<usize>,
-    /// ravel(executed), C-order, agent 0 most significant: [K].
+    /// ravel(executed), C-order, agent 0 most significant: \[K\].
     pub joint_actions: Vec<usize>,
-    /// r^c (acc_joint): [K].
+    /// r^c (acc_joint): \[K\].
     pub rewards: Vec<f32>,
-    /// done as 0.0 / 1.0: [K].
+    /// done as 0.0 / 1.0: \[K\].
     pub dones: Vec<f32>,
     /// Executed macro-actions: [K * N].
     pub executed: Vec<usize>,

@@ -111,7 +111,7 @@ pub fn has_avx512() -> bool {
 }
 
 simd_dispatch! {
-    /// xs[i] = sigmoid(xs[i]).
+    /// xs\[i\] = sigmoid(xs\[i\]).
     pub fn sigmoid_inplace(xs: &mut [f32]) {
         for x in xs.iter_mut() {
             *x = sigmoid_approx(*x);
@@ -120,7 +120,7 @@ simd_dispatch! {
 }
 
 simd_dispatch! {
-    /// xs[i] = tanh(xs[i]).
+    /// xs\[i\] = tanh(xs\[i\]).
     pub fn tanh_inplace(xs: &mut [f32]) {
         for x in xs.iter_mut() {
             *x = tanh_approx(*x);
@@ -129,7 +129,7 @@ simd_dispatch! {
 }
 
 simd_dispatch! {
-    /// out[i] = tanh(xs[i]). Panics if the lengths differ.
+    /// out\[i\] = tanh(xs\[i\]). Panics if the lengths differ.
     pub fn tanh_into(xs: &[f32], out: &mut [f32]) {
         assert_eq!(xs.len(), out.len(), "tanh_into: length mismatch");
         for (o, &x) in out.iter_mut().zip(xs) {

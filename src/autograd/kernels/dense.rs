@@ -36,7 +36,7 @@ impl Activation {
     }
 }
 
-/// out = act(x · w^T + b) with x: [m, k], w: [n, k], b: [n], out: [m, n] (overwritten).
+/// out = act(x · w^T + b) with x: [m, k], w: [n, k], b: \[n\], out: [m, n] (overwritten).
 /// Panics on mismatched shapes.
 pub fn linear_forward(
     x: ArrayView2<f32>,
@@ -117,7 +117,7 @@ pub fn dot(a: &[f32], b: &[f32]) -> f32 {
 }
 
 simd_dispatch! {
-    /// out[o] = act(w[o, :] . x + b[o]) for w: [out.len(), x.len()] row-major, act a leaky ReLU
+    /// out\[o\] = act(w[o, :] . x + b\[o\]) for w: [out.len(), x.len()] row-major, act a leaky ReLU
     /// with `slope` (1 = identity): one layer for one input row (acting).
     pub fn matvec_act(w: &[f32], x: &[f32], b: &[f32], slope: f32, out: &mut [f32]) {
         for (o, (row, &bv)) in out.iter_mut().zip(w.chunks_exact(x.len()).zip(b)) {
@@ -128,7 +128,7 @@ simd_dispatch! {
 }
 
 simd_dispatch! {
-    /// gates[r] = w_ih[r, :] . x + b_ih[r] + w_hh[r, :] . h + b_hh[r]: the LSTM's gate
+    /// gates\[r\] = w_ih[r, :] . x + b_ih\[r\] + w_hh[r, :] . h + b_hh\[r\]: the LSTM's gate
     /// pre-activations for one input row (acting).
     pub fn lstm_gates_row(
         w_ih: &[f32],

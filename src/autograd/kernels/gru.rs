@@ -28,7 +28,7 @@ use super::gemm::{gemm, transposed, Mode};
 use super::lstm::{rd, wr, LANES};
 use crate::autograd::SeqPacking;
 
-/// The four GRU parameter tensors. w_ih: [3H, in], w_hh: [3H, H], biases: [3H], gates stacked
+/// The four GRU parameter tensors. w_ih: [3H, in], w_hh: [3H, H], biases: \[3H\], gates stacked
 /// r, z, n as in PyTorch's `weight_ih_l0`.
 #[derive(Debug, Clone, Copy)]
 pub struct GruWeights<'a> {
@@ -49,7 +49,7 @@ impl GruWeights<'_> {
         self.w_ih.ncols()
     }
 
-    /// Panics unless the shapes are consistent ([3H, in], [3H, H], [3H], [3H]).
+    /// Panics unless the shapes are consistent ([3H, in], [3H, H], \[3H\], \[3H\]).
     pub fn check(&self) {
         let h = self.hidden();
         assert_eq!(self.w_hh.nrows(), 3 * h, "gru: w_hh must be [3H, H]");
@@ -218,7 +218,7 @@ fn forward_row<const L: usize>(
 
 simd_dispatch! {
     /// The pointwise part of one step for its n rows: gates [n, 3H] holds x W_ih^T (activated
-    /// in place into r, z, n), rec [n, 3H] holds h_prev W_hh^T, bias [4H] is
+    /// in place into r, z, n), rec [n, 3H] holds h_prev W_hh^T, bias \[4H\] is
     /// [b_ir + b_hr, b_iz + b_hz, b_in, b_hn]; h_prev, hn (receives W_hn h_prev + b_hn) and
     /// h_out: [n, H].
     pub fn forward_cells(
@@ -255,7 +255,7 @@ pub const BACKWARD_CHUNK_ROWS: usize = 256;
 pub const DG_BLOCKS: [&str; 4] = ["a_n", "r", "z", "b_n"];
 
 /// The rows of a [3H, c] matrix reordered from (r, z, n) to (n, r, z): the right operand of
-/// dx = dA [`permute_nrz`](W_ih), and (applied to dA^T x) W_ih's gradient in that order.
+/// dx = dA `permute_nrz`(W_ih), and (applied to dA^T x) W_ih's gradient in that order.
 pub fn permute_nrz(w: ArrayView2<f32>) -> Array2<f32> {
     let h = w.nrows() / 3;
     assert_eq!(w.nrows(), 3 * h, "permute_nrz: rows must be 3H");
@@ -267,7 +267,7 @@ pub fn permute_nrz(w: ArrayView2<f32>) -> Array2<f32> {
 
 /// Gradients of the gate pre-activations given dy = dL/dh, all in packed order, and the
 /// forward's cache (`h_prev`, `gates`, `hn`, see [`GruCache`]). `dg`: [K, 4H] (overwritten,
-/// blocks as [`DG_BLOCKS`]); `dh_rec`: [batch_size(0), H] scratch; `dbias` [4H] receives the
+/// blocks as [`DG_BLOCKS`]); `dh_rec`: [batch_size(0), H] scratch; `dbias` \[4H\] receives the
 /// column sums of dg (b_ih's gradient is blocks r, z, a_n; b_hh's is blocks r, z, b_n).
 /// Steps are processed last to first; whenever at least [`BACKWARD_CHUNK_ROWS`] rows are
 /// complete (and at the end), `on_rows(rows, dg)` is called with their packed row range
@@ -399,10 +399,10 @@ fn backward_row<const L: usize>(
 
 simd_dispatch! {
     /// The pointwise part of one backward step for its n rows. dL/dh of row j is its output
-    /// gradient dy[j] plus dh_rec[j], the part through the next step (zero for sequences that
-    /// ended here); dh_rec[j] is then overwritten with z dh, the direct part of dL/dh_prev.
-    /// Writes dg [n, 4H] (see [`DG_BLOCKS`]) and adds its column sums to dbias [4H].
-    /// gates: [n, 3H]; h_prev, hn: [n, H].
+    /// gradient dy\[j\] plus dh_rec\[j\], the part through the next step (zero for sequences that
+    /// ended here); dh_rec\[j\] is then overwritten with z dh, the direct part of dL/dh_prev.
+    /// Writes dg \[n, 4H\] (see [`DG_BLOCKS`]) and adds its column sums to dbias \[4H\].
+    /// gates: \[n, 3H\]; h_prev, hn: \[n, H\].
     pub fn backward_cells(
         dy: &[f32],
         dh_rec: &mut [f32],

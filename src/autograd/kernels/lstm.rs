@@ -22,7 +22,7 @@ use super::activations::{sigmoid_approx, simd_dispatch, tanh_approx};
 use super::gemm::{gemm, transposed, Mode};
 use crate::autograd::SeqPacking;
 
-/// The four LSTM parameter tensors. w_ih: [4H, in], w_hh: [4H, H], biases: [4H].
+/// The four LSTM parameter tensors. w_ih: [4H, in], w_hh: [4H, H], biases: \[4H\].
 #[derive(Debug, Clone, Copy)]
 pub struct LstmWeights<'a> {
     pub w_ih: ArrayView2<'a, f32>,
@@ -42,7 +42,7 @@ impl LstmWeights<'_> {
         self.w_ih.ncols()
     }
 
-    /// Panics unless the shapes are consistent ([4H, in], [4H, H], [4H], [4H]).
+    /// Panics unless the shapes are consistent ([4H, in], [4H, H], \[4H\], \[4H\]).
     pub fn check(&self) {
         let h = self.hidden();
         assert_eq!(self.w_hh.nrows(), 4 * h, "w_hh must be [4H, H]");
@@ -271,7 +271,7 @@ pub const BACKWARD_CHUNK_ROWS: usize = 256;
 /// Gradients of the gate pre-activations given dy = dL/dh, all in packed order, and the
 /// forward's activated `gates` [K, 4H], cell states `c` and `tanh_c` [K, H] (see
 /// [`LstmCache`]). `dgates`: [K, 4H] (overwritten); `dh_rec`, `dc`: [batch_size(0), H] scratch;
-/// `db` [4H] receives the column sums of dgates (the gradient of either bias).
+/// `db` \[4H\] receives the column sums of dgates (the gradient of either bias).
 /// Steps are processed last to first; whenever at least [`BACKWARD_CHUNK_ROWS`] rows of dgates
 /// are complete (and at the end), `on_rows(rows, dgates)` is called with their packed row range
 /// (descending, disjoint, covering 0..K), so the caller can use them while they are in cache.
@@ -416,10 +416,10 @@ fn backward_row<const L: usize>(
 
 simd_dispatch! {
     /// The pointwise part of one backward step for its n rows. dL/dh of row j is its output
-    /// gradient dy[j] plus dh_rec[j], the part through the next step (zero for sequences that
-    /// ended here); dc[j] likewise carries dL/dc from the next step. Writes the pre-activation
-    /// gradients dgates [n, 4H], adds their column sums to db [4H] (the bias gradient), and
-    /// leaves dL/dc_prev in dc. c_prev: [n, H] (zeros at step 0).
+    /// gradient dy\[j\] plus dh_rec\[j\], the part through the next step (zero for sequences that
+    /// ended here); dc\[j\] likewise carries dL/dc from the next step. Writes the pre-activation
+    /// gradients dgates \[n, 4H\], adds their column sums to db \[4H\] (the bias gradient), and
+    /// leaves dL/dc_prev in dc. c_prev: \[n, H\] (zeros at step 0).
     pub fn backward_cells(
         dy: &[f32],
         dh_rec: &[f32],

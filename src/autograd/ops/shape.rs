@@ -74,7 +74,7 @@ impl Tape {
         self.push_op(y, Op::SliceCols { x, start }, &[x])
     }
 
-    /// y[k, 0] = x[k, index[k]]: one column per row, e.g. the Q-value of the action taken.
+    /// y[k, 0] = x[k, index\[k\]]: one column per row, e.g. the Q-value of the action taken.
     /// Result [m, 1]. Panics if `index` does not have one entry per row or an entry is out of
     /// range (actions are validated where they enter the program).
     pub fn gather_cols(&mut self, x: Var, index: &[usize]) -> Var {
@@ -96,7 +96,7 @@ impl Tape {
         )
     }
 
-    /// y[k, :] = x[index[k], :]: select (or reorder, or repeat) rows. Panics on an index out of
+    /// y[k, :] = x[index\[k\], :]: select (or reorder, or repeat) rows. Panics on an index out of
     /// range.
     pub fn gather_rows(&mut self, x: Var, index: &[usize]) -> Var {
         let (rows, cols) = self.shape(x);

@@ -35,7 +35,7 @@ fn lt(a: &Node, b: &Node) -> bool {
     }
 }
 
-/// A binary heap with CPython's `heapq` algorithm and [`lt`] as `<`. The buffer is reused, so
+/// A binary heap with CPython's `heapq` algorithm and `lt` as `<`. The buffer is reused, so
 /// searching allocates nothing once it has grown to the largest frontier.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PyHeap {
