@@ -5,7 +5,8 @@ use std::io::{self, Write};
 use std::path::Path;
 
 /// Write `bytes` to `path` by writing a sibling temp file, syncing it, and renaming it over
-/// `path`, so readers see either the old file or the new one, never a torn one.
+/// `path`, so readers see either the old file or the new one, never a torn one. `path` must be a
+/// regular file or not exist ([`check_output_file`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomic_with(path, |f| f.write_all(bytes))
 }
@@ -16,20 +17,14 @@ pub fn write_atomic_with(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {
+    check_output_file(path)?;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     if let Some(dir) = dir {
         fs::create_dir_all(dir)?;
     }
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
-    let tmp = path.with_file_name(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let (tmp, file) = create_temp_beside(path)?;
     let written = (|| {
-        let mut f = io::BufWriter::new(fs::File::create(&tmp)?);
+        let mut f = io::BufWriter::new(file);
         write(&mut f)?;
         let f = f.into_inner().map_err(io::IntoInnerError::into_error)?;
         f.sync_all()?;
@@ -41,11 +36,68 @@ pub fn write_atomic_with(
     })
 }
 
+/// Refuse to write onto anything but a regular file: a device (as root, renaming a GIF over
+/// `/dev/null` would replace it), a FIFO, a socket, a directory, or a link (which a shared tree
+/// could plant). A path that does not exist yet is fine.
+pub fn check_output_file(path: &Path) -> io::Result<()> {
+    match fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+        Ok(m) if m.file_type().is_symlink() => Err(super::links::link_refused(path)),
+        Ok(m) if m.is_file() => Ok(()),
+        Ok(m) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} is {}, not a regular file; macdec writes only regular files",
+                path.display(),
+                if m.is_dir() {
+                    "a directory"
+                } else {
+                    "a device, FIFO or socket"
+                }
+            ),
+        )),
+    }
+}
+
+/// The `<n>` of the next temp file name this process tries.
+static TEMP_COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// A new temp file beside `path`, created exclusively and without following a link (a name
+/// someone planted is skipped, never written through): `.<name>.<pid>-<n>.tmp`.
+pub fn create_temp_beside(path: &Path) -> io::Result<(std::path::PathBuf, fs::File)> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
+    for _ in 0..64 {
+        let n = TEMP_COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tmp = path.with_file_name(format!(
+            ".{}.{}-{n}.tmp",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
+        match super::links::open_options_no_follow()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(f) => return Ok((tmp, f)),
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(io::Error::new(
+        io::ErrorKind::AlreadyExists,
+        format!("no free temp file name beside {}", path.display()),
+    ))
+}
+
 /// The pid in a temp file name written by [`write_atomic`] (`.<name>.<pid>.tmp`), if it is one.
 fn temp_file_pid(file_name: &str) -> Option<u32> {
     let stem = file_name.strip_prefix('.')?.strip_suffix(".tmp")?;
     let (_, pid) = stem.rsplit_once('.')?;
-    pid.parse().ok()
+    // `<pid>-<n>`, or `<pid>` as earlier versions named them.
+    pid.split('-').next()?.parse().ok()
 }
 
 /// Whether process `pid` may still be running (and writing). Without `/proc`, every other
@@ -106,6 +158,7 @@ mod tests {
         assert!(parent.exists(), "pid 1 is alive: its temp file stays");
         assert!(other.exists());
         assert_eq!(temp_file_pid(".checkpoint.bin.123.tmp"), Some(123));
+        assert_eq!(temp_file_pid(".checkpoint.bin.123-7.tmp"), Some(123));
         assert_eq!(temp_file_pid("checkpoint.bin"), None);
     }
 
@@ -119,5 +172,40 @@ mod tests {
         assert!(write_atomic(&target, b"data").is_err());
         let names: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(names.len(), 1);
+    }
+
+    #[test]
+    fn outputs_onto_devices_directories_and_links_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let outside = dir.path().join("outside");
+        fs::write(&outside, b"keep").unwrap();
+        let link = dir.path().join("out.gif");
+        std::os::unix::fs::symlink(&outside, &link).unwrap();
+        let e = write_atomic(&link, b"x").unwrap_err();
+        assert!(e.to_string().contains("symbolic link"), "{e}");
+        assert_eq!(fs::read(&outside).unwrap(), b"keep");
+        let e = write_atomic(dir.path(), b"x").unwrap_err();
+        assert!(e.to_string().contains("a directory"), "{e}");
+        if Path::new("/dev/null").exists() {
+            let e = check_output_file(Path::new("/dev/null")).unwrap_err();
+            assert!(e.to_string().contains("not a regular file"), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_planted_temp_file_link_is_never_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let outside = dir.path().join("outside");
+        fs::write(&outside, b"keep").unwrap();
+        let p = dir.path().join("config.toml");
+        // Plant links at the next temp names this process would try.
+        let next = TEMP_COUNTER.load(std::sync::atomic::Ordering::Relaxed);
+        for n in next..next + 10 {
+            let name = format!(".config.toml.{}-{n}.tmp", std::process::id());
+            let _ = std::os::unix::fs::symlink(&outside, dir.path().join(name));
+        }
+        write_atomic(&p, b"new").unwrap();
+        assert_eq!(fs::read(&p).unwrap(), b"new");
+        assert_eq!(fs::read(&outside).unwrap(), b"keep");
     }
 }

@@ -5,32 +5,104 @@
 use std::io::{self, Read};
 use std::path::Path;
 
-/// The bytes of the regular file `path`, refusing anything else and anything over `max_bytes`.
-pub fn read_regular_file(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
-    let meta = std::fs::metadata(path)?;
-    if !meta.is_file() {
+/// Whether a read follows a link at the file's own name: a path the user typed may be a link;
+/// a file inside a results tree may not ([`super::links`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Links {
+    /// Follow a link to its target.
+    Follow,
+    /// Refuse a link by name.
+    Refuse,
+}
+
+/// Open `path` for reading if it is a regular file, checked on the open handle (no race
+/// between the check and the read). The open is non-blocking, so a FIFO is refused instead of
+/// waiting forever for a writer.
+pub fn open_regular(path: &Path, links: Links) -> io::Result<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let mut options = match links {
+        Links::Follow => std::fs::OpenOptions::new(),
+        Links::Refuse => super::links::open_options_no_follow(),
+    };
+    let flags = libc::O_NONBLOCK
+        | match links {
+            Links::Follow => 0,
+            Links::Refuse => libc::O_NOFOLLOW,
+        };
+    let file = options
+        .read(true)
+        .custom_flags(flags)
+        .open(path)
+        .map_err(|e| super::links::explain_no_follow(path, e))?;
+    if !file.metadata()?.is_file() {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             "not a regular file",
         ));
     }
-    let too_big = |len: u64| {
-        io::Error::new(
-            io::ErrorKind::InvalidData,
-            format!("{len} bytes or more, at most {max_bytes} expected"),
-        )
-    };
-    if meta.len() > max_bytes {
-        return Err(too_big(meta.len()));
+    Ok(file)
+}
+
+/// The bytes of the regular file `path`, refusing anything else and anything over `max_bytes`.
+pub fn read_regular_file(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
+    read_regular(path, max_bytes, Links::Follow)
+}
+
+/// [`read_regular_file`] for a file inside a results tree: a link is refused too.
+pub fn read_in_tree(path: &Path, max_bytes: u64) -> io::Result<Vec<u8>> {
+    read_regular(path, max_bytes, Links::Refuse)
+}
+
+/// [`read_in_tree`] as UTF-8 text.
+pub fn read_text_in_tree(path: &Path, max_bytes: u64) -> io::Result<String> {
+    String::from_utf8(read_in_tree(path, max_bytes)?)
+        .map_err(|_| io::Error::new(io::ErrorKind::InvalidData, "not UTF-8 text"))
+}
+
+/// [`read_regular_file`] as UTF-8 text.
+pub fn read_text_file(path: &Path, max_bytes: u64) -> io::Result<String> {
+    String::from_utf8(read_regular_file(path, max_bytes)?)
+        .map_err(|_| io::Error::new(io::ErrorKind::InvalidData, "not UTF-8 text"))
+}
+
+/// The bytes of the regular file `path` (a link at its name followed or refused as `links`
+/// says), at most `max_bytes`: checked before reading and enforced while reading (the file
+/// may grow in between).
+pub fn read_regular(path: &Path, max_bytes: u64, links: Links) -> io::Result<Vec<u8>> {
+    let file = open_regular(path, links)?;
+    let len = file.metadata()?.len();
+    if len > max_bytes {
+        return Err(too_big(len, max_bytes));
     }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    std::fs::File::open(path)?
-        .take(max_bytes + 1)
-        .read_to_end(&mut bytes)?;
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(max_bytes + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > max_bytes {
-        return Err(too_big(bytes.len() as u64));
+        return Err(too_big(bytes.len() as u64, max_bytes));
     }
     Ok(bytes)
+}
+
+/// Decompress gzip `bytes`, refusing output over `max_bytes` (a small crafted file can expand
+/// a thousandfold).
+pub fn gunzip_bounded(bytes: &[u8], max_bytes: u64) -> io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    flate2::read::GzDecoder::new(bytes)
+        .take(max_bytes + 1)
+        .read_to_end(&mut out)?;
+    if out.len() as u64 > max_bytes {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("decompresses to more than {max_bytes} bytes"),
+        ));
+    }
+    Ok(out)
+}
+
+fn too_big(len: u64, max_bytes: u64) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!("{len} bytes or more, at most {max_bytes} expected"),
+    )
 }
 
 #[cfg(test)]
@@ -55,5 +127,29 @@ mod tests {
             // Would block forever if opened.
             assert!(read_regular_file(&fifo, 1000).is_err());
         }
+    }
+
+    #[test]
+    fn links_are_followed_or_refused_as_asked() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("secret");
+        std::fs::write(&target, "x").unwrap();
+        let link = dir.path().join("config.toml");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        assert_eq!(read_regular_file(&link, 10).unwrap(), b"x");
+        let e = read_in_tree(&link, 10).unwrap_err();
+        assert!(e.to_string().contains("symbolic link"), "{e}");
+    }
+
+    #[test]
+    fn a_gzip_bomb_stops_at_the_bound() {
+        use std::io::Write;
+        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        e.write_all(&vec![b'0'; 10_000_000]).unwrap();
+        let bomb = e.finish().unwrap();
+        assert!(bomb.len() < 20_000);
+        let err = gunzip_bounded(&bomb, 1_000_000).unwrap_err();
+        assert!(err.to_string().contains("more than 1000000 bytes"), "{err}");
+        assert_eq!(gunzip_bounded(&bomb, 10_000_000).unwrap().len(), 10_000_000);
     }
 }

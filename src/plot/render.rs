@@ -33,20 +33,24 @@ pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
         path: path.to_path_buf(),
         message,
     };
-    // Draw into a sibling temp file and rename it over `path`, so a reader never sees a torn PNG.
-    let name = path
-        .file_name()
-        .map_or_else(|| "figure.png".into(), |n| n.to_string_lossy());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp.png", std::process::id()));
+    let (w, h) = SIZE;
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
-        let root = BitMapBackend::new(&tmp, SIZE).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
         draw(&root, fig).map_err(err)?;
         root.present().map_err(|e| err(e.to_string()))?;
     }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        err(e.to_string())
+    // Encoded into the one atomic writer: a reader never sees a torn PNG, and the file is
+    // written only onto a regular file or a new name.
+    crate::files::atomic::write_atomic_with(path, |out| {
+        let mut png = png::Encoder::new(out, w, h);
+        png.set_color(png::ColorType::Rgb);
+        png.set_depth(png::BitDepth::Eight);
+        png.write_header()
+            .and_then(|mut writer| writer.write_image_data(&rgb))
+            .map_err(std::io::Error::other)
     })
+    .map_err(|e| err(e.to_string()))
 }
 
 /// Draw `fig` as SVG text; `path` is only used in error messages.
