@@ -175,6 +175,108 @@ fn a_run_being_trained_by_another_process_is_left_to_it_and_force_is_refused() {
 }
 
 #[test]
+fn a_second_process_with_a_different_config_fails_naming_the_difference() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(
+        &config,
+        TINY.replace("total_epi = 60", "total_epi = 1000000"),
+    )
+    .unwrap();
+    let other = dir.path().join("other").join("tiny.toml");
+    std::fs::create_dir_all(other.parent().unwrap()).unwrap();
+    std::fs::write(
+        &other,
+        TINY.replace("total_epi = 60", "total_epi = 1000000")
+            .replace("batch_size = 16", "batch_size = 8"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let run = out.join("tiny/our1/seed-0");
+    let args = ["--methods", "our1", "--seeds", "0", "--no-plot"];
+    let mut first = spawn_train(&config, &out, &args);
+    let start = Instant::now();
+    while !run.join(".lock").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // Started while the first holds the lock, perhaps before its config.toml is written.
+    let second = train(&other, &out, &args);
+    first.kill().unwrap();
+    first.wait().unwrap();
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert!(!second.status.success(), "{err}");
+    assert!(err.contains("batch_size"), "{err}");
+    assert!(!err.contains("left tiny/our1/seed-0"), "{err}");
+}
+
+#[test]
+fn links_in_the_results_tree_are_never_followed() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(&config, TINY).unwrap();
+    let outside = dir.path().join("outside");
+    std::fs::create_dir_all(outside.join("our1/seed-0")).unwrap();
+    std::fs::write(outside.join("precious"), "keep").unwrap();
+    std::fs::write(outside.join("our1/seed-0/precious"), "keep").unwrap();
+    let args = ["--methods", "our1", "--seeds", "0", "--no-plot"];
+    // A linked experiment directory, with and without --force.
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::os::unix::fs::symlink(&outside, out.join("tiny")).unwrap();
+    for extra in [&[][..], &["--force"][..]] {
+        let o = train(&config, &out, &[&args[..], extra].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{extra:?}: {err}");
+        assert!(err.contains("is a symbolic link"), "{err}");
+    }
+    // A linked lock file or config.toml inside a real run directory.
+    for planted in [".lock", "config.toml"] {
+        let out = dir.path().join(format!("out-{planted}"));
+        let run = out.join("tiny/our1/seed-0");
+        std::fs::create_dir_all(&run).unwrap();
+        let target = outside.join("precious");
+        std::os::unix::fs::symlink(&target, run.join(planted)).unwrap();
+        for extra in [&[][..], &["--force"][..]] {
+            let o = train(&config, &out, &[&args[..], extra].concat());
+            let err = String::from_utf8_lossy(&o.stderr);
+            if extra.is_empty() || planted == ".lock" {
+                assert!(!o.status.success(), "{planted} {extra:?}: {err}");
+                assert!(err.contains("symbolic link"), "{planted} {extra:?}: {err}");
+            } else {
+                // --force empties the run's own directory: the link goes, not its target.
+                assert!(o.status.success(), "{planted} {extra:?}: {err}");
+            }
+        }
+    }
+    let mut left: Vec<String> = walk(&outside);
+    left.sort();
+    assert_eq!(left, ["our1/seed-0/precious", "precious"]);
+    assert_eq!(
+        std::fs::read_to_string(outside.join("precious")).unwrap(),
+        "keep"
+    );
+}
+
+/// Every file below `root`, as paths relative to it.
+fn walk(root: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(root).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            for sub in walk(&p) {
+                out.push(format!(
+                    "{}/{sub}",
+                    p.file_name().unwrap().to_string_lossy()
+                ));
+            }
+        } else {
+            out.push(p.file_name().unwrap().to_string_lossy().into_owned());
+        }
+    }
+    out
+}
+
+#[test]
 fn a_symlinked_run_directory_is_refused_and_its_target_is_untouched() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("tiny.toml");
@@ -197,10 +299,7 @@ fn a_symlinked_run_directory_is_refused_and_its_target_is_untouched() {
         );
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{extra:?}: {err}");
-        assert!(
-            err.contains("is not a directory (a symlink or a file)"),
-            "{err}"
-        );
+        assert!(err.contains("is a symbolic link"), "{err}");
     }
     let left: Vec<_> = std::fs::read_dir(&outside)
         .unwrap()

@@ -881,8 +881,11 @@ fn tidy_results(results: &Path, out: Option<&Path>) -> Result<()> {
 
 fn replay(path: &Path, verbose: bool) -> Result<()> {
     use crate::envs::replay::{parse_replay, stream_replay};
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading replay file {}", path.display()))?;
+    let text = crate::files::bounded_read::read_text_file(
+        path,
+        crate::files::bounded_read::MAX_ACTIONS_BYTES,
+    )
+    .with_context(|| format!("reading replay file {}", path.display()))?;
     let file = parse_replay(&text).with_context(|| format!("parsing {}", path.display()))?;
     drop(text);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());

@@ -66,16 +66,8 @@ static TEMP_COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64
 /// A new temp file beside `path`, created exclusively and without following a link (a name
 /// someone planted is skipped, never written through): `.<name>.<pid>-<n>.tmp`.
 pub fn create_temp_beside(path: &Path) -> io::Result<(std::path::PathBuf, fs::File)> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
     for _ in 0..64 {
-        let n = TEMP_COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let tmp = path.with_file_name(format!(
-            ".{}.{}-{n}.tmp",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
+        let tmp = temp_name_beside(path)?;
         match super::links::open_options_no_follow()
             .write(true)
             .create_new(true)
@@ -90,6 +82,25 @@ pub fn create_temp_beside(path: &Path) -> io::Result<(std::path::PathBuf, fs::Fi
         io::ErrorKind::AlreadyExists,
         format!("no free temp file name beside {}", path.display()),
     ))
+}
+
+/// The next temp name beside `path` for this process: `.<name>.<pid>-<n>.tmp`, `n` counting up.
+pub fn temp_name_beside(path: &Path) -> io::Result<std::path::PathBuf> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
+    let n = TEMP_COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    Ok(path.with_file_name(format!(
+        ".{}.{}-{n}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    )))
+}
+
+/// Whether `file_name` is a temp name of [`temp_name_beside`] whose process is this one or gone
+/// (so nothing is writing it any more).
+pub fn temp_name_is_stale(file_name: &str) -> bool {
+    temp_file_pid(file_name).is_some_and(|pid| pid == std::process::id() || !may_be_alive(pid))
 }
 
 /// The pid in a temp file name written by [`write_atomic`] (`.<name>.<pid>.tmp`), if it is one.
@@ -110,15 +121,11 @@ fn may_be_alive(pid: u32) -> bool {
 /// Remove the temp files in `dir` left by [`write_atomic`] calls of processes that died mid-write
 /// (killed, or out of disk). Returns how many were removed.
 pub fn remove_stale_temp_files(dir: &Path) -> io::Result<usize> {
-    let me = std::process::id();
     let mut removed = 0;
     for entry in fs::read_dir(dir)? {
         let entry = entry?;
         let name = entry.file_name();
-        let Some(pid) = name.to_str().and_then(temp_file_pid) else {
-            continue;
-        };
-        if (pid == me || !may_be_alive(pid)) && entry.file_type()?.is_file() {
+        if name.to_str().is_some_and(temp_name_is_stale) && entry.file_type()?.is_file() {
             fs::remove_file(entry.path())?;
             removed += 1;
         }

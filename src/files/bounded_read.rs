@@ -5,6 +5,20 @@
 use std::io::{self, Read};
 use std::path::Path;
 
+/// Text macdec reads whole: experiment files, a run's `config.toml`, a results tree's shared-curve
+/// list. The largest committed one is a few KiB.
+pub const MAX_TEXT_BYTES: u64 = 1 << 20;
+/// A `replay --actions` file: a long episode's actions as JSON.
+pub const MAX_ACTIONS_BYTES: u64 = 64 << 20;
+/// A metrics file, after decompression: at most 10^6 evaluation rows of a few hundred bytes.
+pub const MAX_METRICS_BYTES: u64 = 512 << 20;
+/// A safetensors file of one net read by its own reader (a policy's weight files are bounded
+/// tighter, by their architecture's size).
+pub const MAX_WEIGHTS_BYTES: u64 = 4 << 30;
+/// A training checkpoint (nets, optimizer state and the replay buffer, bounded in turn by the
+/// config's limits).
+pub const MAX_CHECKPOINT_BYTES: u64 = 64 << 30;
+
 /// Whether a read follows a link at the file's own name: a path the user typed may be a link;
 /// a file inside a results tree may not ([`super::links`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

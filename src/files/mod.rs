@@ -5,4 +5,5 @@
 
 pub mod atomic;
 pub mod bounded_read;
+pub mod dir_swap;
 pub mod links;

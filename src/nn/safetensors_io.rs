@@ -4,6 +4,8 @@
 //! bare `nn.GRU`'s names (`weight_ih_l0` [3H, in], ...), both ways
 //! (`safetensors.torch.save_file(gru.state_dict(), path)` gives a file we read).
 
+use crate::files::atomic::write_atomic;
+use crate::files::bounded_read::{read_regular_file, MAX_WEIGHTS_BYTES};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -301,20 +303,18 @@ impl GruParams {
             path: path.to_path_buf(),
             source,
         };
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        std::fs::write(&tmp, gru_to_safetensors_bytes(self)).map_err(io)?;
-        std::fs::rename(&tmp, path).map_err(io)
+        write_atomic(path, &gru_to_safetensors_bytes(self)).map_err(io)
     }
 
     /// Read a GRU from a safetensors file of a bare `nn.GRU` state_dict, e.g. written by
     /// `safetensors.torch.save_file(gru.state_dict(), path)`; sizes come from the file (see
     /// [`gru_from_safetensors_bytes`] for the checks).
     pub fn load_safetensors(path: &Path) -> Result<GruParams, WeightsError> {
-        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let bytes =
+            read_regular_file(path, MAX_WEIGHTS_BYTES).map_err(|source| WeightsError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
         gru_from_safetensors_bytes(&bytes, path)
     }
 }
@@ -327,18 +327,16 @@ impl QNet {
             path: path.to_path_buf(),
             source,
         };
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".tmp");
-        std::fs::write(&tmp, to_safetensors_bytes(&self.params)).map_err(io)?;
-        std::fs::rename(&tmp, path).map_err(io)
+        write_atomic(path, &to_safetensors_bytes(&self.params)).map_err(io)
     }
 
     /// Read a net of size `cfg` from `path` (see [`from_safetensors_bytes`] for the checks).
     pub fn load_safetensors(path: &Path, cfg: QNetConfig) -> Result<QNet, WeightsError> {
-        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let bytes =
+            read_regular_file(path, MAX_WEIGHTS_BYTES).map_err(|source| WeightsError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
         Ok(QNet {
             params: from_safetensors_bytes(&bytes, cfg, path)?,
         })
@@ -346,10 +344,11 @@ impl QNet {
 
     /// Read a net from `path`, taking its sizes from the file.
     pub fn load_safetensors_any_size(path: &Path) -> Result<QNet, WeightsError> {
-        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let bytes =
+            read_regular_file(path, MAX_WEIGHTS_BYTES).map_err(|source| WeightsError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
         let cfg = config_of_safetensors(&bytes, path)?;
         Ok(QNet {
             params: from_safetensors_bytes(&bytes, cfg, path)?,

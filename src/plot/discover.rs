@@ -12,6 +12,7 @@ use crate::algos::method::Method;
 use crate::experiment::metrics::{self, MetricsError};
 use crate::experiment::provenance::Provenance;
 use crate::experiment::results_tree;
+use crate::files::bounded_read::{read_text_in_tree, MAX_TEXT_BYTES};
 use std::path::{Path, PathBuf};
 
 pub use crate::experiment::config::SHARED_CURVES_FILE;
@@ -158,11 +159,11 @@ pub fn discover_metric(results: &Path, metric: &str) -> Result<Discovery, PlotEr
 fn curve_dirs(results: &Path, exp_dir: &Path, notes: &mut Vec<String>) -> Vec<PathBuf> {
     let mut dirs = subdirs_or_note(exp_dir, notes);
     let shared_path = exp_dir.join(SHARED_CURVES_FILE);
-    if !shared_path.is_file() {
+    if std::fs::symlink_metadata(&shared_path).is_err() {
         return dirs;
     }
     let shared: std::collections::BTreeMap<String, String> =
-        match std::fs::read_to_string(&shared_path)
+        match read_text_in_tree(&shared_path, MAX_TEXT_BYTES)
             .map_err(|e| e.to_string())
             .and_then(|t| toml::from_str(&t).map_err(|e| e.to_string()))
         {
@@ -187,7 +188,8 @@ fn curve_dirs(results: &Path, exp_dir: &Path, notes: &mut Vec<String>) -> Vec<Pa
             continue;
         }
         let target = results.join(&home).join(&curve);
-        if !target.is_dir() {
+        // A real directory: a link would draw runs from outside the results tree.
+        if !std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_dir()) {
             notes.push(format!(
                 "{}: shared curve {curve} has no runs yet in {}",
                 exp_dir.display(),
@@ -271,7 +273,7 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
     if points.is_empty() {
         return Err(RunProblem::Skip(format!("no `{metric}` values yet")));
     }
-    let config_text = std::fs::read_to_string(dir.join(CONFIG_FILE)).ok();
+    let config_text = read_text_in_tree(&dir.join(CONFIG_FILE), MAX_TEXT_BYTES).ok();
     let setting = config_text
         .as_deref()
         .and_then(|text| EnvSetting::from_config_toml(text).ok());
@@ -296,13 +298,14 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Subdirectories sorted by name (files are ignored: they are not part of the layout).
+/// Subdirectories sorted by name (files are ignored: they are not part of the layout; nor are
+/// links, which would lead out of the results tree).
 fn sorted_subdirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     let mut dirs = Vec::new();
     for entry in std::fs::read_dir(dir)? {
-        let path = entry?.path();
-        if path.is_dir() {
-            dirs.push(path);
+        let entry = entry?;
+        if entry.file_type()?.is_dir() {
+            dirs.push(entry.path());
         }
     }
     dirs.sort();

@@ -13,6 +13,8 @@ pub enum PolicyError {
     MissingRun { dir: PathBuf },
     #[error("{dir}: has no {POLICY_FILE} (nor manifest.json, the name exports had before format_version 2): not a policy directory")]
     Missing { dir: PathBuf },
+    #[error("{dir}: holds {file}, which is not part of a policy directory; choose an empty or new --out directory")]
+    NotAPolicyDir { dir: PathBuf, file: String },
     #[error("{path}: {message}")]
     Io { path: PathBuf, message: String },
     #[error("{path}: not a valid policy description: {message}")]

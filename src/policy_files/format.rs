@@ -9,3 +9,6 @@ pub const FORMAT: &str = "macdec-policy";
 /// formats (a run's `macdec-run-policy` and an export's `manifest.json`); both still load,
 /// converted on read ([`super::legacy`]).
 pub const FORMAT_VERSION: u32 = 2;
+/// The description file of a version-1 export (read, never written; converted by
+/// [`super::legacy`]).
+pub const MANIFEST_FILE_V1: &str = "manifest.json";

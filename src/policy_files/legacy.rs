@@ -23,8 +23,7 @@ use std::path::Path;
 
 /// The `format` tag of a version-1 run `policy.json`.
 pub const RUN_FORMAT_V1: &str = "macdec-run-policy";
-/// The description file of a version-1 export.
-pub const MANIFEST_FILE_V1: &str = "manifest.json";
+pub use super::format::MANIFEST_FILE_V1;
 
 /// A version-1 run `policy.json`.
 #[derive(Deserialize)]

@@ -2,11 +2,13 @@
 //! directory (see the module doc of [`crate::policy_files`] for the JSON shape).
 
 use super::architecture::{Architecture, DDRQN, GRU_ACTOR, LEAKY_RELU_SLOPE};
+use super::directory::check_only_policy_files;
 use super::error::PolicyError;
 use super::policy_env::{CustomEnv, PolicyEnv};
 use crate::envs::{EnvSpec, MacroEnv};
-use crate::files::atomic::{remove_stale_temp_files, write_atomic};
+use crate::files::atomic::write_atomic;
 use crate::files::bounded_read::read_regular_file;
+use crate::files::dir_swap::replace_dir;
 use crate::nn::safetensors_io::{named_to_safetensors_bytes, to_safetensors_bytes};
 use crate::nn::{ActingNet, GruActor, QNet, QNetConfig};
 use serde::{Deserialize, Serialize};
@@ -273,9 +275,12 @@ impl Manifest {
         Ok(manifest)
     }
 
-    /// The one writer: [`Self::new`], then every net's file and `policy.json` last, each
-    /// atomically, so a reader sees complete files and a description whose checksums tell
-    /// whether the files beside it are the ones it describes.
+    /// The one writer: [`Self::new`], then every net's file and `policy.json` written into a
+    /// new generation of `dir` that replaces the old one in one atomic step
+    /// ([`crate::files::dir_swap`]): a kill at any moment leaves the complete old set or the
+    /// complete new one, and a reader never sees a description beside another set's weights.
+    /// An existing `dir` must hold only a policy directory's files (an earlier export, import or
+    /// run policy), so nobody's other files are replaced.
     pub fn write_new(
         dir: &Path,
         env: PolicyEnv,
@@ -286,16 +291,16 @@ impl Manifest {
         nets: &[NetFile],
     ) -> Result<Manifest, PolicyError> {
         let manifest = Manifest::new(env, agents, discount, evaluated, run, nets)?;
-        std::fs::create_dir_all(dir).map_err(|e| PolicyError::io(dir, e))?;
-        remove_stale_temp_files(dir).map_err(|e| PolicyError::io(dir, e))?;
-        for n in nets {
-            let path = dir.join(&n.file);
-            write_atomic(&path, &n.bytes).map_err(|e| PolicyError::io(&path, e))?;
-        }
-        let path = dir.join(POLICY_FILE);
-        let text =
-            serde_json::to_string_pretty(&manifest).map_err(|e| PolicyError::io(&path, e))?;
-        write_atomic(&path, text.as_bytes()).map_err(|e| PolicyError::io(&path, e))?;
+        check_only_policy_files(dir)?;
+        let text = serde_json::to_string_pretty(&manifest)
+            .map_err(|e| PolicyError::io(&dir.join(POLICY_FILE), e))?;
+        replace_dir(dir, |new| {
+            for n in nets {
+                write_atomic(&new.join(&n.file), &n.bytes)?;
+            }
+            write_atomic(&new.join(POLICY_FILE), text.as_bytes())
+        })
+        .map_err(|e| PolicyError::io(dir, e))?;
         Ok(manifest)
     }
 
@@ -837,6 +842,7 @@ fn is_plain_file_name(name: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
     use crate::policy_files::architecture::synthetic_weights;
 
     fn bp10() -> EnvSpec {

@@ -34,7 +34,8 @@
 //! Loading checks everything against the domain and the files, so nothing runs weights that are
 //! corrupt, truncated, swapped between agents or written for another domain: the SHA-256 of every
 //! weight file, bounded reads of regular files only, each file's tensors against its entry, the
-//! layout against a built-in domain. Writes are atomic, `policy.json` last.
+//! layout against a built-in domain. A write replaces the whole directory in one atomic step
+//! (a new generation swapped in), so a kill or a concurrent reader never meets a mixed set.
 //!
 //! Compatibility: `agents` entries and architectures refuse unknown keys (a typo is an error,
 //! as export manifests always did); the top level and net entries ignore keys they do not know
@@ -44,6 +45,7 @@
 //! `"macdec-run-policy"` policy.json and an export's `manifest.json`, still load ([`legacy`]).
 
 pub mod architecture;
+mod directory;
 pub mod error;
 pub mod format;
 pub mod legacy;

@@ -13,6 +13,7 @@ use crate::experiment::provenance::Provenance;
 use crate::experiment::results_tree::{self, CONFIG};
 use crate::experiment::runner::Progress;
 use crate::experiment::train_run::{train_run, RunError, RunManifest};
+use crate::files::bounded_read::{read_text_in_tree, MAX_TEXT_BYTES};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use std::path::{Path, PathBuf};
@@ -108,7 +109,7 @@ pub fn choose(runs: &[PathBuf], k: usize, seed: u64) -> Vec<PathBuf> {
 /// Read a committed run's manifest.
 pub fn read_manifest(dir: &Path) -> Result<RunManifest, AuditError> {
     let path = dir.join(CONFIG);
-    let text = std::fs::read_to_string(&path).map_err(|e| AuditError::BadConfig {
+    let text = read_text_in_tree(&path, MAX_TEXT_BYTES).map_err(|e| AuditError::BadConfig {
         path: path.clone(),
         message: e.to_string(),
     })?;

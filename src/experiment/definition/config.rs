@@ -169,7 +169,11 @@ eps_l_d_steps = 1000
 impl Experiment {
     /// Load an experiment file and apply command-line overrides.
     pub fn load(path: &Path, overrides: &Overrides) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        let text = crate::files::bounded_read::read_text_file(
+            path,
+            crate::files::bounded_read::MAX_TEXT_BYTES,
+        )
+        .map_err(|source| ConfigError::Read {
             path: path.to_path_buf(),
             source,
         })?;
@@ -392,10 +396,9 @@ impl Experiment {
             return Ok(());
         }
         let text = toml::to_string(&self.shared_curves).map_err(std::io::Error::other)?;
-        crate::files::atomic::write_atomic(
-            &out.join(&self.name).join(SHARED_CURVES_FILE),
-            text.as_bytes(),
-        )
+        let dir = out.join(&self.name);
+        crate::files::links::create_real_dirs(out, &dir)?;
+        crate::files::atomic::write_atomic(&dir.join(SHARED_CURVES_FILE), text.as_bytes())
     }
 }
 

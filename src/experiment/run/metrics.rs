@@ -10,6 +10,7 @@
 //! [`crate::algos::value::learner::METRIC_COLUMNS`]. A reader takes any family columns between
 //! `eval_return` and `wall_seconds` by their header names.
 
+use crate::files::bounded_read::{gunzip_bounded, read_in_tree, MAX_METRICS_BYTES};
 use serde::Serialize;
 use std::path::Path;
 
@@ -29,7 +30,7 @@ pub fn locate(dir: &Path) -> Option<std::path::PathBuf> {
     [METRICS_FILE, METRICS_FILE_GZ]
         .iter()
         .map(|name| dir.join(name))
-        .find(|p| p.is_file())
+        .find(|p| std::fs::symlink_metadata(p).is_ok())
 }
 
 /// One evaluation point of a run: the training loop's own record, written as one CSV row.
@@ -129,16 +130,15 @@ pub fn write(
         .map_err(|source| MetricsError::Io { path: p(), source })
 }
 
-/// The bytes of a metrics file as CSV text, decompressing a `.gz` file.
+/// The bytes of a metrics file as CSV text, decompressing a `.gz` file (both at most
+/// [`MAX_METRICS_BYTES`]).
 pub fn read_text(path: &Path) -> Result<Vec<u8>, MetricsError> {
     let p = || path.display().to_string();
     let io = |source| MetricsError::Io { path: p(), source };
-    let bytes = std::fs::read(path).map_err(io)?;
+    // Inside a results tree: a regular file, not a link, of bounded size, also decompressed.
+    let bytes = read_in_tree(path, MAX_METRICS_BYTES).map_err(io)?;
     if path.extension().is_some_and(|e| e == "gz") {
-        let mut text = Vec::new();
-        std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&bytes[..]), &mut text)
-            .map_err(io)?;
-        Ok(text)
+        gunzip_bounded(&bytes, MAX_METRICS_BYTES).map_err(io)
     } else {
         Ok(bytes)
     }

@@ -45,7 +45,8 @@ pub fn run_dir(root: &Path, experiment: &str, curve: &str, seed: u64) -> PathBuf
 
 /// Whether the run in `dir` has finished training (its marker exists).
 pub fn is_finished(dir: &Path) -> bool {
-    dir.join(FINISHED).is_file()
+    // Not through a link: a planted `finished` would make an unfinished run look done.
+    std::fs::symlink_metadata(dir.join(FINISHED)).is_ok_and(|m| m.is_file())
 }
 
 /// How deep below a results root a run directory may sit: `<experiment>/<curve>/seed-<k>` (3),

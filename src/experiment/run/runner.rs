@@ -10,6 +10,7 @@ use crate::experiment::config::RunSpec;
 use crate::experiment::results_tree;
 use crate::experiment::train_run::{existing_run, Existing};
 use crate::experiment::work_queue::run_in_order;
+use crate::files::links::{check_real_dirs, create_real_dirs};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -134,10 +135,14 @@ where
     let todo: Vec<Result<bool, String>> = runs
         .iter()
         .map(|r| {
+            let dir = r.dir(&opts.out);
+            // Anyone who can write to a shared results tree could link a run's directory, or one
+            // above it, elsewhere: nothing below --out is created, read or emptied through one.
+            check_real_dirs(&opts.out, &dir).map_err(|e| e.to_string())?;
             if opts.force {
                 return Ok(true);
             }
-            match existing_run(r, &r.dir(&opts.out)) {
+            match existing_run(r, &dir) {
                 Ok(Existing::Finished) => Ok(false),
                 Ok(_) => Ok(true),
                 Err(e) => Err(e.to_string()),
@@ -206,6 +211,7 @@ where
         let start = std::time::Instant::now();
         // A panic is a bug, but it fails this run only, not its neighbours.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            create_real_dirs(&opts.out, &dir).map_err(|e| e.to_string())?;
             run_one(spec, &dir, &progress)
         }))
         .unwrap_or_else(|panic| {

@@ -21,6 +21,10 @@ use crate::experiment::run_settings::RunSettings;
 use crate::experiment::runner::{Progress, RunEnd};
 use crate::experiment::seeds::{stream, Role};
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
+use crate::files::bounded_read::{
+    read_in_tree, read_text_in_tree, MAX_CHECKPOINT_BYTES, MAX_TEXT_BYTES,
+};
+use crate::files::links::{explain_no_follow, open_options_no_follow};
 use crate::policy_files::{
     write_actor_policy_files, write_policy_files, AgentLayout, NetRole, PolicyError, RunInfo,
 };
@@ -118,7 +122,7 @@ pub enum Existing {
 pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
     let config_path = dir.join(CONFIG);
     let finished = results_tree::is_finished(dir);
-    if !config_path.exists() {
+    if std::fs::symlink_metadata(&config_path).is_err() {
         if finished {
             return Err(RunError::UnreadableRun {
                 path: config_path,
@@ -127,7 +131,7 @@ pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
         }
         return Ok(Existing::Nothing);
     }
-    let text = std::fs::read_to_string(&config_path).map_err(|e| io(&config_path, e))?;
+    let text = read_text_in_tree(&config_path, MAX_TEXT_BYTES).map_err(|e| io(&config_path, e))?;
     let existing: RunManifest = toml::from_str(&text).map_err(|e| RunError::UnreadableRun {
         path: config_path.clone(),
         message: e.message().to_string(),
@@ -163,18 +167,45 @@ fn lock_run_dir(dir: &Path) -> Result<std::fs::File, RunError> {
     }
     std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
     let path = dir.join(LOCK);
-    let file = std::fs::OpenOptions::new()
+    // Never through a link planted at `.lock`: creating or truncating its target elsewhere.
+    let file = open_options_no_follow()
         .create(true)
         .truncate(false)
         .write(true)
         .open(&path)
-        .map_err(|e| io(&path, e))?;
+        .map_err(|e| io(&path, explain_no_follow(&path, e)))?;
     match file.try_lock() {
         Ok(()) => Ok(file),
         Err(std::fs::TryLockError::WouldBlock) => Err(RunError::Busy {
             dir: dir.to_path_buf(),
         }),
         Err(std::fs::TryLockError::Error(e)) => Err(io(&path, e)),
+    }
+}
+
+/// How long a process that finds a run locked waits for the holder's `config.toml`: the holder
+/// writes it right after taking the lock.
+const HOLDER_CONFIG_WAIT: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// The run in `dir` is locked by another process: if that process trains this very run, leave it
+/// to it ([`RunEnd::Busy`], or [`RunEnd::AlreadyFinished`]); if it trains a different one, this
+/// run cannot be trained there, which is an error naming the keys that differ (exiting 0 would
+/// claim a run that is never trained).
+fn held_elsewhere(spec: &RunSpec, dir: &Path) -> Result<RunEnd, RunError> {
+    let start = std::time::Instant::now();
+    loop {
+        match existing_run(spec, dir) {
+            Ok(Existing::Finished) => return Ok(RunEnd::AlreadyFinished),
+            Ok(Existing::Unfinished) => return Ok(RunEnd::Busy),
+            Ok(Existing::Nothing) if start.elapsed() >= HOLDER_CONFIG_WAIT => {
+                return Ok(RunEnd::Busy)
+            }
+            Ok(Existing::Nothing) => std::thread::sleep(std::time::Duration::from_millis(50)),
+            Err(RunError::ConfigMismatch { dir, keys }) => {
+                return Err(RunError::BusyWithOtherRun { dir, keys })
+            }
+            Err(e) => return Err(e),
+        }
     }
 }
 
@@ -208,6 +239,8 @@ pub enum RunError {
     Io { path: PathBuf, message: String },
     #[error("{dir}: another macdec process is training this run (it holds {dir}/.lock); wait for it or stop it")]
     Busy { dir: PathBuf },
+    #[error("{dir}: another macdec process is training a different run here (differs in {keys}); this run was not trained: use another --out, or stop that process and rerun with --force")]
+    BusyWithOtherRun { dir: PathBuf, keys: String },
     #[error("{path}: refused checkpoint: {message} (or rerun with --force)")]
     BadCheckpoint { path: PathBuf, message: String },
     #[error(transparent)]
@@ -241,24 +274,21 @@ fn identity_of(m: &RunManifest) -> CheckpointIdentity {
     CheckpointIdentity::new(&m.experiment, m.method, &m.variant, m.seed, &m.config)
 }
 
-/// Read a checkpoint file's bytes: a regular file only (a FIFO or a device is refused).
+/// Read a checkpoint file's bytes: a regular file only (a FIFO, a device or a link is refused),
+/// of bounded size.
 fn read_checkpoint_bytes(path: &Path) -> Result<Vec<u8>, RunError> {
-    let meta = std::fs::metadata(path).map_err(|e| io(path, e))?;
-    if !meta.is_file() {
-        return Err(RunError::BadCheckpoint {
-            path: path.to_path_buf(),
-            message: "not a regular file".into(),
-        });
-    }
-    std::fs::read(path).map_err(|e| io(path, e))
+    read_in_tree(path, MAX_CHECKPOINT_BYTES).map_err(|e| RunError::BadCheckpoint {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }
 
 /// Load a run's trainer from its checkpoint, verified (format, checksum, exact length) and, when
 /// the run's `config.toml` sits beside it, checked to be that run's.
 pub fn load_checkpoint(path: &Path) -> Result<AnyLoop, RunError> {
     let expected = match path.parent().map(|d| d.join(CONFIG)) {
-        Some(config) if config.exists() => {
-            let text = std::fs::read_to_string(&config).map_err(|e| io(&config, e))?;
+        Some(config) if std::fs::symlink_metadata(&config).is_ok() => {
+            let text = read_text_in_tree(&config, MAX_TEXT_BYTES).map_err(|e| io(&config, e))?;
             let m: RunManifest = toml::from_str(&text).map_err(|e| RunError::UnreadableRun {
                 path: config.clone(),
                 message: e.message().to_string(),
@@ -358,7 +388,7 @@ pub fn train_run(
 ) -> Result<RunEnd, RunError> {
     // Held until this function returns, whatever the outcome.
     let _lock = match lock_run_dir(dir) {
-        Err(RunError::Busy { .. }) if !force => return Ok(RunEnd::Busy),
+        Err(RunError::Busy { .. }) if !force => return held_elsewhere(spec, dir),
         lock => lock?,
     };
     if force {
@@ -378,7 +408,7 @@ pub fn train_run(
     }
     let checkpoint = dir.join(CHECKPOINT);
     let identity = identity_of(&RunManifest::for_spec(spec));
-    let mut trainer = if checkpoint.exists() {
+    let mut trainer = if std::fs::symlink_metadata(&checkpoint).is_ok() {
         load_checkpoint_of(&checkpoint, Some(&identity))?
     } else {
         let env = spec.env.clone();
