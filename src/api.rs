@@ -29,7 +29,12 @@ pub const LIBRARY_EXPERIMENT: &str = "library";
 pub enum LibraryTrainError {
     /// A config key is out of range; the message names it and the allowed values.
     #[error("config key `{key}`: {message}")]
-    Config { key: &'static str, message: String },
+    Config {
+        /// The config key.
+        key: &'static str,
+        /// What was wrong and what is allowed.
+        message: String,
+    },
     /// The domain, the replay or an update failed, or training diverged.
     #[error(transparent)]
     Train(#[from] TrainError),
@@ -59,10 +64,13 @@ pub fn train<E: MacroEnv>(
 /// trained with, enough to put the policy on robots ([`Self::export`]).
 #[derive(Debug, Clone)]
 pub struct TrainedPolicy {
+    /// The method trained.
     pub method: Method,
+    /// The run's seed.
     pub seed: u64,
     /// Training episodes completed (the config's `total_epi`).
     pub episodes_trained: u64,
+    /// The hyperparameters it trained with.
     pub config: RunConfig,
     /// Every evaluation point, as [`train`] returns them.
     pub evals: Vec<EvalPoint>,

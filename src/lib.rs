@@ -54,6 +54,8 @@
 //! or [`train_policy`] and [`TrainedPolicy::export`] to put the trained policy on robots (see
 //! `examples/custom_domain.rs`).
 
+#![warn(missing_docs)]
+
 pub mod algos;
 pub mod api;
 pub mod autograd;

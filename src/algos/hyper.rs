@@ -135,12 +135,17 @@ pub struct ValueConfig {
     pub sample_epi: bool,
     /// Hysteresis moves from init_h to end_h over h_stable_at episodes (`docs/ALGORITHMS.md` §5.6).
     pub dynamic_h: bool,
+    /// Hysteresis h at the start (with `dynamic_h`).
     pub init_h: f64,
+    /// Hysteresis h from `h_stable_at` episodes on.
     pub end_h: f64,
+    /// Episodes over which h moves from `init_h` to `end_h`.
     pub h_stable_at: usize,
     /// Linear epsilon decay over eps_l_d_steps episodes (`docs/ALGORITHMS.md` §4.1); else the exponential schedule.
     pub eps_l_d: bool,
+    /// Episodes of the linear epsilon decay.
     pub eps_l_d_steps: usize,
+    /// Epsilon once the linear decay is over.
     pub eps_end: f64,
     /// Carry the exploring nets' hidden state during training episodes (`docs/ALGORITHMS.md` §4.4, quirk Q1).
     pub h_explore: bool,
@@ -164,9 +169,11 @@ pub struct ValueConfig {
     pub batch_size: usize,
     /// Decentralized nets: MLP width M and LSTM width H (Dec-HDDRQN's `mlp_layer_size`/`rnn_h_size`).
     pub dec_mlp_layer_size: usize,
+    /// H of the decentralized nets.
     pub dec_rnn_h_size: usize,
     /// Centralized net: M and H (Cen-DDRQN's `mlp_layer_size`/`rnn_h_size`).
     pub cen_mlp_layer_size: usize,
+    /// H of the centralized net.
     pub cen_rnn_h_size: usize,
     /// Evaluate before training and then every eval_freq training episodes (ICRA code: 10).
     pub eval_freq: usize,

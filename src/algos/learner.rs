@@ -27,8 +27,11 @@ pub enum Schedule {
     /// primitive step; a training iteration runs every `train_freq` steps once `start_train`
     /// training episodes are done; targets are hard-copied every `target_update_freq` steps.
     EveryStep {
+        /// Main-loop steps between training iterations.
         train_freq: u64,
+        /// Training episodes to complete before the first iteration.
         start_train: u64,
+        /// Main-loop steps between hard target copies.
         target_update_freq: u64,
         /// Evaluate before training and every `eval_freq` training episodes.
         eval_freq: u64,
@@ -39,8 +42,11 @@ pub enum Schedule {
     /// targets are hard-copied when the count is a multiple of `target_update_freq`. An
     /// evaluation precedes every update whose episode count is a multiple of `eval_period`.
     EpisodeBatches {
+        /// Completed episodes per update.
         train_freq: u64,
+        /// Episodes between hard target copies.
         target_update_freq: u64,
+        /// Episodes between evaluations.
         eval_period: u64,
     },
 }

@@ -80,7 +80,9 @@ pub enum AcCritic {
 /// An actor-critic method's design: its actor and its critic.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AcDesign {
+    /// Who acts.
     pub actor: AcActor,
+    /// What the critics see and whose return they learn.
     pub critic: AcCritic,
     /// The name of the reference's class (`--alg`), which keys its published settings.
     pub reference_alg: &'static str,
@@ -357,8 +359,11 @@ impl Method {
 pub struct HysteresisRule {
     /// Follow the schedule (`docs/ALGORITHMS.md` §5.6); otherwise h = 1 - epsilon (the reference's fallback).
     pub dynamic: bool,
+    /// h at episode 0.
     pub init_h: f64,
+    /// h from `h_stable_at` episodes on.
     pub end_h: f64,
+    /// Episodes over which h moves linearly from `init_h` to `end_h`.
     pub h_stable_at: f64,
 }
 

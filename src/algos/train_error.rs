@@ -20,27 +20,44 @@ impl TrainError {
 /// Why training stopped early.
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {
+    /// An environment refused a step or reset.
     #[error(transparent)]
     Env(#[from] EnvError),
+    /// The replay buffer refused a record or a sample.
     #[error(transparent)]
     Replay(#[from] ReplayError),
+    /// A value-based update failed.
     #[error(transparent)]
     Update(#[from] UpdateError),
+    /// A loss or parameter became NaN or infinite.
     #[error("{method} seed {seed}: non-finite {what} at episode {episode}")]
     NonFinite {
+        /// The method trained.
         method: Method,
+        /// The run's seed.
         seed: u64,
+        /// `loss` or `parameter`.
         what: &'static str,
+        /// Training episodes completed.
         episode: u64,
     },
+    /// The method's nets cannot be built for the domain; the text says why.
     #[error("{0}")]
     Nets(String),
+    /// The config is for the other family (value-based vs actor-critic).
     #[error("{method}: the config holds another method family's keys")]
-    WrongFamily { method: Method },
+    WrongFamily {
+        /// The method asked for.
+        method: Method,
+    },
+    /// More training lanes (parallel environments) than a run has random streams for.
     #[error("{method} asks for {asked} training lanes; runs have random streams for {available}")]
     TooManyLanes {
+        /// The method.
         method: Method,
+        /// Lanes the config asks for.
         asked: usize,
+        /// The most lanes a run supports (`MAX_LANES`).
         available: usize,
     },
 }

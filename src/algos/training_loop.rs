@@ -15,13 +15,17 @@ use serde::{Deserialize, Serialize};
 /// Independent random streams of one run (one per role, `docs/ALGORITHMS.md` §8).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunRngs {
+    /// Initial net weights.
     pub init: ChaCha8Rng,
+    /// Exploration (epsilon-greedy draws, actor sampling).
     pub explore: ChaCha8Rng,
+    /// Replay sampling.
     pub replay: ChaCha8Rng,
     /// The first training lane's environment.
     pub env: EnvRng,
     /// The second training lane's environment (Our-2's centralized lane).
     pub cen_env: EnvRng,
+    /// The evaluation environment.
     pub eval_env: EnvRng,
 }
 
@@ -35,9 +39,13 @@ const EXTRA_LANE_STREAMS: u64 = 1 << 32;
 /// One evaluation point, as the metrics file records it (one `metrics.csv` row).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EvalPoint {
+    /// Training episodes completed.
     pub episode: u64,
+    /// Primitive steps taken by the training environments.
     pub env_steps: u64,
+    /// Training updates (iterations) done.
     pub updates: u64,
+    /// Mean evaluation return, discounted per primitive step (`docs/ALGORITHMS.md` §7.1).
     pub eval_return: f64,
     /// The family's own columns, in the order of [`Learner::metric_columns`] (value-based:
     /// `epsilon`, `hysteresis`, `loss`); `None` is an empty cell.
@@ -50,7 +58,10 @@ pub struct EvalPoint {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Advance {
     /// A training episode finished; `checkpoint_due` when the episode count hits checkpoint_freq.
-    Episode { checkpoint_due: bool },
+    Episode {
+        /// Whether a checkpoint is due now.
+        checkpoint_due: bool,
+    },
     /// `total_epi` episodes are done.
     Finished,
 }

@@ -22,10 +22,15 @@ use crate::nn::{GruParams, LstmParams};
 /// One benchmarked shape: input and hidden size, `batch` sequences of `seq` steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RnnShape {
+    /// Label in the table, e.g. `bp10x10-dec`.
     pub name: &'static str,
+    /// Input features per step.
     pub input: usize,
+    /// Hidden size H.
     pub hidden: usize,
+    /// Sequences per pass.
     pub batch: usize,
+    /// Steps per sequence.
     pub seq: usize,
 }
 
@@ -58,7 +63,9 @@ pub const SHAPES: [RnnShape; 3] = [
 /// Which recurrent layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Rnn {
+    /// The Q-nets' LSTM (4 gates).
     Lstm,
+    /// The actors' GRU (3 gates).
     Gru,
 }
 
@@ -82,10 +89,15 @@ impl Rnn {
 /// Timing of one layer at one shape.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RnnBench {
+    /// The shape timed.
     pub shape: RnnShape,
+    /// The layer timed.
     pub rnn: Rnn,
+    /// Median wall-clock time of one forward and backward pass, in ms.
     pub median_ms: f64,
+    /// 10th percentile of the same, in ms.
     pub p10_ms: f64,
+    /// 90th percentile of the same, in ms.
     pub p90_ms: f64,
     /// Median thread CPU time per pass, where available (see `bench nets`).
     pub cpu_median_ms: Option<f64>,

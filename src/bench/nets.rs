@@ -18,9 +18,13 @@ use crate::nn::{Adam, AdamConfig, QNet, QNetConfig, TdBatch, Updater};
 /// steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NetShape {
+    /// Label in the table, e.g. `wtd-dec`.
     pub name: &'static str,
+    /// The Q-net's sizes.
     pub cfg: QNetConfig,
+    /// Sequences per update.
     pub batch: usize,
+    /// Steps per sequence.
     pub seq: usize,
     /// PyTorch 2.x CPU, 1 thread, the same shape and update (`shared/bench/pytorch_qnet_update.py
     /// --arch ref`), measured on this machine as stated in issue 3.
@@ -61,9 +65,13 @@ pub const SHAPES: [NetShape; 6] = [
 /// Timing of one shape.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NetBench {
+    /// The configuration timed.
     pub shape: NetShape,
+    /// Median wall-clock time of one update, in ms.
     pub median_ms: f64,
+    /// 10th percentile of the same, in ms.
     pub p10_ms: f64,
+    /// 90th percentile of the same, in ms.
     pub p90_ms: f64,
     /// Median CPU time of the thread per update (Linux `CLOCK_THREAD_CPUTIME_ID`), which stays
     /// meaningful when other processes compete for the cores; `None` where unavailable.

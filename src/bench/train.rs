@@ -15,20 +15,28 @@ use std::time::Instant;
 /// What one benchmarked run did and how fast.
 #[derive(Debug, Clone)]
 pub struct TrainBench {
+    /// The benchmark's label.
     pub name: String,
+    /// Training episodes run.
     pub episodes: u64,
+    /// Primitive steps taken.
     pub env_steps: u64,
+    /// Training updates done.
     pub updates: u64,
+    /// Wall-clock time of the run.
     pub seconds: f64,
 }
 
 impl TrainBench {
+    /// Episodes per wall-clock second.
     pub fn episodes_per_second(&self) -> f64 {
         self.episodes as f64 / self.seconds
     }
+    /// Primitive steps per wall-clock second.
     pub fn env_steps_per_second(&self) -> f64 {
         self.env_steps as f64 / self.seconds
     }
+    /// Updates per wall-clock second.
     pub fn updates_per_second(&self) -> f64 {
         self.updates as f64 / self.seconds
     }

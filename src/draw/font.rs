@@ -6,6 +6,7 @@ use super::palette::Colour;
 
 /// Glyph width and height in font pixels.
 pub const GLYPH_W: i64 = 3;
+/// Glyph height in font pixels.
 pub const GLYPH_H: i64 = 5;
 
 /// Horizontal advance per character in font pixels (glyph plus one column of space).

@@ -13,6 +13,8 @@ pub use palette::Colour;
 /// each agent (`R0`, `T1`, `F`) that the status bar prints in the agent's colour.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Picture {
+    /// The world drawn in pixels.
     pub world: Canvas,
+    /// One label per agent, in agent order.
     pub agent_labels: &'static [&'static str],
 }

@@ -13,12 +13,15 @@ pub enum Colour {
     GridLine,
     /// Outlines, walls, heading markers and text.
     Dark,
+    /// Labels drawn on coloured fills (Warehouse: the Fetch's `F`, the Turtlebots' digits).
     White,
     /// Box Pushing goal row (the paper's yellow bar).
     Goal,
     /// Box Pushing waypoints, drawn faintly.
     Waypoint,
+    /// Box Pushing small boxes.
     SmallBox,
+    /// Box Pushing big box.
     BigBox,
     /// Box Pushing robot 0 and Turtlebot 0 (the paper's green T-0).
     Agent0,
@@ -26,13 +29,17 @@ pub enum Colour {
     Agent1,
     /// The Fetch (the paper's gray robot).
     Fetch,
+    /// Warehouse tables and empty staging slots.
     Table,
     /// Warehouse waypoints (red dots as in the reference's renderer); a human waiting for a tool.
     Red,
+    /// Warehouse humans; Overcooked onions.
     Human,
     /// Tool 0, 1, 2 of the Warehouse, wherever they are (staging area, basket, human's request).
     Tool0,
+    /// See [`Colour::Tool0`].
     Tool1,
+    /// See [`Colour::Tool0`].
     Tool2,
     /// Workshop floor.
     Workshop,

@@ -17,7 +17,9 @@ pub struct EnvBench {
     pub steps: u64,
     /// Episodes started.
     pub episodes: u64,
+    /// Wall-clock time of the measurement.
     pub seconds: f64,
+    /// Primitive steps per wall-clock second.
     pub steps_per_second: f64,
 }
 

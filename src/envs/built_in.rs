@@ -42,7 +42,10 @@ macro_rules! any_env {
         #[allow(clippy::large_enum_variant)]
         #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
         pub enum AnyEnv {
-            $($variant($env),)+
+            $(
+                #[doc = concat!("A built-in domain's environment (`", stringify!($variant), "`).")]
+                $variant($env),
+            )+
             /// A domain not built in (the variant comes last, so the built-in variants keep
             /// their bincode indices).
             Custom(CustomEnv),

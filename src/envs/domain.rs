@@ -24,7 +24,9 @@ pub const HORIZON_KEY: &str = "env_terminate_step";
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("`{key}`: {message}")]
 pub struct KeyError {
+    /// The key, as written.
     pub key: String,
+    /// Why it is refused and what is expected.
     pub message: String,
 }
 

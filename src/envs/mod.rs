@@ -37,20 +37,43 @@ pub type EnvRng = ChaCha8Rng;
 /// Why an environment refused its input. Messages name the offending value and the allowed range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EnvError {
+    /// A free agent was given a macro-action it does not have.
     #[error("agent {agent}: macro-action {action} is out of range 0..{n_actions}")]
     ActionOutOfRange {
+        /// The agent.
         agent: usize,
+        /// The index given.
         action: usize,
+        /// Macro-actions the agent has.
         n_actions: usize,
     },
+    /// The joint action has the wrong number of entries.
     #[error("expected one action per agent ({expected}), got {got}")]
-    WrongActionCount { expected: usize, got: usize },
+    WrongActionCount {
+        /// Agents in the domain.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// `step` after the episode ended, without a `reset`.
     #[error("step called after the episode ended; call reset first")]
     EpisodeOver,
+    /// A parameter out of its range.
     #[error("invalid environment parameter `{name}`: {reason}")]
-    InvalidParameter { name: &'static str, reason: String },
+    InvalidParameter {
+        /// The parameter.
+        name: &'static str,
+        /// Its range, or why the value is refused.
+        reason: String,
+    },
+    /// A domain config key that is unknown or has a bad value.
     #[error("invalid domain key `{key}`: {reason}")]
-    InvalidKey { key: String, reason: String },
+    InvalidKey {
+        /// The key, as written.
+        key: String,
+        /// Why it is refused.
+        reason: String,
+    },
 }
 
 /// What one primitive step returns besides the observations (read them with [`MacroEnv::obs`]).

@@ -99,10 +99,12 @@ static REGISTERED: RwLock<Vec<&'static dyn DomainEntry>> = RwLock::new(Vec::new(
 /// Why a domain could not be registered.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RegistryError {
+    /// A name, alias or tag another domain already has; holds it.
     #[error(
         "domain name `{0}` is taken by another domain (every name, alias and tag must be unique)"
     )]
     NameTaken(String),
+    /// A name that is not 1 to 64 letters, digits, `_` or `-`; holds it.
     #[error("domain name {0:?} must be 1 to 64 letters, digits, `_` or `-`")]
     BadName(String),
 }
@@ -166,6 +168,7 @@ pub fn find(name: &str) -> Option<&'static dyn DomainEntry> {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("unknown domain `{name}`: this binary has {known}")]
 pub struct UnknownDomain {
+    /// The name asked for.
     pub name: String,
     /// Every known domain as `name (tag)` ([`names_and_tags`]).
     pub known: String,

@@ -26,6 +26,7 @@ pub const REPLAY_SEED: u64 = 0;
 /// A parsed replay file: which environment, and one row of actions per primitive step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReplayFile {
+    /// The domain and its config, reset before the first step.
     pub spec: EnvSpec,
     /// `steps[k][i]`: agent i's entry at primitive step k+1 (ignored while agent i is busy).
     pub steps: Vec<Vec<i64>>,
@@ -36,45 +37,68 @@ pub struct ReplayFile {
 /// Why a replay file was refused. Messages name the step (1-based) and agent at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum ReplayFileError {
+    /// The text is not JSON.
     #[error("not valid JSON: {0}")]
     Json(#[source] serde_json::Error),
+    /// The top level is not an object; holds what it is (e.g. `an array`).
     #[error("expected a JSON object with `env`, its parameters and `steps`, got {0}")]
     NotAnObject(&'static str),
+    /// No `steps` field.
     #[error("missing field `steps` (a list with one list of actions per primitive step)")]
     MissingSteps,
+    /// `steps` is not a list of lists of integers.
     #[error("`steps` must be a list of lists of integers: {0}")]
     BadSteps(#[source] serde_json::Error),
+    /// The domain fields (`env` and its keys) do not describe a known domain.
     #[error("bad environment description: {0}")]
     BadSpec(#[source] serde_json::Error),
+    /// A reference-form file's `params` do not fit the domain.
     #[error("bad environment description: {0}")]
     BadParams(#[source] super::spec::SpecError),
+    /// `params` is not an object; holds what it is.
     #[error("`params` must be an object of the reference's keyword arguments, got {0}")]
     ParamsNotAnObject(&'static str),
+    /// A `params` entry is null; holds its key.
     #[error("`params.{0}` holds a null, which is not a parameter value")]
     NullParam(String),
+    /// A reference-form file without a string `env`.
     #[error("`env` must be a string naming the domain")]
     MissingEnv,
+    /// The domain refused its config.
     #[error("cannot build the environment: {0}")]
     Build(#[source] EnvError),
+    /// A row of `steps` with the wrong number of entries.
     #[error("step {step}: expected {expected} actions (one per agent), got {got}")]
     RowLength {
+        /// Primitive step, 1-based.
         step: usize,
+        /// Agents in the domain.
         expected: usize,
+        /// Entries in the row.
         got: usize,
     },
+    /// A free agent's entry is not one of its macro-actions.
     #[error("step {step}: agent {agent} is free and needs a macro-action in 0..{n_actions}, got {action}")]
     BadAction {
+        /// Primitive step, 1-based.
         step: usize,
+        /// The agent.
         agent: usize,
+        /// The entry given.
         action: i64,
+        /// Macro-actions the agent has.
         n_actions: usize,
     },
+    /// The environment refused the step.
     #[error("step {step}: {source}")]
     Step {
+        /// Primitive step, 1-based.
         step: usize,
+        /// The environment's error.
         #[source]
         source: EnvError,
     },
+    /// The replay could not be written out.
     #[error("writing the replay: {0}")]
     Output(#[from] std::io::Error),
 }
@@ -149,16 +173,21 @@ fn json_kind(v: &Value) -> &'static str {
 /// One output line. The first line (t = 0, after reset) has only `t` and `obs`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ReplayLine {
+    /// Primitive steps since reset (0 on the first line).
     pub t: usize,
+    /// The macro-action each agent ran during this step (absent on the first line).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub executed: Option<Vec<usize>>,
     /// Each agent's observation, in the spec's layout.
     pub obs: Vec<Vec<f32>>,
+    /// The team reward of this step.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reward: Option<f64>,
     /// The per-agent reward list (reference form only): the team reward for every agent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rewards: Option<Vec<f64>>,
+    /// Whether the episode ended here: the env's terminal flag in the reference form, else
+    /// terminal or horizon.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub done: Option<bool>,
     /// Each agent's macro-action-done flag as 0 or 1.
@@ -172,7 +201,9 @@ pub struct ReplayLine {
 /// A replayed line and, when asked for, the ASCII picture of the state after it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReplayFrame {
+    /// The output line.
     pub line: ReplayLine,
+    /// The ASCII picture of the state after the step, if asked for.
     pub picture: Option<String>,
 }
 
@@ -180,7 +211,9 @@ pub struct ReplayFrame {
 /// episode ended first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Replay {
+    /// One frame per output line, the reset line first.
     pub frames: Vec<ReplayFrame>,
+    /// Rows of `steps` left over because the episode ended first.
     pub unused_steps: usize,
 }
 

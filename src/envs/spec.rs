@@ -22,11 +22,15 @@ pub struct EnvSpec {
 /// Why a spec could not be made: no such domain, or a bad key.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpecError {
+    /// No domain answers to the name.
     #[error(transparent)]
     UnknownDomain(#[from] registry::UnknownDomain),
+    /// A domain key is unknown or has a bad value.
     #[error("{domain}: {source}")]
     Key {
+        /// The domain's name.
         domain: &'static str,
+        /// Which key and why.
         #[source]
         source: KeyError,
     },

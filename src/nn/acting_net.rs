@@ -20,7 +20,9 @@ pub enum ActingNet {
 /// The recurrent state an [`ActingNet`] carries between an agent's decisions.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ActingState {
+    /// A Q-net's LSTM state.
     Lstm(LstmState),
+    /// An actor's GRU state.
     Gru(GruActorState),
 }
 

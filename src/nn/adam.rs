@@ -11,9 +11,13 @@ use crate::autograd::kernels::activations::simd_dispatch;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AdamConfig {
+    /// Learning rate.
     pub lr: f64,
+    /// Decay of the first moment (PyTorch's default 0.9).
     pub beta1: f64,
+    /// Decay of the second moment (PyTorch's default 0.999).
     pub beta2: f64,
+    /// Added to the root of the second moment (PyTorch's default 1e-8).
     pub eps: f64,
 }
 
@@ -33,6 +37,7 @@ impl AdamConfig {
 /// for training checkpoints).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Adam {
+    /// The hyperparameters.
     pub config: AdamConfig,
     step: u64,
     m: Vec<Vec<f32>>,

@@ -51,8 +51,12 @@ impl Default for DemoConfig {
 /// Why the demo refused its settings.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DemoError {
+    /// A count that must be positive was 0.
     #[error("demo: `{name}` must be > 0")]
-    NotPositive { name: &'static str },
+    NotPositive {
+        /// The setting.
+        name: &'static str,
+    },
 }
 
 /// (step, mean loss over the last `report_every` steps) at every report.

@@ -48,9 +48,13 @@ pub const GRU_ACTOR_TENSOR_NAMES: [&str; 12] = [
 /// `a_rnn_layer_size = H`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GruActorConfig {
+    /// Input features: the agent's (or the joint) observation length.
     pub input: usize,
+    /// [m0, m1]: widths of fc1 and fc2 (m0) and of fc3 (m1).
     pub mlp: [usize; 2],
+    /// H: the GRU's hidden size.
     pub hidden: usize,
+    /// One log-probability per (joint) macro-action.
     pub output: usize,
 }
 

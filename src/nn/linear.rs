@@ -51,7 +51,9 @@ impl LinearParams {
 /// A linear layer's parameters on a tape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinearVars {
+    /// The weight [out, in].
     pub weight: Var,
+    /// The bias \[out\].
     pub bias: Var,
 }
 

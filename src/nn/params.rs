@@ -35,7 +35,9 @@ pub trait Params {
 /// A fully connected layer's parameters (PyTorch `nn.Linear`): weight [out, in], bias \[out\].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LinearParams {
+    /// [out, in].
     pub weight: Array2<f32>,
+    /// \[out\].
     pub bias: Array1<f32>,
 }
 

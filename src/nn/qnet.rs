@@ -26,9 +26,13 @@ use crate::autograd::{Activation, LstmVars, Pool, SeqPacking, Tape, Var};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct QNetConfig {
+    /// Input features: the agent's (or the joint) macro-observation length.
     pub input: usize,
+    /// M: width of fc1 and fc3.
     pub mlp: usize,
+    /// H: fc2's output and the LSTM's hidden size.
     pub hidden: usize,
+    /// Q-values: one per (joint) macro-action.
     pub output: usize,
 }
 
@@ -51,7 +55,9 @@ pub enum Dim {
 /// (`nn.Linear.weight` is `[out, in]`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TensorSpec {
+    /// The state_dict name, e.g. `lstm.weight_ih_l0`.
     pub name: &'static str,
+    /// The shape, resolved against a [`QNetConfig`].
     pub dims: &'static [Dim],
 }
 
@@ -147,10 +153,15 @@ impl QNetConfig {
 /// Also the container for its gradients and Adam moments.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct QNetParams {
+    /// Input to M.
     pub fc1: LinearParams,
+    /// M to H.
     pub fc2: LinearParams,
+    /// The LSTM, H to H.
     pub lstm: LstmParams,
+    /// H to M.
     pub fc3: LinearParams,
+    /// M to the Q-values.
     pub fc4: LinearParams,
 }
 
@@ -241,16 +252,22 @@ const LEAKY: Activation = Activation::LEAKY_001;
 /// A recurrent Q-net. `Clone` (or [`QNet::copy_from`]) makes the target net.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct QNet {
+    /// The parameters.
     pub params: QNetParams,
 }
 
 /// A Q-net's parameters on a tape, from [`QNet::bind`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct QNetVars {
+    /// fc1's weight and bias.
     pub fc1: LinearVars,
+    /// fc2's weight and bias.
     pub fc2: LinearVars,
+    /// The LSTM's weights and biases.
     pub lstm: LstmVars,
+    /// fc3's weight and bias.
     pub fc3: LinearVars,
+    /// fc4's weight and bias.
     pub fc4: LinearVars,
 }
 

@@ -20,39 +20,65 @@ use super::qnet::{QNet, QNetConfig, QNetParams, TENSOR_NAMES};
 /// tensor when one is at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum WeightsError {
+    /// The file could not be read or written.
     #[error("{path}: {source}")]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },
+    /// The bytes are not a safetensors file.
     #[error("{path}: not a valid safetensors file: {reason}")]
-    Format { path: PathBuf, reason: String },
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// The parser's reason.
+        reason: String,
+    },
+    /// A tensor the net needs is absent.
     #[error("{path}: tensor `{name}` is missing (expected shape {expected:?})")]
     Missing {
+        /// The file.
         path: PathBuf,
+        /// The tensor's name.
         name: &'static str,
+        /// Its shape.
         expected: Vec<usize>,
     },
+    /// A tensor has the wrong shape.
     #[error("{path}: tensor `{name}` has shape {found:?}, expected {expected:?}")]
     Shape {
+        /// The file.
         path: PathBuf,
+        /// The tensor's name.
         name: String,
+        /// The shape stored.
         found: Vec<usize>,
+        /// The shape the net needs.
         expected: Vec<usize>,
     },
+    /// A tensor is not F32.
     #[error("{path}: tensor `{name}` has dtype {found}, expected F32")]
     Dtype {
+        /// The file.
         path: PathBuf,
+        /// The tensor's name.
         name: String,
+        /// The dtype stored.
         found: String,
     },
+    /// A tensor the net does not have.
     #[error("{path}: unexpected tensor `{name}`; a {what} has exactly {expected}")]
     Unexpected {
+        /// The file.
         path: PathBuf,
+        /// The tensor's name.
         name: String,
         /// What the file should hold ("Q-net", "GRU").
         what: &'static str,
+        /// The tensor names the net has.
         expected: String,
     },
 }

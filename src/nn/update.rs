@@ -12,16 +12,22 @@ use crate::autograd::{SeqPacking, Tape};
 /// x: [K, in] in flat (sequence, time) order; `actions`, `targets`: K entries, same order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TdBatch {
+    /// The inputs, [K, in].
     pub x: Array2<f32>,
+    /// Which rows belong to which sequence and time step.
     pub packing: SeqPacking,
+    /// The chosen action at each of the K positions.
     pub actions: Vec<usize>,
+    /// The TD target at each of the K positions (no gradient flows into it).
     pub targets: Array1<f32>,
 }
 
 /// Reusable state of an update loop: the tape and the gradient buffer.
 #[derive(Debug)]
 pub struct Updater {
+    /// The tape, cleared and reused each update.
     pub tape: Tape,
+    /// The gradient buffer, zeroed and reused each update.
     pub grads: QNetParams,
 }
 

@@ -23,7 +23,9 @@ pub use crate::experiment::results_tree::CONFIG as CONFIG_FILE;
 /// One run's learning curve and what a figure needs to know about it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunData {
+    /// The run's seed (from `seed-<k>`).
     pub seed: u64,
+    /// The run directory.
     pub dir: PathBuf,
     /// `(episode, value)` per evaluation of the plotted column (`eval_return` unless another
     /// was asked for; rows with an empty cell are left out), episodes strictly increasing.
@@ -47,6 +49,7 @@ pub struct CurveData {
     pub method: Option<Method>,
     /// The sweep point after `@`, empty without a sweep.
     pub variant: String,
+    /// The curve's runs, by seed.
     pub runs: Vec<RunData>,
 }
 
@@ -66,14 +69,18 @@ impl CurveData {
 /// The curves of one experiment, in the paper's method order, then by sweep point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExperimentData {
+    /// The experiment's directory name.
     pub name: String,
+    /// Its curves.
     pub curves: Vec<CurveData>,
 }
 
 /// Everything found under a results root, plus notes on what was skipped and why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Discovery {
+    /// The experiments found, by name.
     pub experiments: Vec<ExperimentData>,
+    /// What was skipped and why.
     pub notes: Vec<String>,
 }
 

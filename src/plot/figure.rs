@@ -18,6 +18,7 @@ pub type Rgb = (u8, u8, u8);
 pub struct Series {
     /// Legend text, e.g. "Our-1 (n = 40 seeds)".
     pub label: String,
+    /// The curve's colour (never red, which marks the optimum).
     pub colour: Rgb,
     /// Smoothed mean and standard error per evaluation point (`docs/ALGORITHMS.md` §7.2).
     pub points: Vec<CurvePoint>,
@@ -26,7 +27,9 @@ pub struct Series {
 /// Everything a figure shows, independent of the backend.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
+    /// The figure's title.
     pub title: String,
+    /// One series per curve.
     pub series: Vec<Series>,
     /// The optimal return (red dash-dot line), when the runs' setting has a known one.
     pub optimal: Option<f64>,
@@ -41,8 +44,11 @@ pub struct Figure {
 /// A figure plus its summary rows and notes (e.g. why no optimal line is drawn).
 #[derive(Debug, Clone)]
 pub struct Built {
+    /// The figure.
     pub figure: Figure,
+    /// One summary row per curve.
     pub summary: Vec<CurveSummary>,
+    /// What the figure left out and why.
     pub notes: Vec<String>,
 }
 

@@ -25,22 +25,30 @@ use summary::{CurveSummary, PairTest};
 /// The files written for one experiment and its summary.
 #[derive(Debug, Clone)]
 pub struct ExperimentPlot {
+    /// The experiment's name.
     pub experiment: String,
     /// The figure's title (experiment name and domain).
     pub title: String,
+    /// The learning-curve figure, PNG.
     pub png: PathBuf,
+    /// The same figure, SVG.
     pub svg: PathBuf,
+    /// `<experiment>_summary.csv`: one row per curve.
     pub summary_csv: PathBuf,
+    /// The rows of that file.
     pub summary: Vec<CurveSummary>,
     /// `<experiment>_welch.csv`: one-sided Welch tests between every two curves.
     pub tests_csv: PathBuf,
+    /// The rows of `tests_csv`.
     pub tests: Vec<PairTest>,
 }
 
 /// What [`plot_results`] did, and what it skipped (`notes`, for the user to read).
 #[derive(Debug, Clone)]
 pub struct PlotReport {
+    /// One per experiment drawn.
     pub plots: Vec<ExperimentPlot>,
+    /// What was skipped and why.
     pub notes: Vec<String>,
 }
 

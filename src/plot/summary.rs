@@ -60,13 +60,21 @@ pub struct CurveSummary {
 /// curve learns earlier, per seed rather than from the mean curve).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PairTest {
+    /// Curve A, the one H1 says is higher.
     pub curve_a: String,
+    /// Curve B.
     pub curve_b: String,
+    /// Welch's t on the final returns.
     pub t: f64,
+    /// Welch-Satterthwaite degrees of freedom, final returns.
     pub df: f64,
+    /// One-sided p-value of "A above B", final returns.
     pub p_a_greater: f64,
+    /// Welch's t on the means over training.
     pub t_over_training: f64,
+    /// Degrees of freedom, means over training.
     pub df_over_training: f64,
+    /// One-sided p-value of "A above B", means over training.
     pub p_a_greater_over_training: f64,
 }
 

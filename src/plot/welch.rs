@@ -5,6 +5,7 @@
 /// The result of testing H1: mean(A) > mean(B).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WelchTest {
+    /// Welch's t statistic.
     pub t: f64,
     /// Welch-Satterthwaite degrees of freedom.
     pub df: f64,

@@ -184,20 +184,34 @@ fn weights_error(e: NnWeightsError) -> WeightsError {
 /// Why a weight file does not fit the manifest's architecture.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WeightsError {
+    /// An architecture name this build does not know; holds it.
     #[error("unknown architecture `{0}` (this version knows `ddrqn` and `macromarl-gru-actor`)")]
     UnknownKind(String),
+    /// The bytes are not a safetensors file; holds the parser's reason.
     #[error("not a safetensors file: {0}")]
     Unreadable(String),
+    /// A tensor the architecture needs is absent; holds its name.
     #[error("tensor `{0}` is missing")]
     Missing(String),
+    /// A tensor the architecture does not have; holds its name.
     #[error("tensor `{0}` is not part of the architecture")]
     Unexpected(String),
+    /// A tensor is not F32.
     #[error("tensor `{name}` has dtype {dtype}, expected F32")]
-    Dtype { name: String, dtype: String },
+    Dtype {
+        /// The tensor's name.
+        name: String,
+        /// The dtype stored.
+        dtype: String,
+    },
+    /// A tensor's shape differs from the architecture's.
     #[error("tensor `{name}` has shape {got:?}, expected {expected:?}")]
     Shape {
+        /// The tensor's name.
         name: String,
+        /// The shape the architecture gives.
         expected: Vec<usize>,
+        /// The shape stored.
         got: Vec<usize>,
     },
 }

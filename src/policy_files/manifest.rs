@@ -63,10 +63,13 @@ pub enum NetRole {
 /// of the build that trained it). Written at the top level of `policy.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
+    /// The experiment's name.
     pub experiment: String,
     /// The method's name as in configs (`our1`, `cen-ddrqn`, ...).
     pub method: String,
+    /// The sweep point (`key=value,...`), empty without a sweep.
     pub variant: String,
+    /// The run's seed.
     pub seed: u64,
     /// Training episodes completed when the nets were written.
     pub episodes_trained: u64,
@@ -113,7 +116,9 @@ impl AgentLayout {
 /// its shape (input and output lengths, architecture). Nothing here is specific to Q-nets.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NetEntry {
+    /// What the net computes (Q-values or action log-probabilities).
     pub kind: NetKind,
+    /// Decentralized (one agent's) or centralized.
     pub role: NetRole,
     /// The agent of a decentralized net; absent for a centralized one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -165,13 +170,21 @@ pub struct Manifest {
 /// One net to write: its entry (without the checksum, computed here) and its safetensors bytes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NetFile {
+    /// As [`NetEntry::kind`].
     pub kind: NetKind,
+    /// As [`NetEntry::role`].
     pub role: NetRole,
+    /// As [`NetEntry::agent`].
     pub agent: Option<usize>,
+    /// File name inside the policy directory.
     pub file: String,
+    /// Input length.
     pub input: usize,
+    /// Output length (one per (joint) macro-action).
     pub output: usize,
+    /// Layer widths, as [`NetEntry`] records them.
     pub architecture: Architecture,
+    /// The safetensors bytes to write.
     pub bytes: Vec<u8>,
 }
 
@@ -213,7 +226,9 @@ impl NetFile {
 /// build the net from these bytes (not from a second read of the file).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VerifiedAgent {
+    /// The agent.
     pub index: usize,
+    /// The safetensors bytes, as read and checked.
     pub weights: Vec<u8>,
 }
 

@@ -40,6 +40,7 @@ pub struct CustomEnv {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("the policy's domain `{name}` is not in this binary (it has {}): `macdec robot` serves its agents, but running its episodes needs its simulator: use a binary that registers the domain (`macdec::cli::main_with`, see examples/custom_domain.rs), or drive the robots from your own program (macdec::deploy::run_episodes with your MacroEnv and JsonLink::connect)", crate::envs::registry::names_and_tags())]
 pub struct NotInBinary {
+    /// The domain's name, as the policy records it.
     pub name: String,
 }
 
@@ -88,8 +89,10 @@ impl PolicyEnv {
 /// Why [`PolicyEnv::build`] failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BuildError {
+    /// The domain is not registered in this binary.
     #[error(transparent)]
     NotInBinary(#[from] NotInBinary),
+    /// The domain refused the policy's config.
     #[error(transparent)]
     Env(#[from] EnvError),
 }

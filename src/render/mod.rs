@@ -51,38 +51,64 @@ pub struct Frame {
 /// Why recording or writing a rollout failed. File errors name the path.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    /// The domain implements no `draw`.
     #[error("the domain `{domain}` draws no picture (its MacroEnv has no `draw`), so it cannot be rendered; `macdec replay --verbose` prints its text form")]
-    NoPicture { domain: String },
+    NoPicture {
+        /// The domain's name.
+        domain: String,
+    },
+    /// The environment refused a step of the recorded episode.
     #[error("step {t} of the recorded episode was refused: {source}")]
     Env {
+        /// Primitive step at which it refused.
         t: usize,
+        /// The environment's error.
         #[source]
         source: EnvError,
     },
+    /// Nothing was recorded, so there is no GIF to write.
     #[error("{}: no frames to write", .path.display())]
-    NoFrames { path: PathBuf },
+    NoFrames {
+        /// The GIF that would have been written.
+        path: PathBuf,
+    },
+    /// Frames of different sizes (a GIF has one size).
     #[error("{}: frame {index} is {}x{} pixels but frame 0 is {}x{}; one GIF holds one size (record one domain per file)", .path.display(), .got.0, .got.1, .expected.0, .expected.1)]
     SizeMismatch {
+        /// The GIF.
         path: PathBuf,
+        /// The first frame whose size differs.
         index: usize,
+        /// Its (width, height) in pixels.
         got: (usize, usize),
+        /// Frame 0's (width, height) in pixels.
         expected: (usize, usize),
     },
+    /// Frames wider or taller than a GIF's 65535 pixels.
     #[error("{}: frames of {width}x{height} pixels exceed the GIF limit of 65535", .path.display())]
     TooLarge {
+        /// The GIF.
         path: PathBuf,
+        /// Frame width in pixels.
         width: usize,
+        /// Frame height in pixels.
         height: usize,
     },
+    /// The GIF encoder failed.
     #[error("{}: GIF encoding failed: {source}", .path.display())]
     Encode {
+        /// The GIF.
         path: PathBuf,
+        /// The encoder's error.
         #[source]
         source: gif::EncodingError,
     },
+    /// Writing the GIF failed.
     #[error("{}: writing the GIF failed: {source}", .path.display())]
     Io {
+        /// The GIF.
         path: PathBuf,
+        /// The I/O error.
         #[source]
         source: std::io::Error,
     },

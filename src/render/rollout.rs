@@ -14,16 +14,22 @@ use std::path::Path;
 /// Why a rollout could not be rendered.
 #[derive(Debug, thiserror::Error)]
 pub enum RolloutError {
+    /// The run's policy files could not be read.
     #[error(transparent)]
     Policy(#[from] PolicyError),
+    /// Recording or writing the GIF failed.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// The run's domain is not in this binary: the run directory and why.
     #[error("{0}: {1}")]
     NotInBinary(String, crate::policy_files::NotInBinary),
+    /// The run's environment cannot be built: the run directory and the error.
     #[error("{0}: cannot build the run's environment: {1}")]
     Env(String, crate::envs::EnvError),
+    /// The nets do not fit the domain: the run directory and why.
     #[error("{0}: the policy files' nets do not fit the domain: {1}")]
     NetSize(String, String),
+    /// The run has no net of the kind asked for: the run directory, the kind, the method.
     #[error("{0}: the run has no {1} Q-net (method {2}); leave out --net to show the nets its evaluations used")]
     NoNet(String, &'static str, String),
 }

@@ -15,6 +15,7 @@ pub struct AcConfig {
     pub gamma: f64,
     /// Adam learning rates of the actors and the critics.
     pub a_lr: f64,
+    /// The critics' Adam learning rate (MacroMARL's default 1e-3).
     pub c_lr: f64,
     /// Environments stepped in lockstep while collecting (P1).
     pub n_env: usize,
@@ -28,15 +29,20 @@ pub struct AcConfig {
     /// The exploration mixture's weight moves linearly from eps_start to eps_end over
     /// eps_stable_at episodes (`Linear_Decay`).
     pub eps_start: f64,
+    /// The exploration weight from `eps_stable_at` episodes on.
     pub eps_end: f64,
+    /// Episodes over which the weight decays from `eps_start` to `eps_end`.
     pub eps_stable_at: usize,
     /// Actor: MLP widths [before, after] the GRU, and the GRU's width.
     pub a_mlp_layer_size: Vec<usize>,
+    /// The actor's GRU width.
     pub a_rnn_layer_size: usize,
     /// History critic: MLP widths [before, after] the GRU, and the GRU's width; the state
     /// critic's MLP uses c_mlp_layer_size and c_mid_layer_size.
     pub c_mlp_layer_size: Vec<usize>,
+    /// The history critic's GRU width.
     pub c_rnn_layer_size: usize,
+    /// The state critic's middle MLP width.
     pub c_mid_layer_size: usize,
     /// Evaluate every `eval_freq - eval_freq % train_freq` episodes, from episode 0 (P8).
     pub eval_freq: usize,

@@ -14,9 +14,13 @@ use crate::envs::{FirstRecordObs, MacroEnv, StepOutcome};
 /// have one more row (row t is the observation before step t, row t + 1 the one after it).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Episode {
+    /// Agents in the domain.
     pub n_agents: usize,
+    /// Length of one `obs` row (every agent's observation).
     pub joint_obs_size: usize,
+    /// Length of one `state` row (0 for a domain without a global state).
     pub state_size: usize,
+    /// Primitive steps recorded.
     pub steps: usize,
     /// Every agent's observation concatenated (agent 0 first), `steps + 1` rows.
     pub obs: Vec<f32>,

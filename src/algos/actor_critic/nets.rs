@@ -11,7 +11,9 @@ use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig, Params, StateCritic}
 /// A critic's net: on observation histories (the actor's layers, one output) or on the state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum CriticNet {
+    /// On an agent's (or the joint) observation history: the actor's layers with one output.
     History(GruActor),
+    /// On the global state (Naive Mac-IASC's and Mac-IAISC's critics).
     State(StateCritic),
 }
 
@@ -45,15 +47,20 @@ impl CriticNet {
 /// An actor and its optimizer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Actor {
+    /// The actor's parameters.
     pub net: GruActor,
+    /// Its optimizer state (learning rate `a_lr`).
     pub adam: Adam,
 }
 
 /// A critic, its target (hard-copied every `c_target_update_freq` episodes) and its optimizer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Critic {
+    /// The critic being trained.
     pub net: CriticNet,
+    /// The target that computes bootstrap values, hard-copied from `net`.
     pub target: CriticNet,
+    /// The optimizer state of `net` (learning rate `c_lr`).
     pub adam: Adam,
 }
 
@@ -72,8 +79,11 @@ pub const MAX_JOINT_ACTIONS: usize = 1 << 16;
 /// The sizes a method's nets are built for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NetSizes {
+    /// Each agent's observation length.
     pub obs_sizes: Vec<usize>,
+    /// Each agent's number of macro-actions.
     pub n_actions: Vec<usize>,
+    /// Length of the global state (0 for a domain without one).
     pub state_size: usize,
 }
 
@@ -92,16 +102,30 @@ impl NetSizes {
 /// Why a method's nets cannot be built for a domain.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum NetsError {
+    /// A state critic was asked of a domain without a global state.
     #[error("{method}'s critic needs the global state, and this domain has none (get_state()); use the history-critic variant")]
-    NoState { method: &'static str },
+    NoState {
+        /// The method's name.
+        method: &'static str,
+    },
+    /// The state critic's two MLP widths differ, which the reference cannot run.
     #[error("{method}'s state critic feeds fc2's {m0} outputs into fc3, which takes c_mlp_layer_size[1] = {m1}: the widths must be equal (the reference cannot run otherwise)")]
     StateCriticWidths {
+        /// The method's name.
         method: &'static str,
+        /// `c_mlp_layer_size[0]`, fc2's outputs.
         m0: usize,
+        /// `c_mlp_layer_size[1]`, fc3's inputs.
         m1: usize,
     },
+    /// Mac-CAC's joint actor would be too wide.
     #[error("Mac-CAC's joint actor would have {count} outputs (the product of the agents' macro-actions), beyond {max}")]
-    TooManyJointActions { count: u128, max: usize },
+    TooManyJointActions {
+        /// Joint macro-actions (product of the agents' counts).
+        count: u128,
+        /// [`MAX_JOINT_ACTIONS`].
+        max: usize,
+    },
 }
 
 impl AcNets {

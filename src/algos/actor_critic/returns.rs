@@ -9,7 +9,9 @@
 /// One squeezed sequence's inputs to the return.
 #[derive(Debug, Clone, Copy)]
 pub struct MacroSequence<'a> {
+    /// r_k: macro-action k's discounted macro-reward.
     pub reward: &'a [f32],
+    /// The environment's terminal flag at the end of macro-action k.
     pub terminate: &'a [bool],
     /// gamma^(t_k) as the reference's f32 `discount_b` holds it.
     pub discount: &'a [f32],

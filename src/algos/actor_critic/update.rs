@@ -17,14 +17,21 @@ use crate::nn::{GruActor, StateCritic};
 /// What an update needs besides the nets and the batch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UpdateParams {
+    /// The method: which critics and which advantage each actor takes.
     pub design: AcDesign,
+    /// Discount per primitive step.
     pub gamma: f64,
+    /// Macro-steps of the n-step return (0 and 1: one step).
     pub n_step: usize,
     /// The exploration weight the batch was collected with (the eps-mixture's, P3).
     pub eps: f64,
+    /// Quirk P2 switch, as [`super::config::AcConfig::pg_discount_at_start`].
     pub pg_discount_at_start: bool,
+    /// Quirk P3 switch, as [`super::config::AcConfig::pg_plain_log_prob`].
     pub pg_plain_log_prob: bool,
+    /// Each agent's observation length.
     pub obs_sizes: Vec<usize>,
+    /// Each agent's number of macro-actions.
     pub n_actions: Vec<usize>,
 }
 
@@ -35,25 +42,35 @@ pub struct CriticTrace {
     pub lengths: Vec<usize>,
     /// The bootstrap values B from the target critic, then the returns G, per macro-action.
     pub bootstraps: Vec<f32>,
+    /// The returns G, one per macro-action.
     pub returns: Vec<f32>,
     /// The values before the step, its loss, its gradients, and the advantages G - V after it.
     pub values: Vec<f32>,
+    /// The critic's loss before the step.
     pub loss: f32,
+    /// The critic's gradients of that loss.
     pub grads: CriticNet,
+    /// G - V under the updated critic, one per macro-action.
     pub advantages: Vec<f32>,
 }
 
 /// What one actor's step computed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActorTrace {
+    /// The squeezed sequences' lengths, in batch order.
     pub lengths: Vec<usize>,
     /// Per macro-action: the action taken, gamma^t (the policy gradient's weight, P2), the
     /// advantage and the log-probability of the action under the trained mixture (P3).
     pub actions: Vec<usize>,
+    /// gamma^t, the policy gradient's weight (P2), one per macro-action.
     pub discounts: Vec<f32>,
+    /// The advantage each macro-action is trained with.
     pub advantages: Vec<f32>,
+    /// Log-probability of the action under the trained mixture (P3).
     pub log_probs: Vec<f32>,
+    /// The actor's loss.
     pub loss: f32,
+    /// The actor's gradients of that loss.
     pub grads: GruActor,
 }
 
@@ -61,7 +78,9 @@ pub struct ActorTrace {
 /// ended in the whole batch).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct UpdateTrace {
+    /// One entry per critic, in [`AcNets::critics`] order.
     pub critics: Vec<Option<CriticTrace>>,
+    /// One entry per actor, in [`AcNets::actors`] order.
     pub actors: Vec<Option<ActorTrace>>,
 }
 

@@ -11,7 +11,9 @@ use rand_chacha::ChaCha8Rng;
 /// Epsilon-greedy parameters of one selection; `None` in [`select_dec`] / [`select_cen`] means
 /// greedy (evaluation, deployment).
 pub struct Explore<'a> {
+    /// The exploration stream.
     pub rng: &'a mut ChaCha8Rng,
+    /// Probability of a uniformly random macro-action, in [0, 1].
     pub epsilon: f64,
     /// Keep the advanced hidden state (`h_explore`); without it every query starts from the
     /// episode-start zero state (`docs/ALGORITHMS.md` §4.4, quirk Q1).
@@ -30,6 +32,7 @@ pub struct ActScratch {
 }
 
 impl ActScratch {
+    /// Scratch sized for `env`'s agents and joint observation.
     pub fn new<E: MacroEnv + ?Sized>(env: &E) -> Self {
         ActScratch {
             joint_obs: vec![0.0; env.joint_obs_size()],

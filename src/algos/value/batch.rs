@@ -11,9 +11,13 @@ use super::record::Episode;
 /// records after them up to [`Batch::padded_len`].
 #[derive(Debug, Clone, Copy)]
 pub struct Sequence<'a> {
+    /// The episode the records come from.
     pub episode: &'a Episode,
+    /// First real record's index in the episode.
     pub start: usize,
+    /// One past the last real record's index.
     pub end: usize,
+    /// Zero records before the real ones in the padded form.
     pub lead_pad: usize,
 }
 
@@ -35,6 +39,7 @@ impl Sequence<'_> {
 /// B sampled sequences (with replacement, in draw order) borrowing the buffer's storage.
 #[derive(Debug, Clone)]
 pub struct Batch<'a> {
+    /// The B sequences, in draw order.
     pub sequences: Vec<Sequence<'a>>,
     /// T of the reference's padded `B x T` batch: trace_len (windows) or the longest sampled
     /// episode (episodes, `docs/ALGORITHMS.md` §3.2).

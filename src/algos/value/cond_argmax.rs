@@ -12,26 +12,43 @@ use ndarray::{ArrayView1, ArrayView2};
 /// Why a conditional argmax was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CondArgmaxError {
+    /// Q's columns are not the joint action count.
     #[error("Q has {got} columns, expected the {expected} joint actions")]
-    WrongWidth { expected: usize, got: usize },
+    WrongWidth {
+        /// Joint actions (product of the agents' counts).
+        expected: usize,
+        /// Columns of Q.
+        got: usize,
+    },
+    /// The conditioning has the wrong number of entries.
     #[error(
         "conditioning has {got} entries, expected {expected} ({rows} rows x {n_agents} agents)"
     )]
     WrongCondLength {
+        /// rows x agents.
         expected: usize,
+        /// Entries given.
         got: usize,
+        /// Rows of Q.
         rows: usize,
+        /// Agents.
         n_agents: usize,
     },
+    /// A conditioning entry that is neither -1 (free) nor an action of its agent.
     #[error(
         "row {row}, agent {agent}: conditioning value {value} is neither -1 nor in 0..{n_actions}"
     )]
     BadCondition {
+        /// Row of Q.
         row: usize,
+        /// The agent.
         agent: usize,
+        /// The entry.
         value: i32,
+        /// Macro-actions the agent has.
         n_actions: usize,
     },
+    /// No agents, so no joint action.
     #[error("no agents")]
     NoAgents,
 }

@@ -9,7 +9,9 @@ use crate::nn::{LstmState, QNet};
 /// centralized one with the conditional argmax (Cen-DDRQN).
 #[derive(Clone, Copy)]
 pub enum GreedyPolicy<'a> {
+    /// Each agent's decentralized net, in agent order.
     Dec(&'a [&'a QNet]),
+    /// The centralized net, acting through the conditional argmax.
     Cen(&'a QNet),
 }
 
@@ -42,7 +44,9 @@ pub fn greedy_episode<E: MacroEnv + ?Sized>(
 
 /// A greedy policy with its hidden state(s), stepped one primitive step at a time.
 pub enum GreedyActor<'a> {
+    /// Each agent's net and its hidden state.
     Dec(&'a [&'a QNet], Vec<LstmState>),
+    /// The centralized net and its hidden state.
     Cen(&'a QNet, LstmState),
 }
 

@@ -28,35 +28,62 @@ pub mod window_buffer;
 /// offending quantity and what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ReplayError {
+    /// A vector of the wrong length.
     #[error("{what}: expected length {expected}, got {got}")]
     WrongLength {
+        /// Which vector (e.g. `obs`).
         what: &'static str,
+        /// The length the layout needs.
         expected: usize,
+        /// The length given.
         got: usize,
     },
+    /// An episode with no record was pushed.
     #[error("an episode must hold at least one record")]
     EmptyEpisode,
+    /// A sample was asked of an empty buffer.
     #[error("cannot sample from an empty replay buffer")]
     EmptyBuffer,
+    /// A count that must be positive was 0.
     #[error("`{name}` must be > 0")]
-    Zero { name: &'static str },
+    Zero {
+        /// Its name.
+        name: &'static str,
+    },
+    /// An agent index beyond the layout.
     #[error("agent {agent} is out of range 0..{n_agents}")]
-    AgentOutOfRange { agent: usize, n_agents: usize },
+    AgentOutOfRange {
+        /// The index given.
+        agent: usize,
+        /// Agents in the layout.
+        n_agents: usize,
+    },
+    /// An executed macro-action beyond the agent's action count.
     #[error("agent {agent}: executed macro-action {action} is out of range 0..{n_actions}")]
     ActionOutOfRange {
+        /// The agent.
         agent: usize,
+        /// The macro-action recorded.
         action: usize,
+        /// Macro-actions the agent has.
         n_actions: usize,
     },
+    /// An episode recorded with another domain's layout.
     #[error("episode shape ({n_agents} agents, joint observation {joint_obs}) does not match the layout ({expected_agents} agents, joint observation {expected_obs})")]
     LayoutMismatch {
+        /// The episode's agents.
         n_agents: usize,
+        /// The episode's joint observation length.
         joint_obs: usize,
+        /// The buffer's agents.
         expected_agents: usize,
+        /// The buffer's joint observation length.
         expected_obs: usize,
     },
+    /// A step was recorded before `begin`.
     #[error("step recorded before the episode started (call `begin` after every env reset)")]
     EpisodeNotStarted,
+    /// A restored buffer state that disagrees with itself; the text says what.
     #[error("inconsistent replay state: {0}")]
     Corrupt(String),
 }

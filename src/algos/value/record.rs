@@ -107,12 +107,19 @@ impl Layout {
 /// step, `done` = episode over, `valid[i]` = v_i (agent i's macro-action finished in this step).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RecordRef<'a> {
+    /// The joint macro-observation held before the step.
     pub obs: &'a [f32],
+    /// `executed[i]`: the macro-action agent i ran in this step.
     pub executed: &'a [usize],
+    /// `acc_id[i]`: agent i's undiscounted macro-reward so far.
     pub acc_id: &'a [f32],
+    /// The joint macro-reward so far (undiscounted).
     pub acc_joint: f32,
+    /// The joint observation after the step.
     pub next_obs: &'a [f32],
+    /// Episode over.
     pub done: bool,
+    /// `valid[i]`: v_i, agent i's macro-action finished in this step.
     pub valid: &'a [bool],
 }
 

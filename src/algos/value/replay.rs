@@ -20,7 +20,9 @@ pub use super::batch::{Batch, Sequence};
 /// (`docs/ALGORITHMS.md` §3.2, `sample_epi`, Warehouse).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub enum ReplayBuffer {
+    /// Fixed-length windows (`docs/ALGORITHMS.md` §3.1).
     Windows(WindowBuffer),
+    /// Whole episodes (`docs/ALGORITHMS.md` §3.2).
     Episodes(EpisodeBuffer),
 }
 

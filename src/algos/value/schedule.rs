@@ -7,10 +7,22 @@ use serde::{Deserialize, Serialize};
 /// Why a schedule's parameters were refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ScheduleError {
+    /// A duration (in episodes) that must be positive and finite.
     #[error("`{name}` must be > 0, got {value}")]
-    NotPositive { name: &'static str, value: f64 },
+    NotPositive {
+        /// The parameter.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A probability outside [0, 1].
     #[error("`{name}` must be in [0, 1], got {value}")]
-    OutOfUnitRange { name: &'static str, value: f64 },
+    OutOfUnitRange {
+        /// The parameter.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
 }
 
 /// Linear epsilon decay (`--eps_l_d`, `docs/ALGORITHMS.md` §4.1): from 1.0 to `eps_end` over `eps_l_d_steps`

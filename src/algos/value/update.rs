@@ -21,8 +21,11 @@ use serde::{Deserialize, Serialize};
 /// A policy net, its target copy and its optimizer.
 #[derive(Debug, Serialize, Deserialize)]
 pub struct Nets {
+    /// The net trained.
     pub policy: QNet,
+    /// Its target copy, which computes the TD targets.
     pub target: QNet,
+    /// The optimizer state of `policy`.
     pub adam: Adam,
     /// Reusable tape and gradient buffers (rebuilt after a resume).
     #[serde(skip)]
@@ -78,7 +81,9 @@ impl Nets {
 /// The knobs of one iteration that change during training or differ by config.
 #[derive(Debug, Clone, Copy)]
 pub struct IterationParams {
+    /// The method, which decides targets and losses.
     pub method: Method,
+    /// Discount per macro-transition in the targets (quirk Q5).
     pub discount: f32,
     /// Current hysteresis h (`docs/ALGORITHMS.md` §5.6), applied where the method says.
     pub h: f32,
@@ -368,8 +373,10 @@ fn step_nets(
 /// Why a training iteration failed.
 #[derive(Debug, thiserror::Error)]
 pub enum UpdateError {
+    /// The replay buffer refused the sample.
     #[error(transparent)]
     Replay(#[from] ReplayError),
+    /// The conditional argmax refused its inputs.
     #[error(transparent)]
     CondArgmax(#[from] CondArgmaxError),
 }

@@ -21,6 +21,7 @@ impl Activation {
     /// The Q-net's hidden activation: PyTorch's `F.leaky_relu` default slope (`docs/ALGORITHMS.md` §2.1).
     pub const LEAKY_001: Activation = Activation::LeakyRelu(0.01);
 
+    /// The activation of one pre-activation value `z`.
     #[inline(always)]
     pub fn apply(self, z: f32) -> f32 {
         match self {

@@ -32,9 +32,13 @@ use crate::autograd::SeqPacking;
 /// r, z, n as in PyTorch's `weight_ih_l0`.
 #[derive(Debug, Clone, Copy)]
 pub struct GruWeights<'a> {
+    /// Input weights [3H, in].
     pub w_ih: ArrayView2<'a, f32>,
+    /// Recurrent weights [3H, H].
     pub w_hh: ArrayView2<'a, f32>,
+    /// Input bias \[3H\].
     pub b_ih: &'a [f32],
+    /// Recurrent bias \[3H\].
     pub b_hh: &'a [f32],
 }
 

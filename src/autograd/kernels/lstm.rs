@@ -25,9 +25,13 @@ use crate::autograd::SeqPacking;
 /// The four LSTM parameter tensors. w_ih: [4H, in], w_hh: [4H, H], biases: \[4H\].
 #[derive(Debug, Clone, Copy)]
 pub struct LstmWeights<'a> {
+    /// Input weights [4H, in].
     pub w_ih: ArrayView2<'a, f32>,
+    /// Recurrent weights [4H, H].
     pub w_hh: ArrayView2<'a, f32>,
+    /// Input bias \[4H\].
     pub b_ih: &'a [f32],
+    /// Recurrent bias \[4H\].
     pub b_hh: &'a [f32],
 }
 

@@ -15,9 +15,13 @@ use crate::autograd::SeqPacking;
 /// (PyTorch names and gate order r, z, n).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GruVars {
+    /// Input weights [3H, in].
     pub w_ih: Var,
+    /// Recurrent weights [3H, H].
     pub w_hh: Var,
+    /// Input bias [1, 3H].
     pub b_ih: Var,
+    /// Recurrent bias [1, 3H].
     pub b_hh: Var,
 }
 

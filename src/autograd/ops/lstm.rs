@@ -17,9 +17,13 @@ use crate::autograd::SeqPacking;
 /// (PyTorch names and gate order i, f, g, o).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LstmVars {
+    /// Input weights [4H, in].
     pub w_ih: Var,
+    /// Recurrent weights [4H, H].
     pub w_hh: Var,
+    /// Input bias [1, 4H].
     pub b_ih: Var,
+    /// Recurrent bias [1, 4H].
     pub b_hh: Var,
 }
 

@@ -44,20 +44,38 @@ pub struct EpisodeTrace {
 /// Why a deployment stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum DeployError {
+    /// Not one robot per agent.
     #[error("the domain has {expected} agents but {got} robots were given")]
-    RobotCount { expected: usize, got: usize },
+    RobotCount {
+        /// Agents in the domain.
+        expected: usize,
+        /// Robots given.
+        got: usize,
+    },
+    /// Talking to a robot failed.
     #[error("robot of agent {agent}: {source}")]
     Link {
+        /// The robot's agent.
         agent: usize,
+        /// What failed.
         #[source]
         source: LinkError,
     },
+    /// The simulated environment refused a step.
     #[error("environment: {0}")]
     Env(#[from] EnvError),
+    /// A robot process could not be started.
     #[error("starting the robot of agent {agent}: {reason}")]
-    Spawn { agent: usize, reason: String },
+    Spawn {
+        /// The robot's agent.
+        agent: usize,
+        /// Why.
+        reason: String,
+    },
+    /// The policy could not be loaded or does not fit; the text says why.
     #[error("policy: {0}")]
     Policy(String),
+    /// An episode's result could not be written.
     #[error("writing an episode's result: {0}")]
     Output(#[from] std::io::Error),
 }

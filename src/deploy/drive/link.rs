@@ -40,22 +40,51 @@ impl<L: RobotLink + ?Sized> RobotLink for Box<L> {
 /// Why talking to a robot failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LinkError {
+    /// Connecting, reading or writing failed; the text names the address or error.
     #[error("connection to the robot failed: {0}")]
     Io(String),
+    /// The robot closed the connection before replying.
     #[error("the robot closed the connection")]
     Closed,
+    /// A reply line longer than `MAX_REPLY_BYTES`.
     #[error("the robot sent a reply longer than {MAX_REPLY_BYTES} bytes")]
     ReplyTooLong,
+    /// A reply that is not a known reply line.
     #[error("the robot sent an unreadable reply ({reason}): {line}")]
-    BadReply { line: String, reason: String },
+    BadReply {
+        /// The line received.
+        line: String,
+        /// The parser's reason.
+        reason: String,
+    },
+    /// The robot answered `{"error": ...}`; holds its text.
     #[error("the robot refused the request: {0}")]
     Refused(String),
+    /// A valid reply of the wrong kind for the request.
     #[error("expected {expected} from the robot, got: {got}")]
-    Unexpected { expected: &'static str, got: String },
+    Unexpected {
+        /// The reply kind expected.
+        expected: &'static str,
+        /// The line received.
+        got: String,
+    },
+    /// The robot chose a macro-action the domain does not have.
     #[error("the robot chose macro-action {action}, out of range 0..{n_actions}")]
-    ActionOutOfRange { action: usize, n_actions: usize },
+    ActionOutOfRange {
+        /// The index it sent.
+        action: usize,
+        /// Macro-actions the agent has.
+        n_actions: usize,
+    },
+    /// The robot serves another agent than the one this link drives.
     #[error("the robot serves agent {got}, expected agent {expected}")]
-    WrongAgent { expected: usize, got: usize },
+    WrongAgent {
+        /// The agent this link drives.
+        expected: usize,
+        /// The agent the robot serves.
+        got: usize,
+    },
+    /// The robot's manifest differs from the driver's.
     #[error("the robot runs a different policy (its manifest differs from ours)")]
     WrongPolicy,
 }

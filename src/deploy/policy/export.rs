@@ -17,16 +17,33 @@ use std::path::{Path, PathBuf};
 /// Why a run could not be exported.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
+    /// Reading the run's policy or writing the export failed.
     #[error(transparent)]
     Policy(#[from] PolicyError),
+    /// The run's method has only centralized nets (e.g. Cen-DDRQN), which no single robot can run.
     #[error("{dir}: the run trained {method}, which has no decentralized nets to put on robots (export a dec-hddrqn, our1, our1-r, our2 run or a decentralized actor-critic run)")]
-    NotDecentralized { dir: PathBuf, method: String },
+    NotDecentralized {
+        /// The run directory.
+        dir: PathBuf,
+        /// The method's name.
+        method: String,
+    },
+    /// A file could not be read or written.
     #[error("{path}: {message}")]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error, as text.
+        message: String,
+    },
+    /// The run has a different number of decentralized nets than the domain has agents.
     #[error("{dir}: {got} decentralized net(s) for a domain of {expected} agent(s)")]
     NetCount {
+        /// The run directory.
         dir: PathBuf,
+        /// Agents in the domain.
         expected: usize,
+        /// Decentralized nets found.
         got: usize,
     },
 }

@@ -34,83 +34,150 @@ const LSTM_PREFIX: &str = "lstm.";
 /// at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum ImportError {
+    /// A file could not be read.
     #[error("{path}: {message}")]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error, as text.
+        message: String,
+    },
+    /// The path is a directory, FIFO or device, refused before reading.
     #[error("{path}: not a regular file")]
-    NotAFile { path: PathBuf },
+    NotAFile {
+        /// The path given.
+        path: PathBuf,
+    },
+    /// The file exceeds [`MAX_STATE_DICT_BYTES`], refused unread.
     #[error("{path}: {size} bytes, more than any DDRQN state_dict ({MAX_STATE_DICT_BYTES} bytes at most); not read")]
-    TooLarge { path: PathBuf, size: u64 },
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its size in bytes.
+        size: u64,
+    },
+    /// The bytes are not a safetensors file.
     #[error("{path}: not a safetensors file ({reason}); convert a torch.save'd module with scripts/torch_to_safetensors.py")]
-    Unreadable { path: PathBuf, reason: String },
+    Unreadable {
+        /// The file.
+        path: PathBuf,
+        /// The safetensors parser's reason.
+        reason: String,
+    },
+    /// Both the `lstm.*` and the `rnn.*` naming appear in one file.
     #[error(
         "{path}: holds both `lstm.*` and `rnn.*` tensors (`{lstm}`, `{rnn}`); a DDRQN has one LSTM"
     )]
     MixedNaming {
+        /// The file.
         path: PathBuf,
+        /// One `lstm.*` tensor found.
         lstm: String,
+        /// One `rnn.*` tensor found.
         rnn: String,
     },
+    /// A tensor the architecture needs is absent.
     #[error("{path}: tensor `{name}` is missing (expected shape {expected})")]
     Missing {
+        /// The file.
         path: PathBuf,
+        /// Canonical tensor name, e.g. `fc1.weight`.
         name: String,
         /// The shape, e.g. `[32, 5]`, or `[M, 5]` while M is not known yet.
         expected: String,
     },
+    /// A tensor that is not part of a DDRQN.
     #[error("{path}: unexpected tensor `{name}`; a DDRQN state_dict has exactly {expected}")]
     Unexpected {
+        /// The file.
         path: PathBuf,
+        /// The tensor's name as stored.
         name: String,
+        /// The tensor names a DDRQN state_dict holds.
         expected: String,
     },
+    /// A tensor is not F32.
     #[error("{path}: tensor `{name}` has dtype {found}, expected F32")]
     Dtype {
+        /// The file.
         path: PathBuf,
+        /// Canonical tensor name.
         name: String,
+        /// The dtype stored.
         found: String,
     },
+    /// A tensor's shape does not fit the domain or the architecture.
     #[error("{path}: tensor `{name}` has shape {found:?}, expected {expected}{hint}")]
     Shape {
+        /// The file.
         path: PathBuf,
+        /// Canonical tensor name.
         name: String,
+        /// The shape stored.
         found: Vec<usize>,
         /// As in [`ImportError::Missing`].
         expected: String,
+        /// Extra advice appended to the message (may be empty).
         hint: String,
     },
+    /// A weight is NaN or infinite.
     #[error("{path}: tensor `{name}` holds {value} at element {index}; weights must be finite")]
     NonFinite {
+        /// The file.
         path: PathBuf,
+        /// Canonical tensor name.
         name: String,
+        /// Flat (row-major) element index.
         index: usize,
+        /// The value found.
         value: f32,
     },
+    /// Two agents' Q-nets have different M or H.
     #[error("{path}: M = {m}, H = {h}, but {first} has M = {first_m}, H = {first_h}; all agents of a policy share one architecture")]
     ArchitectureMismatch {
+        /// The file that disagrees.
         path: PathBuf,
+        /// Its M (fc1 and fc3 width).
         m: usize,
+        /// Its H (fc2 and LSTM width).
         h: usize,
+        /// The first agent's file, whose widths the others must match.
         first: PathBuf,
+        /// M of the first file.
         first_m: usize,
+        /// H of the first file.
         first_h: usize,
     },
+    /// Two agents' actors have different widths.
     #[error("{path}: widths {mlp:?} and hidden size {hidden}, but {first} has {first_mlp:?} and {first_hidden}; all agents of a policy share one architecture")]
     ActorMismatch {
+        /// The file that disagrees.
         path: PathBuf,
+        /// Its two MLP widths.
         mlp: [usize; 2],
+        /// Its recurrent hidden size.
         hidden: usize,
+        /// The first agent's file, whose widths the others must match.
         first: PathBuf,
+        /// MLP widths of the first file.
         first_mlp: [usize; 2],
+        /// Hidden size of the first file.
         first_hidden: usize,
     },
+    /// The number of files is not the domain's number of agents.
     #[error("the {env} domain has {expected} agents, {got} state_dict files were given (one per agent, in agent order)")]
     AgentCount {
+        /// The domain's name.
         env: &'static str,
+        /// Agents the domain has.
         expected: usize,
+        /// Files given.
         got: usize,
     },
+    /// The domain could not be built from its config (the message says why).
     #[error("environment: {0}")]
     Env(String),
+    /// Writing or checking the policy directory failed.
     #[error(transparent)]
     Policy(#[from] PolicyError),
 }
@@ -134,13 +201,16 @@ pub struct CheckedStateDict {
     pub mlp: usize,
     /// H: width of fc2 and the LSTM (rows of `fc2.weight`).
     pub hidden: usize,
+    /// Which LSTM naming the file used (reported; the written file is always `lstm.*`).
     pub naming: Naming,
+    /// The safetensors bytes under canonical names, as `macdec export` writes them.
     pub canonical: Vec<u8>,
 }
 
 /// What to import: the domain, the discount of the reported return, and one file per agent.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImportRequest {
+    /// The domain the policy acts in (its name and config).
     pub env: EnvSpec,
     /// Discount per primitive step of the evaluation return written into the manifest
     /// (the paper's is [`EnvSpec::paper_discount`]).

@@ -17,7 +17,10 @@ pub enum LineEvent {
     TooLong,
     /// End of input. `partial` when it ended inside an unterminated line, which is dropped (a
     /// message is complete only with its newline).
-    Eof { partial: bool },
+    Eof {
+        /// Input ended inside an unterminated line (dropped).
+        partial: bool,
+    },
 }
 
 /// Splits a byte stream into lines of at most `max_bytes` bytes.
@@ -29,6 +32,7 @@ pub struct LineReader<R> {
 }
 
 impl<R: BufRead> LineReader<R> {
+    /// Read lines from `inner`, each at most `max_bytes` bytes long.
     pub fn new(inner: R, max_bytes: usize) -> Self {
         LineReader {
             inner,

@@ -20,11 +20,16 @@ use serde::{Deserialize, Serialize};
 /// A validated request.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Request {
+    /// `{"type": "reset"}`: start a new episode.
     Reset,
+    /// `{"type": "observe", ...}`: the agent's current macro-observation.
     Observe {
+        /// The macro-observation, `obs_size` finite values.
         obs: Vec<f32>,
+        /// True when the robot must pick its next macro-action.
         macro_action_done: bool,
     },
+    /// `{"type": "info"}`: ask for the agent index and the manifest.
     Info,
 }
 
@@ -47,19 +52,30 @@ enum Wire<T> {
 pub enum Reply {
     /// A new macro-action: its index, its name and the Q-values it was chosen from.
     Decision {
+        /// Index of the chosen macro-action.
         action: usize,
+        /// Its name in the domain.
         name: String,
+        /// The agent's Q-values (or actor scores), one per macro-action.
         q: Vec<f32>,
     },
     /// Acknowledgement of a reset or of an observation without a decision.
-    Ack { ok: Ack },
+    Ack {
+        /// What was done.
+        ok: Ack,
+    },
     /// Which agent this robot runs and its policy's manifest.
     Info {
+        /// The agent index this server acts for.
         agent: usize,
+        /// The policy's manifest.
         manifest: Box<Manifest>,
     },
     /// The request was refused; the text says why.
-    Error { error: String },
+    Error {
+        /// What was wrong with the request.
+        error: String,
+    },
 }
 
 /// What an acknowledgement confirms.
@@ -75,22 +91,49 @@ pub enum Ack {
 /// Why a request line was refused. The message goes back to the client as `{"error": ...}`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProtocolError {
+    /// A line beyond the reader's limit.
     #[error("line longer than {limit} bytes; it was discarded up to its newline")]
-    LineTooLong { limit: usize },
+    LineTooLong {
+        /// The limit, in bytes.
+        limit: usize,
+    },
+    /// The line is not JSON.
     #[error("malformed JSON: {detail}{hint}")]
-    MalformedJson { detail: String, hint: &'static str },
+    MalformedJson {
+        /// The parser's reason.
+        detail: String,
+        /// Extra advice (e.g. that JSON has no NaN); may be empty.
+        hint: &'static str,
+    },
+    /// Valid JSON but not a known request; holds the parser's reason.
     #[error("bad message: {0} (expected {{\"type\": \"reset\"}}, {{\"type\": \"observe\", \"obs\": [...], \"macro_action_done\": true|false}} or {{\"type\": \"info\"}})")]
     BadMessage(String),
+    /// `obs` has the wrong number of values for this agent.
     #[error("obs has {got} values, agent {agent} expects {expected}")]
     ObsLength {
+        /// The agent.
         agent: usize,
+        /// Its `obs_size`.
         expected: usize,
+        /// Values received.
         got: usize,
     },
+    /// An observation value is NaN, infinite or beyond f32.
     #[error("obs[{index}] = {value} is not a finite 32-bit number")]
-    NonFiniteObs { index: usize, value: f64 },
+    NonFiniteObs {
+        /// Position in `obs`.
+        index: usize,
+        /// The value received.
+        value: f64,
+    },
+    /// The net produced a non-finite value; the hidden state is left unchanged.
     #[error("the policy produced a non-finite Q-value ({value} for macro-action {action}) for this observation (values too large for the net?); the hidden state is unchanged")]
-    NonFiniteQ { action: usize, value: f32 },
+    NonFiniteQ {
+        /// The macro-action whose value is non-finite.
+        action: usize,
+        /// The value.
+        value: f32,
+    },
 }
 
 const NON_FINITE_HINT: &str = " (JSON has no NaN or Infinity; observations must be finite numbers)";

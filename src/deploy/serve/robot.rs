@@ -13,9 +13,13 @@ use std::sync::Arc;
 /// precomputed `info` reply. Shared by every connection.
 #[derive(Debug)]
 pub struct RobotSpec {
+    /// The agent this robot acts for.
     pub agent: usize,
+    /// Length of its macro-observation.
     pub obs_len: usize,
+    /// Its macro-actions' names, by index.
     pub action_names: Vec<String>,
+    /// The policy's manifest, sent in the `info` reply.
     pub manifest: Manifest,
     info_line: String,
 }
@@ -23,13 +27,24 @@ pub struct RobotSpec {
 /// Why a robot could not start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RobotError {
+    /// The agent is not one of the policy's.
     #[error("agent {agent} is out of range: the policy has agents 0..{n_agents}")]
-    AgentOutOfRange { agent: usize, n_agents: usize },
+    AgentOutOfRange {
+        /// Agent asked for.
+        agent: usize,
+        /// Agents the policy has.
+        n_agents: usize,
+    },
+    /// The loaded net's sizes differ from the manifest's.
     #[error("agent {agent}: the policy has {got} {what}, the manifest says {expected}")]
     PolicyMismatch {
+        /// The agent.
         agent: usize,
+        /// `observation values` or `macro-actions`.
         what: &'static str,
+        /// What the manifest says.
         expected: usize,
+        /// What the net has.
         got: usize,
     },
 }

@@ -18,9 +18,13 @@ pub enum MacroAction {
     /// Move to waypoint `k` (0..=3), the cell below small box 0 / small box 1 / the big box's
     /// left / right half.
     MoveTo(u8),
+    /// Push forward until a stop condition (`docs/BOX_PUSHING.md` §5.2, §5.4).
     Push,
+    /// Turn left, one step (`docs/BOX_PUSHING.md` §5.3).
     TurnLeft,
+    /// Turn right, one step (`docs/BOX_PUSHING.md` §5.3).
     TurnRight,
+    /// Do nothing for one step (`docs/BOX_PUSHING.md` §5.3).
     Stay,
 }
 

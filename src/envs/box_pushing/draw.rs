@@ -22,11 +22,14 @@ pub fn cell_px(grid: usize) -> usize {
 /// Pixel geometry of one grid: cell borders are the 1-pixel lines at multiples of `cell`.
 #[derive(Debug, Clone, Copy)]
 pub struct GridPixels {
+    /// Grid side in cells.
     pub n: i32,
+    /// Side of one cell in pixels.
     pub cell: i64,
 }
 
 impl GridPixels {
+    /// The geometry of an `grid` x `grid` grid.
     pub fn new(grid: usize) -> Self {
         Self {
             n: grid as i32,

@@ -8,11 +8,14 @@
 /// the top row (`docs/BOX_PUSHING.md` Q2), and a front cell may lie outside the grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Cell {
+    /// Column, 0 at the west edge.
     pub col: i32,
+    /// Row, 0 at the bottom (south) edge.
     pub row: i32,
 }
 
 impl Cell {
+    /// The cell at column `col`, row `row`.
     pub const fn new(col: i32, row: i32) -> Self {
         Self { col, row }
     }
@@ -49,9 +52,13 @@ impl Cell {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[repr(u8)]
 pub enum Heading {
+    /// Towards higher rows.
     North = 0,
+    /// Towards higher columns.
     East = 1,
+    /// Towards lower rows.
     South = 2,
+    /// Towards lower columns.
     West = 3,
 }
 
@@ -65,6 +72,7 @@ impl Heading {
         Self::ALL[i % 4]
     }
 
+    /// The direction index, 0 to 3.
     #[inline]
     pub fn index(self) -> usize {
         self as usize

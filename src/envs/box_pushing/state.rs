@@ -6,7 +6,9 @@ use super::geometry::{Cell, Heading};
 /// One robot's physical and controller state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Robot {
+    /// The cell it stands on.
     pub cell: Cell,
+    /// Which way it faces.
     pub heading: Heading,
     /// The macro-action being executed (None only between reset and the first step).
     pub current: Option<MacroAction>,
@@ -35,7 +37,9 @@ impl Robot {
 /// the east of it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Boxes {
+    /// The two small boxes' cells.
     pub small: [Cell; 2],
+    /// The big box's left (western) cell.
     pub big_left: Cell,
 }
 

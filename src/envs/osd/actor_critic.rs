@@ -12,12 +12,18 @@ use crate::algos::actor_critic::config::published_row;
 /// Which published block a Warehouse setting is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Block {
+    /// Warehouse A (`OSD-D-v7`, any speeds but B's and the ablation's; `docs/MACROMARL.md` §3.2).
     A,
+    /// Warehouse B (`OSD-D-v7` with B's human speeds).
     B,
     /// `experiments/Warehouse/*.sh`'s "Ablation" block: A's layout, both humans at 18.
     Ablation,
+    /// Warehouse C (`OSD-T-v0`; Naive Mac-IACC and Mac-IAICC ran `OSD-T-v1`, `docs/MACROMARL.md`
+    /// §5.2).
     C,
+    /// Warehouse D (`OSD-T-v1`).
     D,
+    /// Warehouse E (`OSD-F-v0`).
     E,
 }
 

@@ -13,6 +13,7 @@ use crate::envs::EnvRng;
 /// What a Fetch macro-action index means (the index layout is `[Wait, Pass_T0.., Look_0..]`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FetchAction {
+    /// Wait_Request: wait one step.
     Wait,
     /// Pass to Turtlebot k.
     Pass(usize),

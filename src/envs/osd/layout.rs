@@ -14,6 +14,7 @@ pub const N_WORK_STEPS: usize = N_OBJS + 1;
 pub const FETCH_POS: [f64; 2] = [0.9, 2.5];
 /// Most Turtlebots and humans any layout has (sizes of the fixed arrays).
 pub const MAX_TURTLEBOTS: usize = 3;
+/// Most humans any layout has.
 pub const MAX_HUMANS: usize = 4;
 
 /// What the Turtlebots' `obs_human_wait` bits mean (only with `obs_human_wait = true`).
@@ -53,6 +54,7 @@ pub struct Layout {
     /// arrival does not end the macro-action (one extra step), and Get_Tool waits from the
     /// arrival step on. A reference quirk kept on purpose.
     pub early_return_action: usize,
+    /// What the Turtlebots' `obs_human_wait` bits mean.
     pub human_wait_obs: HumanWaitObs,
     /// The class has `get_state()` (only `osd_ma_double_room.py` v7 and `tripple` v0).
     pub has_state: bool,
@@ -60,16 +62,20 @@ pub struct Layout {
     pub terminal_at_terminate_step: bool,
     /// Names of the Turtlebots' and the Fetch's macro-actions (the reference's `MacroAction` names).
     pub tb_action_names: &'static [&'static str],
+    /// Names of the Fetch's macro-actions, by index.
     pub fetch_action_names: &'static [&'static str],
     /// Published settings: human step times (Warehouse A, C, D, E) and the runner's horizon.
     pub default_human_speeds: &'static [[i64; N_WORK_STEPS]],
+    /// The runner's published horizon in primitive steps.
     pub default_horizon: usize,
 }
 
 impl Layout {
+    /// Humans (one per work area).
     pub fn n_humans(&self) -> usize {
         self.work_areas.len()
     }
+    /// Turtlebots (one per table).
     pub fn n_turtlebots(&self) -> usize {
         self.tables.len()
     }

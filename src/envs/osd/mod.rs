@@ -133,15 +133,19 @@ impl<const V: usize> Osd<V> {
         })
     }
 
+    /// The parameters the environment was built with.
     pub fn params(&self) -> &OsdParams {
         &self.params
     }
+    /// The Turtlebots' current states.
     pub fn turtlebots(&self) -> &[Turtlebot] {
         &self.tbs
     }
+    /// The Fetch's current state.
     pub fn fetch(&self) -> &Fetch {
         &self.fetch
     }
+    /// The humans' current states.
     pub fn humans(&self) -> &[Human] {
         &self.humans
     }

@@ -33,6 +33,7 @@ pub struct Turtlebot {
 }
 
 impl Turtlebot {
+    /// A Turtlebot at `start` (metres), idle, with an empty basket.
     pub fn new(start: [f64; 2]) -> Self {
         Turtlebot {
             pos: start,

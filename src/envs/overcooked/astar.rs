@@ -15,6 +15,7 @@ use super::world::{tile_of, Cell, STAY};
 /// A search node (`AStarAgent`; the unused action history is left out).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Node {
+    /// The node's cell.
     pub at: Cell,
     /// Steps from the start.
     pub g: i32,
@@ -43,10 +44,12 @@ pub struct PyHeap {
 }
 
 impl PyHeap {
+    /// Remove every node, keeping the allocation.
     pub fn clear(&mut self) {
         self.items.clear();
     }
 
+    /// Whether no node is left.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }

@@ -15,14 +15,23 @@ pub const MAX_SIDE: usize = 9;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[repr(u8)]
 pub enum Tile {
+    /// Floor an agent may walk on.
     Space = 0,
+    /// Counter (walls and the divider); items may be put on it.
     Counter = 1,
+    /// An agent.
     Agent = 2,
+    /// The tomato.
     Tomato = 3,
+    /// The lettuce.
     Lettuce = 4,
+    /// A plate.
     Plate = 5,
+    /// A knife (cutting board).
     Knife = 6,
+    /// The delivery counter.
     Delivery = 7,
+    /// The onion.
     Onion = 8,
 }
 
@@ -49,8 +58,11 @@ pub type Cells = [[Tile; MAX_SIDE]; MAX_SIDE];
 /// The reference's map types: A open, B divided by a counter column, C the divider with a gap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum MapType {
+    /// Open kitchen.
     A,
+    /// Divided by a counter column.
     B,
+    /// Divided, with a gap in the divider.
     C,
 }
 

@@ -59,6 +59,7 @@ pub fn names(map: MapType) -> &'static [&'static str] {
 /// What a macro-action index means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Macro {
+    /// Stay in place for one step.
     Stay,
     /// Go to food `k` (tomato, lettuce, onion) and take it.
     GetFood(usize),
@@ -66,6 +67,7 @@ pub enum Macro {
     GetPlate(usize),
     /// Go next to knife `k` (and put down what is held on it).
     GoToKnife(usize),
+    /// Go to the delivery counter (and put down what is held there).
     Deliver,
     /// Chop the unchopped food on an adjacent knife, up to 3 times.
     Chop,
@@ -105,6 +107,7 @@ pub struct MacState {
 }
 
 impl MacState {
+    /// The state at reset: macro-action 0 (stay), done, no chops.
     pub const FRESH: MacState = MacState {
         current: 0,
         done: true,
@@ -114,8 +117,11 @@ impl MacState {
 
 /// What the macro layer reads: the kitchen, the map type and the view radius.
 pub struct Ctx<'a> {
+    /// The kitchen.
     pub world: &'a World,
+    /// The map type (B and C have the divider).
     pub map: MapType,
+    /// The agents' view radius in cells (0: the whole map).
     pub radius: i32,
 }
 

@@ -48,9 +48,11 @@ use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
 pub struct OvercookedParams {
     /// Grid side: 7 (the paper's) or 9 (`grid_dim`).
     pub side: usize,
+    /// The map type: A open, B divided, C divided with a gap.
     pub map: MapType,
     /// One of [`TASKS`].
     pub task: String,
+    /// The reward of each event.
     pub rewards: Rewards,
     /// 2 or 3. The reference's default is 2 and MacroMARL's scripts never pass `n_agent`, so
     /// as published they train 2 agents while the paper and the shipped policies use 3 (spec
@@ -175,6 +177,7 @@ impl Overcooked {
         Ok(env)
     }
 
+    /// The parameters the environment was built with.
     pub fn params(&self) -> &OvercookedParams {
         &self.params
     }

@@ -39,7 +39,9 @@ pub fn obs_len(n_agent: usize) -> usize {
 /// One agent's belief: its last vector observation and the map it navigates on.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Belief {
+    /// The last vector observation, as the reference's `_get_vector_obs` builds it.
     pub obs: Vec<f64>,
+    /// The map as the agent last saw it, which it navigates on.
     pub pomap: Cells,
 }
 

@@ -13,11 +13,14 @@ use super::layout::{Cells, Tile};
 /// A grid cell `(x, y)`: `x` the row of the printed map, `y` the column (the reference's order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Cell {
+    /// Row of the printed map, 0 at the top.
     pub x: i32,
+    /// Column of the printed map, 0 at the left.
     pub y: i32,
 }
 
 impl Cell {
+    /// The cell at row `x`, column `y`.
     pub const fn new(x: i32, y: i32) -> Self {
         Cell { x, y }
     }
@@ -58,9 +61,13 @@ pub enum Held {
 /// A tomato, lettuce or onion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Food {
+    /// Where it is now (on a counter, a knife, a plate or carried, the carrier's cell).
     pub at: Cell,
+    /// Its start counter, where the reference's `Food.refresh` puts it back whole.
     pub start: Cell,
+    /// Chopped [`REQUIRED_CHOPS`] times: it may go onto a plate.
     pub chopped: bool,
+    /// Chops so far, 0 to [`REQUIRED_CHOPS`].
     pub chops: u32,
 }
 
@@ -68,23 +75,31 @@ pub struct Food {
 /// flags in [`FOOD_TILES`] order say the same).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Plate {
+    /// Where it is now.
     pub at: Cell,
+    /// Its start counter, where it goes back after a delivery that is not the finished dish.
     pub start: Cell,
+    /// Which foods are on it, in [`FOOD_TILES`] order.
     pub holds: [bool; 3],
 }
 
 /// A knife's cutting board or the delivery counter: fixed, and holding at most one thing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Station {
+    /// Its cell.
     pub at: Cell,
+    /// What lies on it, if anything.
     pub holding: Option<Held>,
 }
 
 /// An agent in the kitchen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Cook {
+    /// Its cell.
     pub at: Cell,
+    /// Where it starts each episode.
     pub start: Cell,
+    /// What it carries, if anything.
     pub holding: Option<Held>,
     /// Done with the current primitive step's move (the reference's `moved`).
     pub moved: bool,
@@ -93,12 +108,19 @@ pub struct Cook {
 /// Everything that moves or is held, and the map beside it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct World {
+    /// Side of the square map in cells (at most `MAX_SIDE`).
     pub side: usize,
+    /// The tiles as the reference's `self.map` holds them, written beside the objects.
     pub map: Cells,
+    /// Tomato, lettuce, onion, in [`FOOD_TILES`] order.
     pub foods: [Food; 3],
+    /// The two plates, in map scan order.
     pub plates: [Plate; 2],
+    /// The two cutting boards, in map scan order.
     pub knives: [Station; 2],
+    /// The delivery counter.
     pub delivery: Station,
+    /// The agents, in agent order.
     pub cooks: Vec<Cook>,
 }
 

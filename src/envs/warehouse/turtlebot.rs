@@ -20,6 +20,7 @@ pub enum TbAction {
 }
 
 impl TbAction {
+    /// Every action, in code order.
     pub const ALL: [TbAction; 3] = [Self::GoWorkshop, Self::GoToolRoom, Self::GetTool];
 }
 

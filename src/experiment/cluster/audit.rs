@@ -24,24 +24,46 @@ const WALL_COLUMN: &str = "wall_seconds";
 /// Why a run could not be audited (as opposed to being audited and found different).
 #[derive(Debug, thiserror::Error)]
 pub enum AuditError {
+    /// The results tree could not be listed.
     #[error("{path}: cannot read the results tree: {source}")]
     ReadTree {
+        /// The directory.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// A directory that is not a finished run.
     #[error("{dir}: not a finished run (needs {CONFIG}, metrics.csv[.gz] and `finished`)")]
-    NotARun { dir: PathBuf },
+    NotARun {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// The run's `config.toml` does not parse.
     #[error("{path}: not a run config: {message}")]
-    BadConfig { path: PathBuf, message: String },
+    BadConfig {
+        /// The config file.
+        path: PathBuf,
+        /// The parser's reason.
+        message: String,
+    },
+    /// The committed metrics could not be read.
     #[error(transparent)]
     Metrics(#[from] MetricsError),
+    /// The metrics header does not end in the wall-clock column.
     #[error("{path}: the header's last column is not `{WALL_COLUMN}`")]
-    BadHeader { path: PathBuf },
+    BadHeader {
+        /// The metrics file.
+        path: PathBuf,
+    },
+    /// Retraining the run failed.
     #[error("retraining failed: {0}")]
     Retrain(#[from] RunError),
+    /// The scratch directory for the retrained run could not be made.
     #[error("{path}: cannot make a scratch directory: {source}")]
     Scratch {
+        /// The directory.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
 }
@@ -50,11 +72,17 @@ pub enum AuditError {
 #[derive(Debug, Clone, PartialEq)]
 pub enum AuditOutcome {
     /// Every row equal (wall-clock aside).
-    Identical { rows: usize },
+    Identical {
+        /// Data rows compared.
+        rows: usize,
+    },
     /// The first data row (1-based) whose text differs; a missing row is shown as `<none>`.
     Differs {
+        /// Row number, 1-based.
         row: usize,
+        /// The committed row's text.
         committed: String,
+        /// The retrained row's text.
         retrained: String,
     },
 }
@@ -62,9 +90,11 @@ pub enum AuditOutcome {
 /// The audit of one run: where it is, how it was made, what retraining gave.
 #[derive(Debug, Clone)]
 pub struct RunAudit {
+    /// The run's directory.
     pub dir: PathBuf,
     /// The build that trained the committed run, if it recorded one.
     pub provenance: Option<Provenance>,
+    /// What retraining gave.
     pub outcome: AuditOutcome,
 }
 

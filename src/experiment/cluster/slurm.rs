@@ -12,14 +12,25 @@ use std::path::Path;
 /// unchecked: a newline would end a `#SBATCH` directive or a comment and run the rest as a command.
 #[derive(Debug, thiserror::Error)]
 pub enum SlurmError {
+    /// A value holds a newline or control character.
     #[error("{what} {value:?} contains a newline or control character, which would break the job script")]
-    ControlChar { what: String, value: String },
+    ControlChar {
+        /// What the value is (e.g. a flag's name).
+        what: String,
+        /// The value.
+        value: String,
+    },
+    /// A value the option does not accept.
     #[error("{what} {value:?}: {expected}")]
     BadValue {
+        /// The option, e.g. `--time`.
         what: &'static str,
+        /// The value given.
         value: String,
+        /// What it accepts.
         expected: &'static str,
     },
+    /// An experiment or curve name that cannot be a path component.
     #[error(transparent)]
     Name(#[from] NameError),
 }

@@ -21,48 +21,103 @@ use std::path::{Path, PathBuf};
 /// Why a config could not be used. Messages name the file, the key and what was expected.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
+    /// The experiment file could not be read.
     #[error("{path}: cannot read: {source}")]
     Read {
+        /// The experiment file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// The file is not valid TOML.
     #[error("{path}: not valid TOML: {message}")]
-    Toml { path: PathBuf, message: String },
-    #[error("{path}: unknown key `{key}` (keys are the reference's flag names, e.g. total_epi, trace_len, l_rate)")]
-    UnknownKey { path: PathBuf, key: String },
-    #[error("{path}: `{key}`: {message}")]
-    BadValue {
+    Toml {
+        /// The experiment file.
         path: PathBuf,
-        key: String,
+        /// The TOML parser's reason.
         message: String,
     },
+    /// A key no config knows (a typo, or a flag the reference does not have).
+    #[error("{path}: unknown key `{key}` (keys are the reference's flag names, e.g. total_epi, trace_len, l_rate)")]
+    UnknownKey {
+        /// The experiment file.
+        path: PathBuf,
+        /// The key, as written.
+        key: String,
+    },
+    /// A known key with a value of the wrong type or out of range.
+    #[error("{path}: `{key}`: {message}")]
+    BadValue {
+        /// The experiment file.
+        path: PathBuf,
+        /// The key, as written.
+        key: String,
+        /// What was expected.
+        message: String,
+    },
+    /// The `seeds` field cannot be parsed.
     #[error("{path}: {source}")]
-    Seeds { path: PathBuf, source: SeedsError },
+    Seeds {
+        /// The experiment file.
+        path: PathBuf,
+        /// Why.
+        source: SeedsError,
+    },
+    /// A `--set` item without `=`; holds the item as given.
     #[error("--set `{0}`: expected key=value, e.g. total_epi=300 or dec-hddrqn.init_h=0.3")]
     BadSet(String),
+    /// A `--set` item whose value does not parse or validate.
     #[error("--set `{item}`: {message}")]
-    BadSetValue { item: String, message: String },
+    BadSetValue {
+        /// The item as given.
+        item: String,
+        /// What was expected.
+        message: String,
+    },
+    /// The file (after `--methods`) selects no method.
     #[error("{path}: no methods to run")]
-    NoMethods { path: PathBuf },
+    NoMethods {
+        /// The experiment file.
+        path: PathBuf,
+    },
+    /// The experiment name cannot name a results directory.
     #[error("{path}: {source} (set `name = \"...\"` in the file)")]
-    BadName { path: PathBuf, source: NameError },
+    BadName {
+        /// The experiment file.
+        path: PathBuf,
+        /// Why the name is refused.
+        source: NameError,
+    },
+    /// An entry (e.g. a method) listed twice.
     #[error("{path}: {what} `{value}` is listed twice; each run must appear once")]
     Duplicate {
+        /// The experiment file.
         path: PathBuf,
+        /// What is repeated, e.g. `method`.
         what: &'static str,
+        /// The repeated entry.
         value: String,
     },
+    /// Two sweep points of one method that resolve to the same config.
     #[error("{path}: {method} sweep points `{a}` and `{b}` resolve to the same config; list each value once")]
     DuplicatePoint {
+        /// The experiment file.
         path: PathBuf,
+        /// The method's name.
         method: &'static str,
+        /// The first point's variant name.
         a: String,
+        /// The second point's variant name.
         b: String,
     },
+    /// Methods x sweep points x seeds exceeds the runner's limit.
     #[error("{path}: the experiment expands to {count} runs, at most {max} allowed (fewer seeds or sweep values)")]
     TooManyRuns {
+        /// The experiment file.
         path: PathBuf,
+        /// The number of runs, as text (`at least N` when counting stopped early).
         count: String,
+        /// The limit.
         max: usize,
     },
 }
@@ -92,10 +147,13 @@ enum SeedsField {
 /// One training run to perform: a method, a sweep point and a seed, with its resolved config.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunSpec {
+    /// The experiment's name (first component of the run directory).
     pub experiment: String,
+    /// The method trained.
     pub method: Method,
     /// Empty when the experiment has no sweep; else e.g. `trace_len=10,l_rate=0.001`.
     pub variant: String,
+    /// The run's seed; every random stream of the run derives from it.
     pub seed: u64,
     /// The domain the run trains on.
     pub env: EnvSpec,
@@ -127,8 +185,11 @@ impl RunSpec {
 /// A parsed experiment: everything needed to list its runs.
 #[derive(Debug, Clone)]
 pub struct Experiment {
+    /// The experiment's name, also its results directory.
     pub name: String,
+    /// The methods to run, in file order (after `--methods`).
     pub methods: Vec<Method>,
+    /// The seeds each method and sweep point runs with.
     pub seeds: Vec<u64>,
     /// Curves whose runs belong to another experiment (curve name -> that experiment's name):
     /// Figure 6's Our-2 is Figure 5's Our-2, trained once and drawn in both. All the file
@@ -146,7 +207,9 @@ pub use crate::experiment::results_tree::SHARED_CURVES as SHARED_CURVES_FILE;
 /// The command-line overrides of `macdec train`.
 #[derive(Debug, Clone, Default)]
 pub struct Overrides {
+    /// Run only these methods (`--methods`), instead of the file's.
     pub methods: Option<Vec<Method>>,
+    /// Run these seeds (`--seeds`), instead of the file's.
     pub seeds: Option<Vec<u64>>,
     /// `key=value` pairs; `method.key=value` targets one method.
     pub set: Vec<String>,

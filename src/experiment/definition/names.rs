@@ -11,23 +11,42 @@ pub const MAX_NAME_BYTES: usize = 200;
 /// Why a name cannot be used.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum NameError {
+    /// An empty name.
     #[error("{kind} name is empty")]
-    Empty { kind: &'static str },
+    Empty {
+        /// What the name names (e.g. `experiment`).
+        kind: &'static str,
+    },
+    /// A name beyond [`MAX_NAME_BYTES`].
     #[error("{kind} name {name:?} is {len} bytes long, at most {MAX_NAME_BYTES} allowed")]
     TooLong {
+        /// What the name names.
         kind: &'static str,
+        /// The name given.
         name: String,
+        /// Its length in bytes.
         len: usize,
     },
+    /// A character outside the allowed set.
     #[error("{kind} name {name:?} contains {found:?}: names are one path component of letters, digits and {allowed}")]
     BadChar {
+        /// What the name names.
         kind: &'static str,
+        /// The name given.
         name: String,
+        /// The first character refused.
         found: char,
+        /// The punctuation allowed besides letters and digits, in words.
         allowed: &'static str,
     },
+    /// A name starting with `.` or `-` (hidden file, or read as a flag).
     #[error("{kind} name {name:?} must not start with `.` or `-`")]
-    BadStart { kind: &'static str, name: String },
+    BadStart {
+        /// What the name names.
+        kind: &'static str,
+        /// The name given.
+        name: String,
+    },
 }
 
 /// Punctuation allowed in an experiment name (a plain identifier).

@@ -16,6 +16,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 pub struct RunSettings {
     /// The domain and its keys, horizon included (BP 10x10: 100, 30x30: 200; WTD: 150).
     pub env: EnvSpec,
+    /// The run's hyperparameters.
     pub config: RunConfig,
 }
 

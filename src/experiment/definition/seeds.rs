@@ -33,12 +33,16 @@ pub fn stream(seed: u64, role: Role) -> ChaCha8Rng {
 /// A `--seeds` value that could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum SeedsError {
+    /// Neither a range nor a list; holds the text.
     #[error("seeds `{0}`: expected a range `a..b` (end exclusive) or a comma list like `0,3,7`")]
     Syntax(String),
+    /// A range with no seed; holds the text.
     #[error("seeds `{0}`: the range is empty")]
     Empty(String),
+    /// A seed listed twice: the text and the seed.
     #[error("seeds `{0}`: seed {1} appears twice")]
     Duplicate(String, u64),
+    /// More seeds than `MAX_SEEDS`: the text and the count.
     #[error("seeds `{0}`: {1} seeds, at most {max} allowed", max = crate::experiment::limits::MAX_SEEDS)]
     TooMany(String, u128),
 }

@@ -30,9 +30,13 @@ const MAX_IDENTITY_BYTES: usize = 4096;
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CheckpointIdentity {
+    /// The experiment's name.
     pub experiment: String,
+    /// The method's name.
     pub method: String,
+    /// The sweep point, empty without a sweep.
     pub variant: String,
+    /// The run's seed.
     pub seed: u64,
     /// SHA-256 (hex) of the resolved domain and config ([`RunSettings`]) as JSON.
     pub config_sha256: String,
@@ -88,20 +92,31 @@ fn hex(bytes: &[u8]) -> String {
 /// Why checkpoint bytes were refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum CheckpointError {
+    /// The file does not start with macdec's checkpoint header.
     #[error("no macdec checkpoint header: written by an older macdec (or not a checkpoint); delete it to restart the run")]
     NoHeader,
+    /// A checkpoint format version this build does not read.
     #[error("checkpoint format version {found}, this macdec reads version {VERSION}; delete it to restart the run")]
-    Version { found: u32 },
+    Version {
+        /// The version in the file.
+        found: u32,
+    },
+    /// The file ends early; holds which part is missing.
     #[error("truncated: {0}")]
     Truncated(&'static str),
+    /// Bytes after the payload; holds their count.
     #[error("{0} trailing bytes after the payload")]
     Trailing(u64),
+    /// The identity header does not parse; holds why.
     #[error("bad identity header: {0}")]
     Identity(String),
+    /// The payload's checksum does not match.
     #[error("payload checksum mismatch (the file is corrupted)")]
     Checksum,
+    /// The checkpoint is another run's; holds how the identities differ.
     #[error("belongs to another run: {0}")]
     OtherRun(String),
+    /// The payload does not decode into the run's state; holds why.
     #[error("payload does not decode: {0}")]
     Decode(String),
 }

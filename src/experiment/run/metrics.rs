@@ -41,6 +41,7 @@ pub use crate::algos::training_loop::EvalPoint as MetricsRow;
 pub struct MetricsTable {
     /// The names of the rows' [`MetricsRow::family`] values, in order.
     pub family_columns: Vec<String>,
+    /// One row per evaluation point, in file order.
     pub rows: Vec<MetricsRow>,
 }
 
@@ -67,15 +68,30 @@ impl MetricsTable {
 /// Why a metrics file could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum MetricsError {
+    /// The CSV reader or writer failed.
     #[error("{path}: {source}")]
-    Csv { path: String, source: csv::Error },
+    Csv {
+        /// The metrics file.
+        path: String,
+        /// The CSV error.
+        source: csv::Error,
+    },
+    /// The file could not be opened, read or written.
     #[error("{path}: {source}")]
     Io {
+        /// The metrics file.
         path: String,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// The header or a row does not have the expected columns.
     #[error("{path}: {message}")]
-    Layout { path: String, message: String },
+    Layout {
+        /// The metrics file.
+        path: String,
+        /// What was expected.
+        message: String,
+    },
 }
 
 /// One CSV cell, written exactly as the csv crate writes the field's type (integers as

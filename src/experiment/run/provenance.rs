@@ -8,11 +8,13 @@ use serde::{Deserialize, Serialize};
 /// another commit or CPU is allowed (and `macdec plot` reports mixtures).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Provenance {
+    /// The crate version (`CARGO_PKG_VERSION`).
     pub macdec_version: String,
     /// The commit hash, `<hash>-dirty` if the code differed from it, or `unknown`.
     pub git_commit: String,
     /// `avx512`, `avx2` or `portable` (see [`crate::autograd::kernels::kernel_path`]).
     pub kernel_path: String,
+    /// The CPU's model name with its family (see [`cpu_model`]), or `unknown`.
     pub cpu_model: String,
 }
 

@@ -56,12 +56,16 @@ pub enum RunEnd {
 /// What became of one run.
 #[derive(Debug)]
 pub enum RunStatus {
+    /// Trained to the end by this invocation (possibly resumed from a checkpoint).
     Finished {
+        /// Wall-clock time this invocation spent on it.
         seconds: f64,
     },
+    /// Already finished; nothing to do.
     Skipped,
     /// Being trained by another process.
     Busy,
+    /// Stopped by an error; holds its message.
     Failed(String),
 }
 

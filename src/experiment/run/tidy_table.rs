@@ -21,18 +21,29 @@ pub const RUN_COLUMNS: [&str; 4] = ["experiment", "method", "variant", "seed"];
 /// Why the table could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum TidyError {
+    /// The results tree could not be listed.
     #[error("{path}: cannot read the results tree: {source}")]
     ReadTree {
+        /// The directory.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// No run with a metrics file below the root.
     #[error("{path}: no runs found (expected <experiment>/<method>/seed-<k>/metrics.csv[.gz])")]
-    NoRuns { path: PathBuf },
+    NoRuns {
+        /// The root.
+        path: PathBuf,
+    },
+    /// A metrics file could not be read.
     #[error(transparent)]
     Metrics(#[from] MetricsError),
+    /// The table could not be written.
     #[error("{path}: {source}")]
     Write {
+        /// The output file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
 }
@@ -48,6 +59,7 @@ pub struct TidyRun {
     pub method: String,
     /// The sweep point after `@` (empty without one).
     pub variant: String,
+    /// The run's seed (from `seed-<k>`).
     pub seed: u64,
 }
 

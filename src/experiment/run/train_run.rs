@@ -35,9 +35,13 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunManifest {
+    /// The experiment's name.
     pub experiment: String,
+    /// The method trained.
     pub method: Method,
+    /// The sweep point (`key=value,...`), empty without a sweep.
     pub variant: String,
+    /// The run's seed.
     pub seed: u64,
     /// The domain and hyperparameters, written as one table.
     pub config: RunSettings,
@@ -231,18 +235,53 @@ fn clear_run_dir(dir: &Path) -> Result<(), RunError> {
 /// Why a run could not proceed.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
+    /// The directory holds a run with another config.
     #[error("{dir}: holds a different run (differs in {keys}); rerun with --force to replace it")]
-    ConfigMismatch { dir: PathBuf, keys: String },
+    ConfigMismatch {
+        /// The run directory.
+        dir: PathBuf,
+        /// The keys that differ, comma-separated.
+        keys: String,
+    },
+    /// The existing run's files cannot be read back.
     #[error("{path}: {message}; rerun with --force to replace the run")]
-    UnreadableRun { path: PathBuf, message: String },
+    UnreadableRun {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// A file could not be read or written.
     #[error("{path}: {message}")]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error, as text.
+        message: String,
+    },
+    /// Another process holds the run's lock.
     #[error("{dir}: another macdec process is training this run (it holds {dir}/.lock); wait for it or stop it")]
-    Busy { dir: PathBuf },
+    Busy {
+        /// The run directory.
+        dir: PathBuf,
+    },
+    /// Another process holds the run's lock and trains a different run there.
     #[error("{dir}: another macdec process is training a different run here (differs in {keys}); this run was not trained: use another --out, or stop that process and rerun with --force")]
-    BusyWithOtherRun { dir: PathBuf, keys: String },
+    BusyWithOtherRun {
+        /// The run directory.
+        dir: PathBuf,
+        /// The keys whose values differ, comma-separated.
+        keys: String,
+    },
+    /// The checkpoint does not fit the run (or is damaged).
     #[error("{path}: refused checkpoint: {message} (or rerun with --force)")]
-    BadCheckpoint { path: PathBuf, message: String },
+    BadCheckpoint {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// Why it was refused.
+        message: String,
+    },
+    /// Training itself failed.
     #[error(transparent)]
     Train(#[from] TrainError),
     #[error(transparent)]
