@@ -50,6 +50,9 @@ pub enum RunEnd {
     /// Another process holds the run's lock and is training it: left to that process, so
     /// several processes (or machines sharing the results tree) can work through one campaign.
     Busy,
+    /// Stopped early on request ([`crate::experiment::stop::StopSignal`]), its checkpoint saved:
+    /// training it again resumes it.
+    Stopped,
 }
 
 /// What became of one run.
@@ -61,6 +64,8 @@ pub enum RunStatus {
     Skipped,
     /// Being trained by another process.
     Busy,
+    /// Stopped early on request, resumable ([`RunEnd::Stopped`]).
+    Stopped,
     Failed(String),
 }
 
@@ -230,6 +235,10 @@ where
             Ok(RunEnd::Busy) => {
                 say(format!("left {name} to the other process training it"));
                 RunStatus::Busy
+            }
+            Ok(RunEnd::Stopped) => {
+                say(format!("stopped {name} (resumable)"));
+                RunStatus::Stopped
             }
             Err(e) => {
                 say(format!("FAILED {name}: {e}"));
