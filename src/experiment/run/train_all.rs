@@ -64,8 +64,11 @@ checkpoint_freq = 20
         }
     }
 
+    /// A metrics row without its wall-clock column, floats as bits.
+    type Row = (u64, u64, u64, u64, Vec<Option<u64>>);
+
     /// Every metrics row without its wall-clock column.
-    fn rows(dir: &Path) -> Vec<(u64, u64, u64, u64, Vec<Option<u64>>)> {
+    fn rows(dir: &Path) -> Vec<Row> {
         let table = metrics::read(&dir.join(metrics::METRICS_FILE)).unwrap();
         table
             .rows
