@@ -5,6 +5,7 @@ import gzip
 import io
 import math
 import re
+import sys
 
 import numpy as np
 import pandas as pd
@@ -48,6 +49,15 @@ def test_a_fixture_tree_loads_as_a_tidy_frame(tmp_path):
     assert df["critic_loss"][:3].isna().all() and df["critic_loss"][3] == 0.75
     d = macdec.load_results(tmp_path, as_dict=True)
     assert isinstance(d["eval_return"], np.ndarray) and d["method"].tolist() == df["method"].tolist()
+
+
+def test_without_pandas_it_is_a_dict_of_numpy_arrays(tmp_path, monkeypatch):
+    write_tree(tmp_path)
+    monkeypatch.setitem(sys.modules, "pandas", None)  # `import pandas` now fails
+    d = macdec.load_results(tmp_path)
+    assert isinstance(d, dict) and list(d)[:5] == ["experiment", "method", "variant", "seed", "episode"]
+    assert d["eval_return"].tolist() == [1.5, 2.25, -3.0, 7.0, 8.5]
+    assert d["seed"].dtype == np.int64 and d["variant"].tolist()[-1] == "lr=0.01"
 
 
 def test_it_reads_what_macdec_results_writes(tmp_path, run_cli):
