@@ -7,10 +7,11 @@ use crate::bench::nets;
 use crate::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
 use crate::experiment::policy_files::NetRole;
 use crate::experiment::results_tree;
-use crate::experiment::runner::{run_all, RunStatus, RunnerOptions};
+use crate::experiment::runner::{RunStatus, RunnerOptions};
 use crate::experiment::seeds::parse_seeds;
 use crate::experiment::slurm::{job_script, SlurmOptions};
-use crate::experiment::train_run::train_run;
+use crate::experiment::stop::StopSignal;
+use crate::experiment::train_all::train_all;
 use crate::nn::demo;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -591,10 +592,7 @@ fn train(args: TrainArgs) -> Result<()> {
     experiment
         .write_shared_curves(&args.out)
         .with_context(|| format!("recording the shared curves in {}", args.out.display()))?;
-    let force = args.force;
-    let statuses = run_all(&runs, &opts, |spec, dir, progress| {
-        train_run(spec, dir, progress, force).map_err(|e| e.to_string())
-    });
+    let statuses = train_all(&runs, &opts, args.force, &StopSignal::new());
     let failed = statuses
         .iter()
         .filter(|s| matches!(s, RunStatus::Failed(_)))

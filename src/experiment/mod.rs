@@ -10,6 +10,6 @@ pub mod run;
 pub use cluster::{audit, slurm};
 pub use definition::{config, limits, names, paper, run_settings, seeds};
 pub use run::{
-    checkpoint, metrics, policy_files, provenance, report, results_tree, runner, tidy_table,
-    train_run, work_queue,
+    checkpoint, metrics, policy_files, provenance, report, results_tree, runner, stop, tidy_table,
+    train_all, train_run, work_queue,
 };

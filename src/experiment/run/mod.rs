@@ -1,5 +1,6 @@
-//! Running it and what a run writes: the parallel runner ([`runner`], [`work_queue`]), one run on
-//! disk with resume ([`train_run`]), its files ([`results_tree`] names them; [`checkpoint`],
+//! Running it and what a run writes: the parallel runner ([`runner`], [`work_queue`]), every run
+//! of an experiment ([`train_all`], stopped early by a [`stop`] signal), one run on disk with
+//! resume ([`train_run`]), its files ([`results_tree`] names them; [`checkpoint`],
 //! [`metrics`], [`policy_files`], [`provenance`]), the terminal summary ([`report`]) and every
 //! run of a tree as one table ([`tidy_table`]).
 
@@ -10,6 +11,8 @@ pub mod provenance;
 pub mod report;
 pub mod results_tree;
 pub mod runner;
+pub mod stop;
 pub mod tidy_table;
+pub mod train_all;
 pub mod train_run;
 pub mod work_queue;

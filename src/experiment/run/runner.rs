@@ -51,6 +51,9 @@ pub enum RunEnd {
     /// Another process holds the run's lock and is training it: left to that process, so
     /// several processes (or machines sharing the results tree) can work through one campaign.
     Busy,
+    /// Stopped early on request ([`crate::experiment::stop::StopSignal`]), its checkpoint saved:
+    /// training it again resumes it.
+    Stopped,
 }
 
 /// What became of one run.
@@ -65,6 +68,8 @@ pub enum RunStatus {
     Skipped,
     /// Being trained by another process.
     Busy,
+    /// Stopped early on request, resumable ([`RunEnd::Stopped`]).
+    Stopped,
     /// Stopped by an error; holds its message.
     Failed(String),
 }
@@ -240,6 +245,10 @@ where
             Ok(RunEnd::Busy) => {
                 say(format!("left {name} to the other process training it"));
                 RunStatus::Busy
+            }
+            Ok(RunEnd::Stopped) => {
+                say(format!("stopped {name} (resumable)"));
+                RunStatus::Stopped
             }
             Err(e) => {
                 say(format!("FAILED {name}: {e}"));

@@ -192,7 +192,10 @@ pub fn write_tidy_file(root: &Path, path: &Path) -> Result<(usize, usize), TidyE
     }
 }
 
-fn read_run(run: &TidyRun) -> Result<MetricsTable, TidyError> {
+/// The metrics of one run of [`tidy_runs`] (its `metrics.csv`, else `metrics.csv.gz`): what
+/// each row of the table is made from, for readers that build their own table (the Python
+/// package's `load_results`).
+pub fn read_run(run: &TidyRun) -> Result<MetricsTable, TidyError> {
     let path = metrics::locate(&run.dir).ok_or_else(|| TidyError::NoRuns {
         path: run.dir.clone(),
     })?;

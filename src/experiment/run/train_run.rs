@@ -20,6 +20,7 @@ use crate::experiment::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
 use crate::experiment::run_settings::RunSettings;
 use crate::experiment::runner::{Progress, RunEnd};
 use crate::experiment::seeds::{stream, Role};
+use crate::experiment::stop::StopSignal;
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::{
     read_in_tree, read_text_in_tree, MAX_CHECKPOINT_BYTES, MAX_TEXT_BYTES,
@@ -425,6 +426,20 @@ pub fn train_run(
     progress: &Progress,
     force: bool,
 ) -> Result<RunEnd, RunError> {
+    train_run_until(spec, dir, progress, force, &StopSignal::new())
+}
+
+/// [`train_run`] that also ends when `stop` is raised: after the training episode during which
+/// it was raised, the run saves its metrics, checkpoint and policy files as at a checkpoint and
+/// returns [`RunEnd::Stopped`]; training it again resumes from there and ends with the metrics
+/// an uninterrupted run writes (wall-clock column aside).
+pub fn train_run_until(
+    spec: &RunSpec,
+    dir: &Path,
+    progress: &Progress,
+    force: bool,
+    stop: &StopSignal,
+) -> Result<RunEnd, RunError> {
     // Held until this function returns, whatever the outcome.
     let _lock = match lock_run_dir(dir) {
         Err(RunError::Busy { .. }) if !force => return held_elsewhere(spec, dir),
@@ -468,10 +483,14 @@ pub fn train_run(
                 trainer.evals().last().map_or(f64::NAN, |e| e.eval_return)
             ),
         );
-        if checkpoint_due {
+        let stopping = stop.is_stopped();
+        if checkpoint_due || stopping {
             save_metrics(dir, &trainer)?;
             save_checkpoint(&checkpoint, &identity, &mut trainer)?;
             save_policy_files(dir, spec, &trainer)?;
+        }
+        if stopping {
+            return Ok(RunEnd::Stopped);
         }
     }
     save_metrics(dir, &trainer)?;

@@ -1,0 +1,84 @@
+//! Python values to and from the TOML values domains read their keys from: `grid_dim=[6, 6]`
+//! becomes `grid_dim = [6, 6]`, as a config's `[params]` table would hold it.
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString, PyTuple};
+
+/// One Python value as TOML: bool, int, float, str, list/tuple, dict. `key` names it in errors.
+pub fn to_toml(key: &str, value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    if value.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(value.extract()?));
+    }
+    if value.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(value.extract()?));
+    }
+    if value.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(value.extract()?));
+    }
+    if let Ok(i) = value.extract::<i64>() {
+        return Ok(toml::Value::Integer(i));
+    }
+    if let Ok(f) = value.extract::<f64>() {
+        return Ok(toml::Value::Float(f));
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items = value
+            .iter()?
+            .enumerate()
+            .map(|(i, v)| to_toml(&format!("{key}[{i}]"), &v?))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    if let Ok(dict) = value.downcast::<PyDict>() {
+        return Ok(toml::Value::Table(to_table(dict, Some(key))?));
+    }
+    Err(PyValueError::new_err(format!(
+        "parameter `{key}`: {} is not a parameter value (expected a bool, int, float, str, or a list or dict of them)",
+        value.get_type().name()?
+    )))
+}
+
+/// A dict of parameters as a TOML table; keys must be strings.
+pub fn to_table(dict: &Bound<'_, PyDict>, within: Option<&str>) -> PyResult<toml::Table> {
+    let mut table = toml::Table::new();
+    for (k, v) in dict.iter() {
+        let key: String = k.extract().map_err(|_| {
+            PyValueError::new_err(format!(
+                "parameter names must be strings, got {}",
+                k.repr().map(|r| r.to_string()).unwrap_or_default()
+            ))
+        })?;
+        let path = match within {
+            Some(outer) => format!("{outer}.{key}"),
+            None => key.clone(),
+        };
+        table.insert(key, to_toml(&path, &v)?);
+    }
+    Ok(table)
+}
+
+/// A TOML value as the Python value it reads as.
+pub fn to_py(py: Python<'_>, value: &toml::Value) -> PyObject {
+    match value {
+        toml::Value::String(s) => s.into_py(py),
+        toml::Value::Integer(i) => i.into_py(py),
+        toml::Value::Float(f) => f.into_py(py),
+        toml::Value::Boolean(b) => b.into_py(py),
+        toml::Value::Datetime(d) => d.to_string().into_py(py),
+        toml::Value::Array(items) => {
+            PyList::new_bound(py, items.iter().map(|v| to_py(py, v))).into_py(py)
+        }
+        toml::Value::Table(t) => table_to_py(py, t).into_py(py),
+    }
+}
+
+/// A TOML table as a dict, in the table's order.
+pub fn table_to_py<'py>(py: Python<'py>, table: &toml::Table) -> Bound<'py, PyDict> {
+    let dict = PyDict::new_bound(py);
+    for (k, v) in table {
+        dict.set_item(k, to_py(py, v))
+            .expect("setting a str key on a fresh dict cannot fail");
+    }
+    dict
+}

@@ -1,0 +1,89 @@
+"""train: the same files as `macdec train` (metrics.csv byte for byte, wall-clock column
+aside) from a path or a dict; overrides; errors; Ctrl-C stops resumably."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+import tomllib
+
+import pytest
+
+import macdec
+from conftest import TINY, metrics_without_time
+
+
+def test_train_equals_macdec_train_byte_for_byte(tmp_path, run_cli):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    run_cli("train", "--config", config, "--out", tmp_path / "cli", "--quiet", "--no-plot", "--jobs", "2")
+    dirs = macdec.train(config, out=tmp_path / "py", jobs=2)
+    assert [d.relative_to(tmp_path / "py").as_posix() for d in dirs] == [
+        "tiny/dec-hddrqn/seed-0", "tiny/dec-hddrqn/seed-1", "tiny/our1/seed-0", "tiny/our1/seed-1",
+    ]
+    for d in dirs:
+        rel = d.relative_to(tmp_path / "py")
+        ours = metrics_without_time(d / "metrics.csv")
+        assert len(ours) == 1 + 60 // 5 + 1
+        assert ours == metrics_without_time(tmp_path / "cli" / rel / "metrics.csv"), rel
+        assert (d / "finished").exists() and (d / "policy" / "policy.json").exists()
+    assert metrics_without_time(dirs[2] / "metrics.csv") != metrics_without_time(dirs[3] / "metrics.csv")
+    # Finished runs are skipped: nothing is rewritten.
+    before = (dirs[0] / "metrics.csv").read_bytes()
+    macdec.train(config, out=tmp_path / "py")
+    assert (dirs[0] / "metrics.csv").read_bytes() == before
+
+
+def test_a_dict_config_with_methods_seeds_and_overrides(tmp_path, run_cli):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    run_cli("train", "--config", config, "--out", tmp_path / "cli", "--quiet", "--no-plot",
+            "--methods", "our1", "--seeds", "1", "--set", "total_epi=30", "--set", "our1.l_rate=0.002")
+    as_dict = tomllib.loads(TINY)
+    dirs = macdec.train(as_dict, methods="our1", seeds=[1], out=tmp_path / "py",
+                        overrides={"total_epi": 30, "our1.l_rate": 0.002})
+    assert len(dirs) == 1
+    rel = "tiny/our1/seed-1/metrics.csv"
+    assert metrics_without_time(tmp_path / "py" / rel) == metrics_without_time(tmp_path / "cli" / rel)
+    assert len(metrics_without_time(tmp_path / "py" / rel)) == 1 + 30 // 5 + 1
+
+
+def test_bad_configs_are_named(tmp_path):
+    with pytest.raises(ValueError, match="gird_dim"):
+        macdec.train({"methods": ["our1"], "params": {"env_name": "BP_MA", "gird_dim": 8}}, out=tmp_path)
+    with pytest.raises(ValueError, match="not-a-method"):
+        macdec.train({"params": {"env_name": "BP_MA"}}, methods="not-a-method", out=tmp_path)
+    with pytest.raises(FileNotFoundError, match="missing.toml"):
+        macdec.train(tmp_path / "missing.toml", out=tmp_path)
+    assert not any(tmp_path.iterdir())
+
+
+def test_ctrl_c_stops_cleanly_and_training_again_resumes_to_the_same_metrics(tmp_path, run_cli):
+    config = tmp_path / "long.toml"
+    config.write_text(TINY.replace("total_epi = 60", "total_epi = 3000").replace('seeds = "0..2"', 'seeds = "0"')
+                      .replace('methods = ["dec-hddrqn", "our1"]', 'methods = ["our1"]'))
+    run_cli("train", "--config", config, "--out", tmp_path / "whole", "--quiet", "--no-plot")
+    script = textwrap.dedent(f"""
+        import macdec
+        try:
+            macdec.train({str(config)!r}, out={str(tmp_path / "py")!r})
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+    """)
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    metrics = tmp_path / "py" / "tiny" / "our1" / "seed-0" / "metrics.csv"
+    start = time.time()
+    while not metrics.exists() and time.time() - start < 120:
+        time.sleep(0.02)
+    assert metrics.exists(), "no checkpoint was written"
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=120)
+    assert out.strip() == "interrupted"
+    run = metrics.parent
+    assert not (run / "finished").exists(), "the run finished before it could be interrupted; make it longer"
+    assert (run / "checkpoint.bin").exists()
+    macdec.train(config, out=tmp_path / "py")
+    assert (run / "finished").exists()
+    assert metrics_without_time(metrics) == metrics_without_time(tmp_path / "whole" / "tiny" / "our1" / "seed-0" / "metrics.csv")
