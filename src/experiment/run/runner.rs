@@ -10,7 +10,7 @@ use crate::experiment::config::RunSpec;
 use crate::experiment::results_tree;
 use crate::experiment::train_run::{existing_run, Existing};
 use crate::experiment::work_queue::run_in_order;
-use crate::files::links::{check_real_dirs, create_real_dirs};
+use crate::files::links::check_real_dirs;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -220,7 +220,9 @@ where
         let start = std::time::Instant::now();
         // A panic is a bug, but it fails this run only, not its neighbours.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            create_real_dirs(&opts.out, &dir).map_err(|e| e.to_string())?;
+            // Checked again as the run starts (the run creates its directory only when it
+            // trains: a stopped batch leaves no empty ones).
+            check_real_dirs(&opts.out, &dir).map_err(|e| e.to_string())?;
             run_one(spec, &dir, &progress)
         }))
         .unwrap_or_else(|panic| {
