@@ -35,7 +35,8 @@ def root() -> Path:
 
 @pytest.fixture(scope="session")
 def macdec_bin() -> Path:
-    path = Path(os.environ.get("MACDEC_BIN", ROOT / "target" / "release" / "macdec"))
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    path = Path(os.environ.get("MACDEC_BIN", target / "release" / "macdec"))
     if not path.is_file():
         pytest.fail(f"{path}: no macdec binary; run `cargo build --release` first (or set MACDEC_BIN)")
     return path
