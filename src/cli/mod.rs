@@ -88,7 +88,7 @@ enum Command {
         #[arg(long)]
         run: PathBuf,
         /// Episodes to show, one after another.
-        #[arg(long, default_value_t = 1, value_parser = at_least_one)]
+        #[arg(long, default_value_t = 1, value_parser = episode_count)]
         episodes: usize,
         /// The GIF to write.
         #[arg(long, default_value = "rollout.gif")]
@@ -281,10 +281,12 @@ struct RobotArgs {
     #[arg(long)]
     listen: Option<std::net::SocketAddr>,
     /// With --listen: connections served at once (one more is refused with an error line).
-    #[arg(long, default_value_t = 16, value_parser = at_least_one)]
+    #[arg(long, default_value_t = 16, value_parser = |t: &str| bounded_count(t, 4096))]
     max_connections: usize,
-    /// Longest request line in bytes; a longer one gets an error reply and is discarded.
-    #[arg(long, default_value_t = crate::deploy::line_reader::MAX_LINE_BYTES, value_parser = at_least_one)]
+    /// Longest request line in bytes, at most 64 MiB; a longer one gets an error reply and is
+    /// discarded.
+    #[arg(long, default_value_t = crate::deploy::line_reader::MAX_LINE_BYTES,
+          value_parser = |t: &str| bounded_count(t, 64 << 20))]
     max_line_bytes: usize,
     /// With --listen: close a connection silent between requests for this many seconds.
     #[arg(long, default_value_t = crate::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS,
@@ -306,7 +308,7 @@ struct EpisodeArgs {
     #[arg(long)]
     policy: PathBuf,
     /// Episodes to run.
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
+    #[arg(long, default_value_t = 1, value_parser = episode_count)]
     episodes: usize,
     /// Seed of the environment's random stream (default: the run's seed); the stream is the
     /// evaluation env's stream of that seed.
@@ -352,11 +354,11 @@ struct ImportArgs {
     #[arg(long)]
     params: Option<PathBuf>,
     /// ICRA Box Pushing grid size N (N x N); the paper uses 10 and 30.
-    #[arg(long)]
+    #[arg(long, value_parser = |t: &str| bounded_count(t, crate::experiment::limits::MAX_GRID_DIM))]
     grid: Option<usize>,
     /// Episode length in primitive steps (ICRA paper: Box Pushing 100 on 10x10, 200 on 30x30,
     /// Warehouse 150; required for icra). MacroMARL: the published horizon by default.
-    #[arg(long)]
+    #[arg(long, value_parser = |t: &str| bounded_count(t, crate::experiment::limits::MAX_HORIZON))]
     horizon: Option<usize>,
     /// ICRA Warehouse: std of the Turtlebots' movement noise (paper 0).
     #[arg(long, default_value_t = 0.0)]
@@ -410,6 +412,35 @@ fn at_least_one(text: &str) -> Result<usize, String> {
         Ok(n) => Ok(n),
         Err(e) => Err(format!("expected a positive integer: {e}")),
     }
+}
+
+/// An episode count flag: at least 1 and at most a config's `eval_num_epi` may be
+/// ([`MAX_EVAL_NUM_EPI`](crate::experiment::limits::MAX_EVAL_NUM_EPI)), so a flag cannot ask
+/// for more than a config could.
+fn episode_count(text: &str) -> Result<usize, String> {
+    bounded_count(text, crate::experiment::limits::MAX_EVAL_NUM_EPI)
+}
+
+/// A count flag in 1..=`max`: a size from a flag is bounded like one from a config.
+fn bounded_count(text: &str, max: usize) -> Result<usize, String> {
+    match at_least_one(text)? {
+        n if n > max => Err(format!("must be at most {max}, got {n}")),
+        n => Ok(n),
+    }
+}
+
+/// Episode returns for one line: all of them up to ten, else their mean, lowest and highest.
+fn summarize_returns(returns: &[f64]) -> String {
+    if returns.len() <= 10 {
+        return format!("{returns:?}");
+    }
+    let mean = returns.iter().sum::<f64>() / returns.len() as f64;
+    let (lo, hi) = returns
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &r| {
+            (lo.min(r), hi.max(r))
+        });
+    format!("mean {mean}, lowest {lo}, highest {hi}")
 }
 
 /// `--net`: `cen` or `dec`, the names policy.json uses for the two kinds of net.
@@ -503,9 +534,10 @@ fn run() -> Result<()> {
             let returns = crate::render::rollout::render_run(&run, net, episodes, &out, frame_ms)
                 .with_context(|| format!("rendering {}", run.display()))?;
             eprintln!(
-                "wrote {} ({} episode(s), team returns {returns:?})",
+                "wrote {} ({} episode(s), team returns {})",
                 out.display(),
-                returns.len()
+                returns.len(),
+                summarize_returns(&returns)
             );
             Ok(())
         }
@@ -754,12 +786,19 @@ fn audit(args: AuditArgs) -> Result<()> {
         }
         Err((dir, e)) => println!("{}: CANNOT AUDIT: {e}", dir.display()),
     });
-    let bad = results
+    let differ = results
         .iter()
-        .filter(|r| !matches!(r, Ok(a) if matches!(a.outcome, AuditOutcome::Identical { .. })))
+        .filter(|r| matches!(r, Ok(a) if !matches!(a.outcome, AuditOutcome::Identical { .. })))
         .count();
-    if bad > 0 {
-        bail!("{bad} of {} audited run(s) not identical", results.len());
+    let unaudited = results.iter().filter(|r| r.is_err()).count();
+    match (differ, unaudited) {
+        (0, 0) => {}
+        (d, 0) => bail!("{d} of {} audited run(s) differ", results.len()),
+        (0, u) => bail!("{u} of {} run(s) could not be audited", results.len()),
+        (d, u) => bail!(
+            "{d} of {} run(s) differ and {u} could not be audited",
+            results.len()
+        ),
     }
     println!("all {} audited run(s) identical", results.len());
     Ok(())

@@ -20,6 +20,23 @@ use super::MacroEnv;
 /// The config key every domain has: the horizon in primitive steps (the references' name).
 pub const HORIZON_KEY: &str = "env_terminate_step";
 
+/// Longest horizon any domain may have, in primitive steps (papers: 100 to 200). Every spec is
+/// held to it wherever it comes from (a config, a policy or replay file, `import --horizon`), so
+/// a crafted file cannot make a reader allocate or loop for ever.
+pub const MAX_HORIZON: usize = 100_000;
+
+/// The domain's horizon from its keys: present, an integer, 1..=[`MAX_HORIZON`].
+pub fn key_horizon(keys: &toml::Table) -> Result<usize, KeyError> {
+    match key_usize(keys, HORIZON_KEY)? {
+        0 => Err(KeyError::new(HORIZON_KEY, "must be at least 1")),
+        h if h > MAX_HORIZON => Err(KeyError::new(
+            HORIZON_KEY,
+            format!("must be at most {MAX_HORIZON}, got {h}"),
+        )),
+        h => Ok(h),
+    }
+}
+
 /// A bad domain key: which key, and why. Shown as "`key`: message" by config errors.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("`{key}`: {message}")]

@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::domain::{key_usize, KeyError, HORIZON_KEY};
+use super::domain::{key_horizon, KeyError};
 use super::registry::DomainEntry;
 use super::{registry, AnyEnv, EnvError};
 
@@ -60,7 +60,7 @@ impl EnvSpec {
             source,
         };
         let keys = domain.keys(given).map_err(key_error)?;
-        key_usize(&keys, HORIZON_KEY).map_err(key_error)?;
+        key_horizon(&keys).map_err(key_error)?;
         Ok(EnvSpec { domain, keys })
     }
 
@@ -106,7 +106,7 @@ impl EnvSpec {
 
     /// The horizon in primitive steps (the `env_terminate_step` key).
     pub fn horizon(&self) -> usize {
-        key_usize(&self.keys, HORIZON_KEY).expect("checked when the spec was made")
+        key_horizon(&self.keys).expect("checked when the spec was made")
     }
 
     /// A short label for tables, benchmarks and file names: `bp10`, `wtd`, ...
@@ -238,6 +238,23 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(err.contains("gird"), "{err}");
+    }
+
+    #[test]
+    fn a_horizon_beyond_the_limit_is_refused_for_every_domain() {
+        // A policy or replay file is read through this one constructor, so a crafted horizon
+        // is refused before anything is sized by it.
+        for tagged in [
+            r#"{"env": "box-pushing", "grid": 10, "horizon": 1000000000000000}"#,
+            r#"{"env": "warehouse", "horizon": 100001}"#,
+        ] {
+            let err = serde_json::from_str::<EnvSpec>(tagged)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("at most 100000"), "{tagged}: {err}");
+        }
+        let table: toml::Table = toml::from_str("env_terminate_step = 100000").unwrap();
+        assert_eq!(EnvSpec::new("BP_MA", &table).unwrap().horizon(), 100_000);
     }
 
     #[test]

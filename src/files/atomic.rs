@@ -17,18 +17,33 @@ pub fn write_atomic_with(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {
-    check_output_file(path)?;
+    write_atomic_try(path, write, |e| e)
+}
+
+/// [`write_atomic_with`] for a writer with its own error type `E` (an encoder's, a table's), which
+/// file errors are turned into by `io_error`: `path` is replaced only if `write` returns `Ok`,
+/// whose value is returned.
+pub fn write_atomic_try<T, E>(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> Result<T, E>,
+    io_error: impl Fn(io::Error) -> E,
+) -> Result<T, E> {
+    check_output_file(path).map_err(&io_error)?;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     if let Some(dir) = dir {
-        fs::create_dir_all(dir)?;
+        fs::create_dir_all(dir).map_err(&io_error)?;
     }
-    let (tmp, file) = create_temp_beside(path)?;
+    let (tmp, file) = create_temp_beside(path).map_err(&io_error)?;
     let written = (|| {
         let mut f = io::BufWriter::new(file);
-        write(&mut f)?;
-        let f = f.into_inner().map_err(io::IntoInnerError::into_error)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
+        let value = write(&mut f)?;
+        let finish = || -> io::Result<()> {
+            let f = f.into_inner().map_err(io::IntoInnerError::into_error)?;
+            f.sync_all()?;
+            fs::rename(&tmp, path)
+        };
+        finish().map_err(&io_error)?;
+        Ok(value)
     })();
     // A failed write (disk full, say) must not leave its temp file behind.
     written.inspect_err(|_| {

@@ -105,13 +105,56 @@ pub fn pairwise_tests(rows: &[CurveSummary]) -> Vec<PairTest> {
     tests
 }
 
-/// Write rows of any serializable kind as CSV to `path` (atomically), header first.
-pub fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<(), PlotError> {
+/// A row type of a CSV file plot writes: its column names, so a file with no rows (an
+/// experiment with one curve has no Welch tests) still has its header.
+pub trait CsvRow: Serialize {
+    /// The columns, in the order serde writes the fields (checked by the tests).
+    const HEADER: &'static [&'static str];
+}
+
+impl CsvRow for CurveSummary {
+    const HEADER: &'static [&'static str] = &[
+        "curve",
+        "legend",
+        "seeds",
+        "finished",
+        "final_episode",
+        "final_mean",
+        "final_se",
+        "final_n",
+        "reach95_episode",
+        "mean_over_training",
+        "optimal",
+        "run_minutes",
+        "best_mean",
+        "smoothing_points",
+    ];
+}
+
+impl CsvRow for PairTest {
+    const HEADER: &'static [&'static str] = &[
+        "curve_a",
+        "curve_b",
+        "t",
+        "df",
+        "p_a_greater",
+        "t_over_training",
+        "df_over_training",
+        "p_a_greater_over_training",
+    ];
+}
+
+/// Write `rows` as CSV to `path` (atomically), header first, also when there are no rows.
+pub fn write_csv<T: CsvRow>(path: &Path, rows: &[T]) -> Result<(), PlotError> {
     let write_err = |source| PlotError::Write {
         path: path.to_path_buf(),
         source,
     };
-    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(Vec::new());
+    w.write_record(T::HEADER)
+        .map_err(|e| write_err(std::io::Error::other(e)))?;
     for r in rows {
         w.serialize(r)
             .map_err(|e| write_err(std::io::Error::other(e)))?;
@@ -131,7 +174,8 @@ pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) ->
     );
     for r in rows {
         let optimal = r.optimal.map_or("n/a".into(), format_return);
-        let minutes = r.run_minutes.map_or("n/a".into(), |m| format!("{m:.1}"));
+        let minutes = r.run_minutes.map_or("n/a".into(), |m| format_number(m, 1));
+        let two = |v: f64| format_number(v, 2);
         let at = if r.final_n < r.seeds {
             format!(" (n = {})", r.final_n)
         } else {
@@ -143,15 +187,15 @@ pub fn markdown_table(title: &str, rows: &[CurveSummary], tests: &[PairTest]) ->
             (Some(_), Some(e)) => e.to_string(),
         };
         s.push_str(&format!(
-            "| {} | {} ({}) | {} | {:.2} ± {:.2}{at} | {:.2} | {reach} | {:.2} | {optimal} | {minutes} |\n",
+            "| {} | {} ({}) | {} | {} ± {}{at} | {} | {reach} | {} | {optimal} | {minutes} |\n",
             r.legend,
             r.seeds,
             r.finished,
             r.final_episode,
-            r.final_mean,
-            r.final_se,
-            r.best_mean,
-            r.mean_over_training
+            two(r.final_mean),
+            two(r.final_se),
+            two(r.best_mean),
+            two(r.mean_over_training)
         ));
     }
     if !tests.is_empty() {
@@ -223,10 +267,26 @@ pub fn format_p(p: f64) -> String {
 
 /// A return for display: whole numbers without decimals (262), others with two (80.71).
 pub fn format_return(v: f64) -> String {
-    if v.fract() == 0.0 {
+    if v.fract() == 0.0 && v.abs() < WIDE {
         format!("{v:.0}")
     } else {
-        format!("{v:.2}")
+        format_number(v, 2)
+    }
+}
+
+/// From this magnitude on, numbers are shown in scientific notation.
+const WIDE: f64 = 1e9;
+
+/// A number for a table cell with `decimals` decimals, at most about 16 characters wide
+/// whatever its size: 1e300 (a diverged run, a crafted metrics file) as `1.00e300`, not as 301
+/// digits; NaN and infinities as such.
+pub fn format_number(v: f64, decimals: usize) -> String {
+    if !v.is_finite() {
+        format!("{v}")
+    } else if v.abs() >= WIDE {
+        format!("{v:.decimals$e}")
+    } else {
+        format!("{v:.decimals$}")
     }
 }
 
@@ -330,6 +390,53 @@ mod tests {
             "curve,legend,seeds,finished,final_episode,final_mean,final_se,final_n,reach95_episode,mean_over_training,optimal,run_minutes,best_mean,smoothing_points\n\
              our1,Our-1,3,2,1500,1.0,0.0,1,,55.5,,,81.25,21\n"
         );
+    }
+
+    #[test]
+    fn the_header_lists_the_serialized_fields_in_order() {
+        fn serde_header<T: CsvRow>(row: &T) -> String {
+            let mut w = csv::Writer::from_writer(Vec::new());
+            w.serialize(row).unwrap();
+            let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+            text.lines().next().unwrap().to_string()
+        }
+        let rows = ends_higher_learns_later();
+        assert_eq!(serde_header(&rows[0]), CurveSummary::HEADER.join(","));
+        let test = &pairwise_tests(&rows)[0];
+        assert_eq!(serde_header(test), PairTest::HEADER.join(","));
+    }
+
+    #[test]
+    fn a_welch_csv_without_tests_still_has_its_header() {
+        let t = tempfile::tempdir().unwrap();
+        let p = t.path().join("w.csv");
+        write_csv::<PairTest>(&p, &[]).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&p).unwrap(),
+            format!("{}\n", PairTest::HEADER.join(","))
+        );
+    }
+
+    #[test]
+    fn huge_and_odd_numbers_keep_a_sane_width_in_markdown() {
+        let mut r = row("our1", "Our-1", &[1e300, 1e300], &[1.0, 1.0]);
+        r.best_mean = -1e200;
+        r.mean_over_training = f64::NAN;
+        r.optimal = Some(1e250);
+        r.run_minutes = Some(1e100);
+        let md = markdown_table("x", &[r], &[]);
+        let line = md.lines().find(|l| l.starts_with("| Our-1 |")).unwrap();
+        assert!(line.len() < 160, "{line}");
+        assert!(
+            line.contains("1.00e300 ±") && line.contains("-1.00e200"),
+            "{line}"
+        );
+        assert!(
+            line.contains("| NaN |") && line.contains("1.00e250") && line.contains("1.0e100"),
+            "{line}"
+        );
+        assert_eq!(format_return(262.0), "262");
+        assert_eq!(format_return(-3e15), "-3.00e15");
     }
 
     #[test]

@@ -99,7 +99,7 @@ pub enum BuildError {
 
 impl CustomEnv {
     /// The name is 1 to [`MAX_NAME_CHARS`] printable characters and not a built-in domain's (a
-    /// policy saying `box-pushing` must be Box Pushing's); the horizon is positive.
+    /// policy saying `box-pushing` must be Box Pushing's); the horizon is in 1..=[`MAX_HORIZON`](crate::envs::domain::MAX_HORIZON).
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
         let n = self.name.chars().count();
         if n == 0 || n > MAX_NAME_CHARS || self.name.chars().any(char::is_control) {
@@ -120,8 +120,15 @@ impl CustomEnv {
                 ),
             ));
         }
-        if self.horizon == 0 {
-            return Err(("env.horizon", "must be > 0".into()));
+        if self.horizon == 0 || self.horizon > crate::envs::domain::MAX_HORIZON {
+            return Err((
+                "env.horizon",
+                format!(
+                    "must be in 1..={}, got {}",
+                    crate::envs::domain::MAX_HORIZON,
+                    self.horizon
+                ),
+            ));
         }
         Ok(())
     }
@@ -293,6 +300,7 @@ mod tests {
             (c(&"x".repeat(65), 20), "env.name"),
             (c("warehouse", 20), "env.name"),
             (c("rendezvous", 0), "env.horizon"),
+            (c("rendezvous", 100_001), "env.horizon"),
         ] {
             assert_eq!(bad.validate().unwrap_err().0, key, "{bad:?}");
         }

@@ -9,7 +9,8 @@ use std::path::Path;
 
 use super::palette::{gif_palette, TRANSPARENT};
 use super::{Frame, RenderError};
-use crate::files::atomic::write_atomic;
+use crate::files::atomic::write_atomic_try;
+use std::io::Write;
 
 /// How long the last frame of an episode ([`Frame::hold`]) stays up, unless the frame delay is
 /// longer.
@@ -20,69 +21,142 @@ const MIN_DELAY_MS: u32 = 20;
 
 /// Encode `frames` as a looping GIF, each shown `frame_delay_ms` (a held frame at least
 /// [`HOLD_MS`]), and write it to `path` via a temp file and a rename. Frames must all have the
-/// size of the first; errors name `path`.
+/// size of the first; errors name `path`. [`write_gif_with`] streams frames instead.
 pub fn write_gif(frames: &[Frame], path: &Path, frame_delay_ms: u32) -> Result<(), RenderError> {
-    let first = frames.first().ok_or_else(|| RenderError::NoFrames {
-        path: path.to_path_buf(),
-    })?;
-    let (w, h) = (first.image.width(), first.image.height());
-    let too_large = |_| RenderError::TooLarge {
-        path: path.to_path_buf(),
-        width: w,
-        height: h,
-    };
-    let (w16, h16) = (
-        u16::try_from(w).map_err(too_large)?,
-        u16::try_from(h).map_err(too_large)?,
-    );
-    if let Some((index, f)) = frames
-        .iter()
-        .enumerate()
-        .find(|(_, f)| (f.image.width(), f.image.height()) != (w, h))
-    {
-        return Err(RenderError::SizeMismatch {
-            path: path.to_path_buf(),
-            index,
-            got: (f.image.width(), f.image.height()),
-            expected: (w, h),
-        });
-    }
-    let encode = |source| RenderError::Encode {
+    write_gif_with(path, frame_delay_ms, |gif| {
+        frames.iter().try_for_each(|f| gif.push(f))
+    })
+}
+
+/// Write a GIF to `path` whose frames `fill` pushes one at a time ([`GifWriter::push`]), so only
+/// the previous frame is kept: a rollout of many episodes or a large grid takes the memory of
+/// two frames, not of every frame. `path` is replaced (atomically) only if `fill` succeeds and
+/// pushed at least one frame; `fill`'s value is returned.
+pub fn write_gif_with<T>(
+    path: &Path,
+    frame_delay_ms: u32,
+    fill: impl FnOnce(&mut GifWriter<'_>) -> Result<T, RenderError>,
+) -> Result<T, RenderError> {
+    let io_error = |source| RenderError::Io {
         path: path.to_path_buf(),
         source,
     };
-
-    let mut bytes = Vec::new();
-    {
-        let mut enc = gif::Encoder::new(&mut bytes, w16, h16, &gif_palette()).map_err(encode)?;
-        enc.set_repeat(gif::Repeat::Infinite).map_err(encode)?;
-        let mut prev: Option<&[u8]> = None;
-        for f in frames {
-            let pixels = f.image.pixels();
-            let ms = if f.hold {
-                frame_delay_ms.max(HOLD_MS)
-            } else {
-                frame_delay_ms.max(MIN_DELAY_MS)
+    write_atomic_try(
+        path,
+        |out| {
+            let mut gif = GifWriter {
+                out: Some(out),
+                encoder: None,
+                previous: Vec::new(),
+                size: (0, 0),
+                frames: 0,
+                frame_delay_ms,
+                path,
             };
-            let delay = u16::try_from(ms.div_ceil(10)).unwrap_or(u16::MAX);
-            let frame = match prev {
-                None => gif::Frame {
+            let value = fill(&mut gif)?;
+            gif.finish()?;
+            Ok(value)
+        },
+        io_error,
+    )
+}
+
+/// A GIF being written frame by frame ([`write_gif_with`]).
+pub struct GifWriter<'a> {
+    /// The file, until the first frame sizes the encoder.
+    out: Option<&'a mut dyn Write>,
+    encoder: Option<gif::Encoder<&'a mut dyn Write>>,
+    /// The last frame's pixels: the next frame stores only what changed.
+    previous: Vec<u8>,
+    /// Frame 0's (width, height).
+    size: (usize, usize),
+    frames: usize,
+    frame_delay_ms: u32,
+    path: &'a Path,
+}
+
+impl GifWriter<'_> {
+    /// Encode one frame. It must have the size of the first ([`RenderError::SizeMismatch`]);
+    /// the first must fit a GIF ([`RenderError::TooLarge`]).
+    pub fn push(&mut self, f: &Frame) -> Result<(), RenderError> {
+        let path = self.path;
+        let encode = |source| RenderError::Encode {
+            path: path.to_path_buf(),
+            source,
+        };
+        let (w, h) = (f.image.width(), f.image.height());
+        let pixels = f.image.pixels();
+        let ms = if f.hold {
+            self.frame_delay_ms.max(HOLD_MS)
+        } else {
+            self.frame_delay_ms.max(MIN_DELAY_MS)
+        };
+        let delay = u16::try_from(ms.div_ceil(10)).unwrap_or(u16::MAX);
+        match (&mut self.encoder, self.out.take()) {
+            (None, Some(out)) => {
+                let too_large = |_| RenderError::TooLarge {
+                    path: path.to_path_buf(),
+                    width: w,
+                    height: h,
+                };
+                let (w16, h16) = (
+                    u16::try_from(w).map_err(too_large)?,
+                    u16::try_from(h).map_err(too_large)?,
+                );
+                let mut enc = gif::Encoder::new(out, w16, h16, &gif_palette()).map_err(encode)?;
+                enc.set_repeat(gif::Repeat::Infinite).map_err(encode)?;
+                enc.write_frame(&gif::Frame {
                     width: w16,
                     height: h16,
                     buffer: Cow::Borrowed(pixels),
                     delay,
                     ..gif::Frame::default()
-                },
-                Some(before) => changed_patch(before, pixels, w, delay),
-            };
-            enc.write_frame(&frame).map_err(encode)?;
-            prev = Some(pixels);
+                })
+                .map_err(encode)?;
+                self.encoder = Some(enc);
+                self.size = (w, h);
+                self.previous = pixels.to_vec();
+            }
+            (Some(enc), _) => {
+                if (w, h) != self.size {
+                    return Err(RenderError::SizeMismatch {
+                        path: path.to_path_buf(),
+                        index: self.frames,
+                        got: (w, h),
+                        expected: self.size,
+                    });
+                }
+                enc.write_frame(&changed_patch(&self.previous, pixels, w, delay))
+                    .map_err(encode)?;
+                self.previous.copy_from_slice(pixels);
+            }
+            (None, None) => unreachable!("the file is handed to the encoder with frame 0"),
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Frames pushed so far.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Write the GIF's trailer; [`RenderError::NoFrames`] if nothing was pushed.
+    fn finish(self) -> Result<(), RenderError> {
+        let path = self.path;
+        match self.encoder {
+            None => Err(RenderError::NoFrames {
+                path: path.to_path_buf(),
+            }),
+            Some(enc) => enc
+                .into_inner()
+                .map(drop)
+                .map_err(|source| RenderError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }),
         }
     }
-    write_atomic(path, &bytes).map_err(|source| RenderError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
 }
 
 /// The part of `now` that differs from `before` (both `width` wide), as a sub-frame whose

@@ -32,8 +32,8 @@ mod record;
 pub mod rollout;
 
 pub use crate::draw::{canvas, palette, Canvas, Colour};
-pub use gif_out::{write_gif, HOLD_MS};
-pub use record::record_episode;
+pub use gif_out::{write_gif, write_gif_with, GifWriter, HOLD_MS};
+pub use record::{play_episode, record_episode};
 
 /// One drawn primitive step of an episode.
 #[derive(Debug, Clone, PartialEq)]

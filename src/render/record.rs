@@ -5,7 +5,7 @@ use crate::envs::{EnvRng, MacroEnv};
 
 /// Reset `env`, then let `choose` fill the actions and step until the episode ends, drawing a
 /// frame after the reset and after every step (so an episode of T steps gives T + 1 frames; the
-/// last is marked [`Frame::hold`]).
+/// last is marked [`Frame::hold`]). Keeps every frame: [`play_episode`] streams them instead.
 ///
 /// `choose(env, actions)` sees the state before each step and writes `actions[i]` for every free
 /// agent ([`MacroEnv::is_free`]); entries of busy agents are ignored by the environment (spec
@@ -16,13 +16,29 @@ use crate::envs::{EnvRng, MacroEnv};
 pub fn record_episode<E: MacroEnv>(
     env: &mut E,
     rng: &mut EnvRng,
-    mut choose: impl FnMut(&E, &mut [usize]),
+    choose: impl FnMut(&E, &mut [usize]),
 ) -> Result<Vec<Frame>, RenderError> {
+    let mut frames = Vec::new();
+    play_episode(env, rng, choose, |frame| {
+        frames.push(frame);
+        Ok(())
+    })?;
+    Ok(frames)
+}
+
+/// [`record_episode`] that hands each frame to `each` as soon as the next one is drawn (the last
+/// once it is known to be last, marked [`Frame::hold`]) instead of keeping them, so memory stays
+/// at two frames whatever the episode's length. Returns the undiscounted team return.
+pub fn play_episode<E: MacroEnv>(
+    env: &mut E,
+    rng: &mut EnvRng,
+    mut choose: impl FnMut(&E, &mut [usize]),
+    mut each: impl FnMut(Frame) -> Result<(), RenderError>,
+) -> Result<f64, RenderError> {
     env.reset(rng);
     let mut actions = vec![0usize; env.n_agents()];
     let mut team_return = 0.0;
-    let mut frames = Vec::with_capacity(env.horizon() + 1);
-    frames.push(Frame::capture(env, team_return)?);
+    let mut pending = Frame::capture(env, team_return)?;
     for _ in 0..env.horizon() {
         choose(env, &mut actions);
         let out = env.step(&actions, rng).map_err(|source| RenderError::Env {
@@ -30,15 +46,17 @@ pub fn record_episode<E: MacroEnv>(
             source,
         })?;
         team_return += out.reward;
-        frames.push(Frame::capture(env, team_return)?);
+        each(std::mem::replace(
+            &mut pending,
+            Frame::capture(env, team_return)?,
+        ))?;
         if out.done {
             break;
         }
     }
-    if let Some(last) = frames.last_mut() {
-        last.hold = true;
-    }
-    Ok(frames)
+    pending.hold = true;
+    each(pending)?;
+    Ok(team_return)
 }
 
 impl Frame {

@@ -8,7 +8,7 @@ use crate::envs::MacroEnv;
 use crate::experiment::seeds::{stream, Role};
 use crate::nn::QNet;
 use crate::policy_files::{read_policy_files, NetRole, PolicyError};
-use crate::render::{record_episode, write_gif, RenderError};
+use crate::render::{play_episode, write_gif_with, RenderError};
 use std::path::Path;
 
 /// Why a rollout could not be rendered.
@@ -75,15 +75,20 @@ pub fn render_run(
         .map_err(|m| RolloutError::NetSize(run_dir.display().to_string(), m))?;
     let mut rng = stream(run.manifest.run.seed, Role::EvalEnv);
     let mut scratch = ActScratch::new(&env);
-    let mut frames = Vec::new();
-    let mut returns = Vec::new();
-    for _ in 0..episodes.max(1) {
-        let mut actor = GreedyActor::new(policy);
-        let episode = record_episode(&mut env, &mut rng, |e, a| actor.choose(e, &mut scratch, a))?;
-        returns.push(episode.last().map_or(0.0, |f| f.team_return));
-        frames.extend(episode);
-    }
-    write_gif(&frames, out, frame_ms)?;
+    // Frames go to the file as they are drawn: memory is two frames, whatever the episodes.
+    let returns = write_gif_with(out, frame_ms, |gif| {
+        (0..episodes.max(1))
+            .map(|_| {
+                let mut actor = GreedyActor::new(policy);
+                play_episode(
+                    &mut env,
+                    &mut rng,
+                    |e, a| actor.choose(e, &mut scratch, a),
+                    |frame| gif.push(&frame),
+                )
+            })
+            .collect::<Result<Vec<f64>, RenderError>>()
+    })?;
     Ok(returns)
 }
 

@@ -298,7 +298,11 @@ impl Experiment {
         check_experiment_name(&name)
             .map_err(|source| ConfigError::BadName { path: p(), source })?;
         let seeds = match (&overrides.seeds, file.seeds) {
-            (Some(s), _) => s.clone(),
+            (Some(s), _) => {
+                // Checked here too: a library or Python caller fills `Overrides` directly.
+                check_seed_list(s).map_err(|source| ConfigError::Seeds { path: p(), source })?;
+                s.clone()
+            }
             (None, Some(SeedsField::Text(t))) => {
                 parse_seeds(&t).map_err(|source| ConfigError::Seeds { path: p(), source })?
             }
@@ -683,12 +687,15 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
     let config: RunSettings = toml::Value::Table(table.clone())
         .try_into()
         .map_err(|e: toml::de::Error| bad("config", e.message().to_string()))?;
+    // Bad values first, so `l_rate = nan` is named as a bad value, not as an unused key.
+    validate(&config.config, method, config.env.horizon())
+        .map_err(|(key, message)| bad(key, message))?;
     // A domain key the chosen domain does not use (`grid_dim` for OSD_S_4, `tb_m_noisy` for
     // BP_MA) would be dropped and recorded as its default: refuse it instead of ignoring it.
     // (`env_name` itself is recorded by its reference name even when written as an alias.)
     let recorded = toml::Table::try_from(&config).expect("RunSettings serializes to a table");
     for (key, value) in &table {
-        if key != "env_name" && recorded.get(key) != Some(value) {
+        if key != "env_name" && !recorded.get(key).is_some_and(|r| same_value(r, value)) {
             return Err(bad(
                 key,
                 format!(
@@ -698,9 +705,16 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
             ));
         }
     }
-    validate(&config.config, method, config.env.horizon())
-        .map_err(|(key, message)| bad(key, message))?;
     Ok(config)
+}
+
+/// Whether a recorded value is the one given: equal, or both the same NaN (which `==` never
+/// calls equal, so a NaN would read as a key the domain drops).
+fn same_value(recorded: &toml::Value, given: &toml::Value) -> bool {
+    match (recorded, given) {
+        (toml::Value::Float(a), toml::Value::Float(b)) => a.to_bits() == b.to_bits() || a == b,
+        _ => recorded == given,
+    }
 }
 
 /// Range checks that types cannot express, for a domain whose episodes last at most `horizon`
@@ -974,6 +988,35 @@ mod tests {
         );
         let err = parse(wtd, &["tb_m_noisy=-0.5"]).unwrap_err().to_string();
         assert!(err.contains("`tb_m_noisy`"), "{err}");
+    }
+
+    #[test]
+    fn a_nan_is_a_bad_value_not_an_unused_key() {
+        for (set, key) in [
+            ("l_rate=nan", "`l_rate`"),
+            ("discount=nan", "`discount`"),
+            ("eps_end=nan", "`eps_end`"),
+        ] {
+            let err = parse("", &[set]).unwrap_err().to_string();
+            assert!(
+                err.contains(key) && !err.contains("does not use"),
+                "{set}: {err}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_seed_beyond_the_largest_is_refused_when_the_config_is_read() {
+        let err = parse("seeds = [0, 9223372036854775807]", &[]);
+        assert!(err.is_ok(), "{err:?}");
+        let o = Overrides {
+            seeds: Some(vec![9_223_372_036_854_775_808]),
+            ..Overrides::default()
+        };
+        let err = Experiment::parse("", Path::new("e.toml"), "e", &o)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("9223372036854775808"), "{err}");
     }
 
     #[test]

@@ -11,10 +11,14 @@ use crate::algos::hyper::{AcConfig, ValueConfig};
 pub const MAX_RUNS: usize = 100_000;
 /// Seeds in one `--seeds` value or `seeds` list.
 pub const MAX_SEEDS: usize = 10_000;
+/// Largest run seed: a TOML integer is a signed 64-bit one, and every run records its seed in
+/// its `config.toml`.
+pub const MAX_SEED: u64 = i64::MAX as u64;
 /// Box Pushing grid side (paper: 10 and 30); the domain checks it (`envs/box_pushing`).
 pub use crate::envs::box_pushing::MAX_GRID_DIM;
-/// Episode horizon in primitive steps, `env_terminate_step` (paper: 100 to 200).
-pub const MAX_HORIZON: usize = 100_000;
+/// Episode horizon in primitive steps, `env_terminate_step` (paper: 100 to 200); every domain
+/// spec is held to it (`envs::domain`).
+pub use crate::envs::domain::MAX_HORIZON;
 /// Window length `trace_len` and minimum kept records `sub_trace_len` (paper: 15 and 45).
 pub const MAX_TRACE_LEN: usize = 100_000;
 /// Sequences per batch, `batch_size` (paper: 128 and 16).

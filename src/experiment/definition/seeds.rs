@@ -1,6 +1,6 @@
 //! Run seeds: the `--seeds` syntax, and one random stream per role derived from a run's seed.
 
-use crate::experiment::limits::MAX_SEEDS;
+use crate::experiment::limits::{MAX_SEED, MAX_SEEDS};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -45,6 +45,9 @@ pub enum SeedsError {
     /// More seeds than `MAX_SEEDS`: the text and the count.
     #[error("seeds `{0}`: {1} seeds, at most {max} allowed", max = crate::experiment::limits::MAX_SEEDS)]
     TooMany(String, u128),
+    /// A seed beyond [`MAX_SEED`]: the text and the seed.
+    #[error("seeds `{0}`: seed {1} is beyond the largest supported seed, {max} (runs record their seed as a TOML integer)", max = MAX_SEED)]
+    OutOfRange(String, u64),
 }
 
 /// Parse `a..b` (Rust range, end exclusive), `a..=b`, a single seed, or a comma list.
@@ -97,6 +100,9 @@ fn check_seed_list_named(seeds: &[u64], text: &str) -> Result<(), SeedsError> {
     if seeds.len() > MAX_SEEDS {
         return Err(SeedsError::TooMany(text.to_string(), seeds.len() as u128));
     }
+    if let Some(&seed) = seeds.iter().find(|&&s| s > MAX_SEED) {
+        return Err(SeedsError::OutOfRange(text.to_string(), seed));
+    }
     let mut sorted = seeds.to_vec();
     sorted.sort_unstable();
     if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
@@ -116,6 +122,24 @@ mod tests {
         assert_eq!(parse_seeds("2..=3").unwrap(), vec![2, 3]);
         assert_eq!(parse_seeds("7, 1,3").unwrap(), vec![7, 1, 3]);
         assert_eq!(parse_seeds("5").unwrap(), vec![5]);
+    }
+
+    #[test]
+    fn seeds_beyond_the_largest_are_refused_when_parsed() {
+        assert_eq!(parse_seeds(&MAX_SEED.to_string()).unwrap(), vec![MAX_SEED]);
+        for text in [
+            "18446744073709551615",
+            "9223372036854775807..=9223372036854775808",
+        ] {
+            assert!(
+                matches!(parse_seeds(text), Err(SeedsError::OutOfRange(_, s)) if s > MAX_SEED),
+                "{text}"
+            );
+        }
+        assert!(matches!(
+            check_seed_list(&[0, u64::MAX]),
+            Err(SeedsError::OutOfRange(_, u64::MAX))
+        ));
     }
 
     #[test]
@@ -143,8 +167,8 @@ mod tests {
             );
         }
         assert_eq!(
-            parse_seeds("18446744073709551615..=18446744073709551615").unwrap(),
-            vec![u64::MAX]
+            parse_seeds("9223372036854775807..=9223372036854775807").unwrap(),
+            vec![MAX_SEED]
         );
         assert_eq!(
             parse_seeds(&format!("0..{MAX_SEEDS}")).unwrap().len(),

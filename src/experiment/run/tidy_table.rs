@@ -170,26 +170,14 @@ pub fn write_tidy_table(root: &Path, out: &mut dyn Write) -> Result<(usize, usiz
 
 /// Write the table to the file `path`, atomically (a reader never sees half a table).
 pub fn write_tidy_file(root: &Path, path: &Path) -> Result<(usize, usize), TidyError> {
-    let mut result = None;
-    let written = crate::files::atomic::write_atomic_with(path, |f| {
-        let r = write_tidy_table(root, f);
-        let failed = r.is_err();
-        result = Some(r);
-        if failed {
-            Err(std::io::Error::other("not written"))
-        } else {
-            Ok(())
-        }
-    });
-    match (result, written) {
-        (Some(Err(e)), _) => Err(e),
-        (_, Err(source)) => Err(TidyError::Write {
+    crate::files::atomic::write_atomic_try(
+        path,
+        |f| write_tidy_table(root, f),
+        |source| TidyError::Write {
             path: path.to_path_buf(),
             source,
-        }),
-        (Some(Ok(counts)), Ok(())) => Ok(counts),
-        (None, Ok(())) => unreachable!("write_atomic_with calls the writer before renaming"),
-    }
+        },
+    )
 }
 
 /// The metrics of one run of [`tidy_runs`] (its `metrics.csv`, else `metrics.csv.gz`): what

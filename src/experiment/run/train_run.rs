@@ -33,8 +33,11 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// What a run directory's `config.toml` holds: who ran and with which hyperparameters.
+///
+/// Reading one checks it as `train` checks a config ([`RunManifest::check`]), so a tampered file
+/// is refused by every reader (resume, `audit`, checkpoint loading) before anything is sized by it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "RecordedManifest")]
 pub struct RunManifest {
     /// The experiment's name.
     pub experiment: String,
@@ -51,7 +54,60 @@ pub struct RunManifest {
     pub provenance: Option<Provenance>,
 }
 
+/// `config.toml` as parsed, before [`RunManifest::check`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RecordedManifest {
+    experiment: String,
+    method: Method,
+    variant: String,
+    seed: u64,
+    config: RunSettings,
+    #[serde(default)]
+    provenance: Option<Provenance>,
+}
+
+impl TryFrom<RecordedManifest> for RunManifest {
+    type Error = String;
+
+    fn try_from(r: RecordedManifest) -> Result<Self, String> {
+        let manifest = RunManifest {
+            experiment: r.experiment,
+            method: r.method,
+            variant: r.variant,
+            seed: r.seed,
+            config: r.config,
+            provenance: r.provenance,
+        };
+        manifest
+            .check()
+            .map_err(|(key, why)| format!("`{key}`: {why} (train refuses this config)"))?;
+        Ok(manifest)
+    }
+}
+
 impl RunManifest {
+    /// The checks `train` makes before it runs a config: every key in range for the method
+    /// ([`crate::experiment::config::validate`]) and the seed at most
+    /// [`MAX_SEED`](crate::experiment::limits::MAX_SEED). Returns the key and why.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if self.seed > crate::experiment::limits::MAX_SEED {
+            return Err((
+                "seed",
+                format!(
+                    "must be at most {}, got {}",
+                    crate::experiment::limits::MAX_SEED,
+                    self.seed
+                ),
+            ));
+        }
+        crate::experiment::config::validate(
+            &self.config.config,
+            self.method,
+            self.config.env.horizon(),
+        )
+    }
+
     /// The manifest of `spec` as run by this build on this machine.
     pub fn for_spec(spec: &RunSpec) -> Self {
         RunManifest {

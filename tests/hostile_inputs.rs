@@ -1,0 +1,517 @@
+//! Issue 29: hostile inputs through the command line. Outputs onto things that are not regular
+//! files, inputs that are not regular files or never end, a gzip bomb, crafted metadata checked
+//! against train's limits by every reader, sizes from flags bounded like a config's, memory that
+//! does not grow with the work, and messages that name the real problem.
+
+mod common;
+
+use common::{ok, BIN};
+use std::os::unix::fs::FileTypeExt;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::sync::OnceLock;
+use std::time::Duration;
+
+/// A tiny Box Pushing run: a second of training.
+const TINY: &str = r#"
+name = "tiny"
+methods = ["our1"]
+seeds = "1..2"
+
+[params]
+env_name = "BP_MA"
+grid_dim = 8
+env_terminate_step = 20
+total_epi = 20
+eps_l_d_steps = 10
+batch_size = 8
+replay_buffer_size = 500
+eval_freq = 10
+checkpoint_freq = 10
+"#;
+
+/// One trained tiny run shared by the tests of this file (read-only: tests copy it to tamper).
+fn tiny_run() -> &'static Path {
+    static RUN: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, run) = RUN.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("tiny.toml");
+        std::fs::write(&config, TINY).unwrap();
+        let results = dir.path().join("results");
+        let out = Command::new(BIN)
+            .args(["train", "--quiet", "--no-plot", "--config"])
+            .arg(&config)
+            .arg("--out")
+            .arg(&results)
+            .output()
+            .unwrap();
+        ok(&out);
+        let run = results.join("tiny/our1/seed-1");
+        (dir, run)
+    });
+    run
+}
+
+/// A copy of the tiny run in `dir` (its results tree `dir/results/tiny/our1/seed-1`).
+fn copy_of_tiny_run(dir: &Path) -> PathBuf {
+    let run = dir.join("results/tiny/our1/seed-1");
+    copy_dir(tiny_run(), &run);
+    run
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// `macdec args`, killed (and the test failed) if it has not ended within `limit`; with
+/// `max_memory` bytes of address space at most, so a command that would allocate more fails.
+fn macdec_within(args: &[&str], limit: Duration, max_memory: Option<u64>) -> Output {
+    let mut cmd = Command::new(BIN);
+    cmd.args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    if let Some(bytes) = max_memory {
+        // SAFETY: setrlimit is async-signal-safe; nothing else runs between fork and exec.
+        unsafe {
+            cmd.pre_exec(move || {
+                let limit = libc::rlimit {
+                    rlim_cur: bytes,
+                    rlim_max: bytes,
+                };
+                if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+    }
+    let child = cmd.spawn().unwrap();
+    // A watchdog kills the child at the limit, while this thread drains its output (a child
+    // writing more than a pipe holds would otherwise never end).
+    let pid = child.id() as libc::pid_t;
+    let (done, done_rx) = std::sync::mpsc::channel::<()>();
+    let watchdog = std::thread::spawn(move || {
+        let killed = done_rx.recv_timeout(limit).is_err();
+        if killed {
+            // SAFETY: plain kill(2) of our own child, not yet reaped (the main thread is
+            // still waiting for it when the timeout fires).
+            unsafe { libc::kill(pid, libc::SIGKILL) };
+        }
+        killed
+    });
+    let out = child.wait_with_output().unwrap();
+    let _ = done.send(());
+    let killed = watchdog.join().unwrap();
+    assert!(
+        !killed,
+        "`macdec {}` still running after {limit:?}",
+        args.join(" ")
+    );
+    out
+}
+
+/// `macdec args` within 60 s.
+fn macdec(args: &[&str]) -> Output {
+    macdec_within(args, Duration::from_secs(60), None)
+}
+
+/// The failure message of a command that must fail cleanly (exit 1 or clap's 2, no panic, no
+/// abort).
+fn refused(out: &Output) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "expected a clean refusal, got {:?}: {err}",
+        out.status
+    );
+    assert!(
+        !err.contains("panicked") && !err.contains("memory allocation"),
+        "{err}"
+    );
+    err
+}
+
+fn mkfifo(path: &Path) {
+    let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn outputs_onto_fifos_devices_and_foreign_directories_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = tiny_run();
+    let fifo = dir.path().join("out.gif");
+    mkfifo(&fifo);
+    let err = refused(&macdec(&["render", "--run", s(run), "--out", s(&fifo)]));
+    assert!(err.contains("out.gif"), "{err}");
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+
+    // As root, renaming a GIF over /dev/null would have replaced the device.
+    let err = refused(&macdec(&["render", "--run", s(run), "--out", "/dev/null"]));
+    assert!(err.contains("/dev/null"), "{err}");
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+
+    // plot writes <out>/<experiment>.png: a FIFO there is refused, not opened.
+    let plots = dir.path().join("plots");
+    std::fs::create_dir(&plots).unwrap();
+    mkfifo(&plots.join("tiny.png"));
+    let results = run.parent().unwrap().parent().unwrap().parent().unwrap();
+    let err = refused(&macdec(&[
+        "plot",
+        "--results",
+        s(results),
+        "--out",
+        s(&plots),
+    ]));
+    assert!(err.contains("tiny.png"), "{err}");
+
+    // export and import --out: a FIFO, or a directory holding anything but policy files.
+    let err = refused(&macdec(&["export", "--run", s(run), "--out", s(&fifo)]));
+    assert!(err.contains("out.gif"), "{err}");
+    let foreign = dir.path().join("foreign");
+    std::fs::create_dir(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), "mine").unwrap();
+    refused(&macdec(&["export", "--run", s(run), "--out", s(&foreign)]));
+    let policy = run.join("policy");
+    let agents = format!(
+        "{},{}",
+        s(&policy.join("dec_agent_0.safetensors")),
+        s(&policy.join("dec_agent_1.safetensors"))
+    );
+    let err = refused(&macdec(&[
+        "import",
+        "--env",
+        "box-pushing",
+        "--grid",
+        "8",
+        "--horizon",
+        "20",
+        "--agents",
+        &agents,
+        "--out",
+        s(&foreign),
+    ]));
+    assert!(
+        err.contains("notes.txt") || err.contains("foreign"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("notes.txt")).unwrap(),
+        "mine"
+    );
+}
+
+#[test]
+fn inputs_that_are_not_regular_files_are_refused_without_waiting() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("input");
+    mkfifo(&fifo);
+    let quick = Duration::from_secs(20);
+    // Nothing ever writes to the FIFO: opening it for reading would block for ever.
+    for args in [
+        vec!["train", "--config", s(&fifo), "--out", s(dir.path())],
+        vec!["replay", "--actions", s(&fifo)],
+        vec!["replay", "--actions", "/dev/zero"],
+        vec!["train", "--config", "/dev/zero", "--out", s(dir.path())],
+        vec!["replay", "--actions", s(dir.path())],
+    ] {
+        let err = refused(&macdec_within(&args, quick, None));
+        assert!(err.contains("not a regular file"), "{args:?}: {err}");
+    }
+    // A policy whose description is a FIFO.
+    let policy = dir.path().join("policy");
+    copy_dir(&tiny_run().join("policy"), &policy);
+    std::fs::remove_file(policy.join("policy.json")).unwrap();
+    mkfifo(&policy.join("policy.json"));
+    let err = refused(&macdec_within(
+        &["eval", "--policy", s(&policy)],
+        quick,
+        None,
+    ));
+    assert!(err.contains("not a regular file"), "{err}");
+}
+
+#[test]
+fn a_gzip_bomb_in_a_results_tree_stops_at_the_bound() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let run = copy_of_tiny_run(dir.path());
+    std::fs::remove_file(run.join("metrics.csv")).unwrap();
+    // 600 MiB of zeros, about 600 KB compressed: beyond the 512 MiB bound on metrics.
+    let file = std::fs::File::create(run.join("metrics.csv.gz")).unwrap();
+    let mut gz = flate2::write::GzEncoder::new(file, flate2::Compression::fast());
+    let zeros = vec![b'0'; 1 << 20];
+    for _ in 0..600 {
+        gz.write_all(&zeros).unwrap();
+    }
+    gz.finish().unwrap();
+    let plots = dir.path().join("plots");
+    // Unbounded, the bomb took more than 4 GB; the bound keeps plot under 2 GiB of address space.
+    let out = macdec_within(
+        &[
+            "plot",
+            "--results",
+            s(&dir.path().join("results")),
+            "--out",
+            s(&plots),
+        ],
+        Duration::from_secs(120),
+        Some(2 << 30),
+    );
+    let err = refused(&out);
+    assert!(
+        err.contains("metrics.csv.gz") && err.contains("536870912"),
+        "{err}"
+    );
+}
+
+/// `policy.json` of a copy of the tiny run, edited by `edit`.
+fn tamper_policy(run: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
+    let path = run.join("policy/policy.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    edit(&mut v);
+    std::fs::write(&path, v.to_string()).unwrap();
+}
+
+#[test]
+fn a_crafted_policy_is_refused_by_every_reader_before_it_sizes_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = copy_of_tiny_run(dir.path());
+    // Within the file's byte bound, far beyond train's horizon limit: a mock robot team would
+    // play it for ever and render would allocate 64 PB of frames.
+    tamper_policy(&run, |v| {
+        v["env"]["horizon"] = 1_000_000_000_000_000u64.into()
+    });
+    let policy = run.join("policy");
+    let out_dir = dir.path().join("export");
+    let gif = dir.path().join("x.gif");
+    for args in [
+        vec!["export", "--run", s(&run), "--out", s(&out_dir)],
+        vec!["render", "--run", s(&run), "--out", s(&gif)],
+        vec!["eval", "--policy", s(&policy)],
+        vec!["deploy", "--policy", s(&policy), "--mock"],
+        vec!["robot", "--policy", s(&policy), "--agent", "0"],
+    ] {
+        let out = macdec_within(&args, Duration::from_secs(30), Some(4 << 30));
+        let err = refused(&out);
+        assert!(
+            err.contains("env_terminate_step") && err.contains("at most 100000"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!gif.exists() && !out_dir.exists());
+
+    // A custom domain's horizon is held to the same limit.
+    let run = copy_of_tiny_run(&dir.path().join("custom"));
+    tamper_policy(
+        &run,
+        |v| v["env"] = serde_json::json!({"env": "custom", "name": "corridor", "horizon": 100_001}),
+    );
+    let err = refused(&macdec(&[
+        "robot",
+        "--policy",
+        s(&run.join("policy")),
+        "--agent",
+        "0",
+    ]));
+    assert!(err.contains("env.horizon"), "{err}");
+}
+
+#[test]
+fn audit_refuses_a_committed_config_that_train_would_refuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = copy_of_tiny_run(dir.path());
+    let config = run.join("config.toml");
+    let text = std::fs::read_to_string(&config).unwrap();
+    for (from, to, key) in [
+        ("batch_size = 8", "batch_size = 0", "`batch_size`"),
+        ("l_rate = 0.001", "l_rate = nan", "`l_rate`"),
+        ("total_epi = 20", "total_epi = 200000000", "`total_epi`"),
+    ] {
+        assert!(text.contains(from), "{text}");
+        std::fs::write(&config, text.replace(from, to)).unwrap();
+        let out = macdec(&["audit", "--run", s(&run)]);
+        let all = format!("{}{}", String::from_utf8_lossy(&out.stdout), refused(&out));
+        assert!(
+            all.contains(key) && all.contains("train refuses") && !all.contains("identical"),
+            "{to}: {all}"
+        );
+    }
+}
+
+#[test]
+fn sizes_from_flags_obey_the_config_limits() {
+    let run = tiny_run();
+    let policy = run.join("policy");
+    let agents = format!(
+        "{},{}",
+        s(&policy.join("dec_agent_0.safetensors")),
+        s(&policy.join("dec_agent_1.safetensors"))
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("imported");
+    for (args, flag) in [
+        (
+            vec!["render", "--run", s(run), "--episodes", "100001"],
+            "--episodes",
+        ),
+        (
+            vec!["eval", "--policy", s(&policy), "--episodes", "100001"],
+            "--episodes",
+        ),
+        (
+            vec![
+                "import",
+                "--env",
+                "box-pushing",
+                "--grid",
+                "8",
+                "--horizon",
+                "100001",
+                "--agents",
+                &agents,
+                "--out",
+                s(&out),
+            ],
+            "--horizon",
+        ),
+        (
+            vec![
+                "import",
+                "--env",
+                "box-pushing",
+                "--grid",
+                "1001",
+                "--horizon",
+                "20",
+                "--agents",
+                &agents,
+                "--out",
+                s(&out),
+            ],
+            "--grid",
+        ),
+        (
+            vec![
+                "robot",
+                "--policy",
+                s(&policy),
+                "--agent",
+                "0",
+                "--max-line-bytes",
+                "99999999999",
+            ],
+            "--max-line-bytes",
+        ),
+    ] {
+        let err = refused(&macdec(&args));
+        assert!(
+            err.contains(flag) && err.contains("at most"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn render_keeps_two_frames_not_every_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let gif = dir.path().join("many.gif");
+    // 300 episodes of 21 frames of about 260 x 300 pixels: 500 MB kept, a few MB streamed.
+    let out = macdec_within(
+        &[
+            "render",
+            "--run",
+            s(tiny_run()),
+            "--episodes",
+            "300",
+            "--out",
+            s(&gif),
+        ],
+        Duration::from_secs(120),
+        Some(256 << 20),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("300 episode(s)") && err.contains("mean"),
+        "{err}"
+    );
+    let bytes = std::fs::read(&gif).unwrap();
+    assert!(bytes.starts_with(b"GIF89a") && bytes.ends_with(b";"));
+}
+
+#[test]
+fn replay_verbose_on_the_largest_grid_stays_small() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("big.json");
+    let steps = vec![[7, 7]; 30];
+    std::fs::write(
+        &file,
+        serde_json::json!({"env": "box-pushing", "grid": 1000, "horizon": 100000, "steps": steps})
+            .to_string(),
+    )
+    .unwrap();
+    let out = macdec_within(
+        &["replay", "--actions", s(&file), "--verbose"],
+        Duration::from_secs(60),
+        Some(512 << 20),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 31);
+}
+
+#[test]
+fn a_nan_rate_and_a_seed_beyond_the_largest_are_named_before_any_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("results");
+    let err = refused(&macdec(&[
+        "train",
+        "--set",
+        "l_rate=nan",
+        "--out",
+        s(&results),
+    ]));
+    assert!(
+        err.contains("`l_rate`")
+            && err.contains("positive number")
+            && !err.contains("does not use"),
+        "{err}"
+    );
+    let err = refused(&macdec(&[
+        "train",
+        "--seeds",
+        "9223372036854775808",
+        "--out",
+        s(&results),
+    ]));
+    assert!(
+        err.contains("9223372036854775808") && err.contains("largest"),
+        "{err}"
+    );
+    assert!(!results.exists(), "no run may start");
+}
