@@ -25,7 +25,9 @@ use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::{
     read_in_tree, read_text_in_tree, MAX_CHECKPOINT_BYTES, MAX_TEXT_BYTES,
 };
-use crate::files::links::{explain_no_follow, open_options_no_follow};
+use crate::files::links::{
+    check_real_dirs, create_real_dirs, explain_no_follow, open_options_no_follow,
+};
 use crate::policy_files::{
     write_actor_policy_files, write_policy_files, AgentLayout, NetRole, PolicyError, RunInfo,
 };
@@ -214,9 +216,18 @@ pub fn existing_run(spec: &RunSpec, dir: &Path) -> Result<Existing, RunError> {
 /// Take the run's lock, creating its directory: two processes training one run (a campaign
 /// started twice, a Slurm task beside a local run) would interleave their checkpoints and
 /// metrics. The lock is the operating system's, so a killed process never leaves it held; the
-/// file itself stays (it is empty). Only a real directory is accepted: through a symlink the run
-/// would write outside the results root.
-fn lock_run_dir(dir: &Path) -> Result<std::fs::File, RunError> {
+/// file itself stays (it is empty). Every directory from the results root down to the run is
+/// created or accepted only as a real directory, and checked again once the lock is held, so a
+/// link swapped in by someone else who can write to a shared tree is refused rather than followed
+/// out of the results root.
+fn lock_run_dir(spec: &RunSpec, dir: &Path) -> Result<std::fs::File, RunError> {
+    let root = results_root_of(spec, dir);
+    let not_real = |e: std::io::Error| {
+        io(
+            dir,
+            format!("{e}; a run directory and the directories above it must be real directories"),
+        )
+    };
     match std::fs::symlink_metadata(dir) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
         Err(e) => return Err(io(dir, e)),
@@ -226,7 +237,7 @@ fn lock_run_dir(dir: &Path) -> Result<std::fs::File, RunError> {
             "is not a directory (a symlink or a file); a run directory must be a real directory",
         )),
     }
-    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    create_real_dirs(root, dir).map_err(not_real)?;
     let path = dir.join(LOCK);
     // Never through a link planted at `.lock`: creating or truncating its target elsewhere.
     let file = open_options_no_follow()
@@ -236,12 +247,28 @@ fn lock_run_dir(dir: &Path) -> Result<std::fs::File, RunError> {
         .open(&path)
         .map_err(|e| io(&path, explain_no_follow(&path, e)))?;
     match file.try_lock() {
-        Ok(()) => Ok(file),
-        Err(std::fs::TryLockError::WouldBlock) => Err(RunError::Busy {
-            dir: dir.to_path_buf(),
-        }),
-        Err(std::fs::TryLockError::Error(e)) => Err(io(&path, e)),
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            return Err(RunError::Busy {
+                dir: dir.to_path_buf(),
+            })
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(io(&path, e)),
     }
+    check_real_dirs(root, dir).map_err(not_real)?;
+    Ok(file)
+}
+
+/// The results root `dir` was made from (`<root>/<experiment>/<curve>/seed-<k>`), or its parent
+/// when it is not a run directory of that layout (an audit's scratch run).
+fn results_root_of<'a>(spec: &RunSpec, dir: &'a Path) -> &'a Path {
+    let relative = spec.dir(Path::new(""));
+    let depth = if dir.ends_with(&relative) {
+        relative.components().count()
+    } else {
+        1
+    };
+    dir.ancestors().nth(depth).unwrap_or(Path::new(""))
 }
 
 /// How long a process that finds a run locked waits for the holder's `config.toml`: the holder
@@ -497,7 +524,7 @@ pub fn train_run_until(
     stop: &StopSignal,
 ) -> Result<RunEnd, RunError> {
     // Held until this function returns, whatever the outcome.
-    let _lock = match lock_run_dir(dir) {
+    let _lock = match lock_run_dir(spec, dir) {
         Err(RunError::Busy { .. }) if !force => return held_elsewhere(spec, dir),
         lock => lock?,
     };
@@ -555,4 +582,54 @@ pub fn train_run_until(
     let marker = dir.join(FINISHED);
     write_atomic(&marker, b"").map_err(|e| io(&marker, e))?;
     Ok(RunEnd::Trained)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::config::{Experiment, Overrides};
+
+    fn spec() -> RunSpec {
+        let e = Experiment::parse("", Path::new("e.toml"), "e", &Overrides::default()).unwrap();
+        e.runs().unwrap().remove(0)
+    }
+
+    #[test]
+    fn the_results_root_is_found_from_the_run_layout() {
+        let spec = spec();
+        let root = Path::new("/data/results");
+        assert_eq!(results_root_of(&spec, &spec.dir(root)), root);
+        assert_eq!(
+            results_root_of(&spec, &spec.dir(Path::new(""))),
+            Path::new("")
+        );
+        assert_eq!(
+            results_root_of(&spec, Path::new("/tmp/scratch/run")),
+            Path::new("/tmp/scratch")
+        );
+    }
+
+    #[test]
+    fn the_lock_refuses_a_link_anywhere_below_the_results_root() {
+        let t = tempfile::tempdir().unwrap();
+        let spec = spec();
+        let root = t.path().join("results");
+        let dir = spec.dir(&root);
+        let outside = t.path().join("outside");
+        std::fs::create_dir_all(&outside).unwrap();
+        // The curve directory is a link out of the tree: nothing is created through it.
+        let curve = dir.parent().unwrap();
+        std::fs::create_dir_all(curve.parent().unwrap()).unwrap();
+        std::os::unix::fs::symlink(&outside, curve).unwrap();
+        let err = lock_run_dir(&spec, &dir).unwrap_err().to_string();
+        assert!(err.contains("symbolic link"), "{err}");
+        assert_eq!(std::fs::read_dir(&outside).unwrap().count(), 0);
+        // A real tree locks, and a second lock of the same run is busy.
+        std::fs::remove_file(curve).unwrap();
+        let _held = lock_run_dir(&spec, &dir).unwrap();
+        assert!(matches!(
+            lock_run_dir(&spec, &dir),
+            Err(RunError::Busy { .. })
+        ));
+    }
 }
