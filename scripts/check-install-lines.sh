@@ -114,6 +114,12 @@ layer() {
     mount --bind "$check_dir/src.git" "$root/mnt/macdec.git"
     mount -o remount,bind,ro "$root/mnt/macdec.git"
     cp /etc/resolv.conf "$root/etc/resolv.conf"
+    # A site whose HTTPS goes through its own CA lists it here; every machine of the site has it,
+    # so the fresh one does too (the README's ca-certificates install then trusts it).
+    if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null; then
+        mkdir -p "$root/usr/local/share/ca-certificates"
+        cp /usr/local/share/ca-certificates/*.crt "$root/usr/local/share/ca-certificates/"
+    fi
 }
 # Is the layer NAME (upper dir) there from this or an earlier run?
 have() { [ -d "$check_dir/layers/$1/upper" ]; }
