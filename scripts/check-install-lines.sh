@@ -16,12 +16,14 @@
 # Each stage prints PASS or FAIL with its wall time; its whole output is in $CHECK_DIR/logs/.
 #
 # Layers: the minimal system ($BASE, made with `debootstrap --variant=minbase` if absent) is never
-# changed; each stage writes into its own overlayfs layer on top of the one it starts from
-# (rust on the base; train and test on rust; ros and python on train/test's, or on rust's when
-# those were not run), so ros and python each start from a system with only the Rust toolchain
-# and the built checkout, never from one another's packages. A stage given again starts its layer
-# anew. Everything mounted is unmounted when the script ends, also on failure or Ctrl-C, after
-# any process still running inside the chroot is killed.
+# changed; each stage writes into its own overlayfs layer over the one it starts from: rust over
+# the base; train over rust; test, ros and python each over train (over rust when train was not
+# run), so each starts from a system with only the Rust toolchain and the built checkout, never
+# from another's packages. A stage given again starts its layer anew (and the layers over it are
+# then stale: give them again too); before a stage over rust, the checkout there is moved to the
+# commit checked (as `git pull` would). test, ros and python may run in separate invocations at
+# the same time. Everything mounted is unmounted when the script ends, also on failure or Ctrl-C,
+# after any process still running inside its chroots is killed.
 #
 # Environment: CHECK_DIR (default /var/tmp/macdec-install-check), BASE (default $CHECK_DIR/base),
 # MIRROR (default http://deb.debian.org/debian), CARGO_BUILD_JOBS (passed on if set).
@@ -61,6 +63,7 @@ cleanup() {
     local i
     for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do unmount_root "${mounted[$i]}" || true; done
     mounted=()
+    rm -rf "${src:-}" "${readme:-}"
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
@@ -78,11 +81,11 @@ if [ ! -x "$base/bin/bash" ]; then
 fi
 
 # The code the fresh system clones: the checkout's committed HEAD (not its work tree).
-rm -rf "$check_dir/src.git"
-git clone -q --bare "$repo" "$check_dir/src.git"
+src=$check_dir/src-$$.git
+git clone -q --bare "$repo" "$src"
 readme=$(mktemp)
-git -C "$check_dir/src.git" show HEAD:README.md >"$readme"
-commit=$(git -C "$check_dir/src.git" rev-parse --short HEAD)
+git -C "$src" show HEAD:README.md >"$readme"
+commit=$(git -C "$src" rev-parse --short HEAD)
 
 # Lines of the N-th ```sh block under the heading "## $1" ("" = before the first heading),
 # without trailing comments.
@@ -111,7 +114,7 @@ layer() {
     mount --rbind /dev "$root/dev"
     mount --make-rslave "$root/dev"
     mkdir -p "$root/mnt/macdec.git"
-    mount --bind "$check_dir/src.git" "$root/mnt/macdec.git"
+    mount --bind "$src" "$root/mnt/macdec.git"
     mount -o remount,bind,ro "$root/mnt/macdec.git"
     cp /etc/resolv.conf "$root/etc/resolv.conf"
     # A site whose HTTPS goes through its own CA lists it here; every machine of the site has it,
@@ -123,6 +126,14 @@ layer() {
 }
 # Is the layer NAME (upper dir) there from this or an earlier run?
 have() { [ -d "$check_dir/layers/$1/upper" ]; }
+# Move the checkout made by the rust stage to the commit checked (no-op when it is already there).
+sync_checkout() {
+    chroot "$root" /bin/sh -c 'cd /root/macdec && git fetch -q /mnt/macdec.git HEAD &&
+        git checkout -q --detach FETCH_HEAD' >>"$check_dir/logs/sync.log" 2>&1 || {
+        echo "check-install-lines: could not update the checkout in $root" >&2
+        exit 1
+    }
+}
 up() { echo "$check_dir/layers/$1/upper"; }
 release() { # unmount the last layer
     unmount_root "${mounted[-1]}"
@@ -174,24 +185,33 @@ if want rust; then
     release
 fi
 
-if want train || want test; then
+top=$(block "")
+if want train; then
     need rust
-    layer main "$(up rust)" "$base"
-    top=$(block "")
-    want train && { run_stage train /root/macdec "$(echo "$top" | sed -n 1p)" || true; }
-    want test && { run_stage test /root/macdec "$(echo "$top" | sed -n 2p)" || true; }
+    layer train "$(up rust)" "$base"
+    sync_checkout
+    run_stage train /root/macdec "$(echo "$top" | sed -n 1p)" || true
     release
 fi
 
-# ros and python start from the built checkout (main) when it is there, else from rust.
+# test, ros and python start from the built checkout (train) when it is there, else from rust.
 built=("$(up rust)" "$base")
-have main && built=("$(up main)" "${built[@]}")
+have train && built=("$(up train)" "${built[@]}")
+
+if want test; then
+    need rust
+    layer test "${built[@]}"
+    sync_checkout
+    run_stage test /root/macdec "$(echo "$top" | sed -n 2p)" || true
+    release
+fi
 
 if want ros; then
     need rust
     apt_line=$(block "Running on robots with ROS" | grep -m1 '^apt-get .*ros-core')
     smoke=$(block "Running on robots with ROS" 2 | grep -m1 -o '^scripts/ros-smoke.sh')
     layer ros "${built[@]}"
+    sync_checkout
     run_stage ros /root/macdec "$apt_line
 $smoke" || true
     release
@@ -200,10 +220,10 @@ fi
 if want python; then
     need rust
     layer python "${built[@]}"
+    sync_checkout
     run_stage python /root/macdec "$(block "From Python")" || true
     release
 fi
 
-rm -f "$readme"
 echo "check-install-lines: logs in $check_dir/logs; layers in $check_dir/layers (rm -rf to free)" >&2
 exit $status
