@@ -10,8 +10,9 @@
 # of the same policy and seed, and print one line per policy: identical, or where it first
 # differed. Exit status 0 only if every policy is identical.
 #
-# Needs Debian's ROS 1: apt-get install ros-core python3-rospy python3-rostopic (std_srvs and
-# diagnostic_msgs come with them). Environment: MACDEC (default target/release/macdec, built if
+# Needs Debian's ROS 1, the README's line (ros-core brings neither std_srvs nor diagnostic_msgs,
+# and procps's pgrep only by chance): apt-get install ros-core python3-rospy python3-std-srvs
+# python3-diagnostic-msgs procps. Environment: MACDEC (default target/release/macdec, built if
 # missing), ROS_PORT (default 11311; must be free), EPISODES (3), SEED (0); EVAL_SEED (default
 # SEED) seeds only the `macdec eval` side, so a test can show that a real difference is reported.
 # Everything it starts (roscore, roslaunch and the nodes) is stopped when it exits.
@@ -25,16 +26,22 @@ eval_seed=${EVAL_SEED:-$seed}
 macdec=${MACDEC:-$repo/target/release/macdec}
 py=/usr/bin/python3
 
-for tool in roscore roslaunch "$py"; do
-    command -v "$tool" >/dev/null || {
-        echo "ros-smoke: $tool not found; apt-get install ros-core python3-rospy python3-rostopic" >&2
-        exit 2
-    }
+# What is missing, by the Debian package that brings it; all of it named in one message.
+missing=()
+for need in roscore:ros-core roslaunch:ros-core pgrep:procps setsid:util-linux "$py:python3"; do
+    command -v "${need%:*}" >/dev/null || missing+=("${need##*:}")
 done
-"$py" -c 'import rospy, std_msgs.msg, std_srvs.srv, diagnostic_msgs.msg' 2>/dev/null || {
-    echo "ros-smoke: $py cannot import rospy, std_msgs, std_srvs and diagnostic_msgs" >&2
+if [ -x "$py" ]; then
+    for need in rospy:python3-rospy std_msgs.msg:python3-std-msgs std_srvs.srv:python3-std-srvs \
+        diagnostic_msgs.msg:python3-diagnostic-msgs rosgraph:python3-rosgraph roslaunch:python3-roslaunch; do
+        "$py" -c "import ${need%:*}" 2>/dev/null || missing+=("${need##*:}")
+    done
+fi
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "ros-smoke: missing: $(printf '%s\n' "${missing[@]}" | sort -u | paste -sd ' '); as root:" >&2
+    echo "  apt-get install -y ros-core python3-rospy python3-std-srvs python3-diagnostic-msgs procps" >&2
     exit 2
-}
+fi
 if [ ! -x "$macdec" ]; then
     (cd "$repo" && cargo build --release --quiet)
 fi

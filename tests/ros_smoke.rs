@@ -1,5 +1,6 @@
 //! The ROS end-to-end check (issue 14), ignored by default because it needs Debian's ROS 1
-//! (`apt-get install ros-core python3-rospy python3-rostopic`) and the free port 11311:
+//! (`apt-get install ros-core python3-rospy python3-std-srvs python3-diagnostic-msgs procps`, the
+//! README's line) and the free port 11311:
 //!
 //! `cargo test --release --test ros_smoke -- --ignored`
 //!
