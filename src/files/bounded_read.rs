@@ -49,10 +49,7 @@ pub fn open_regular(path: &Path, links: Links) -> io::Result<std::fs::File> {
         .open(path)
         .map_err(|e| super::links::explain_no_follow(path, e))?;
     if !file.metadata()?.is_file() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            "not a regular file",
-        ));
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, NotRegular));
     }
     Ok(file)
 }
@@ -113,10 +110,24 @@ pub fn gunzip_bounded(bytes: &[u8], max_bytes: u64) -> io::Result<Vec<u8>> {
 }
 
 fn too_big(len: u64, max_bytes: u64) -> io::Error {
-    io::Error::new(
-        io::ErrorKind::InvalidData,
-        format!("{len} bytes or more, at most {max_bytes} expected"),
-    )
+    io::Error::new(io::ErrorKind::FileTooLarge, TooBig { len, max_bytes })
+}
+
+/// The error inside the [`io::Error`] of a read refused because the path is a directory, FIFO,
+/// device or socket, for callers with their own error variant for it (`e.get_ref()`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("not a regular file")]
+pub struct NotRegular;
+
+/// The error inside the [`io::Error`] of a read refused for its size: at least `len` bytes where
+/// `max_bytes` is the bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("{len} bytes or more, at most {max_bytes} expected")]
+pub struct TooBig {
+    /// Bytes found (the size, or what was read before the bound stopped it).
+    pub len: u64,
+    /// The bound.
+    pub max_bytes: u64,
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 //! `rnn` in `MA_hddrqn` (Dec-HDDRQN); both are accepted.
 
 use crate::envs::{AnyEnv, EnvSpec, MacroEnv};
+use crate::files::bounded_read::{read_regular_file, NotRegular, TooBig};
 use crate::nn::safetensors_io::{from_safetensors_bytes, to_safetensors_bytes};
 use crate::nn::QNetConfig;
 use crate::policy_files::architecture::Architecture;
@@ -15,7 +16,6 @@ use crate::policy_files::{sha256_hex, Manifest, PolicyError, RunInfo};
 use safetensors::tensor::Dtype;
 use safetensors::SafeTensors;
 use serde::Serialize;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Largest state_dict file read. The paper's nets are about 0.1 MB (Warehouse, H = 64); even
@@ -220,36 +220,27 @@ pub struct ImportRequest {
 }
 
 /// Read `path` whole, refusing anything but a regular file of at most `max_bytes` before
-/// reading it (a FIFO or device would block or never end).
+/// reading it (a FIFO or device would block or never end): [`read_regular_file`] with this
+/// command's errors.
 pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, ImportError> {
-    let io = |e: std::io::Error| ImportError::Io {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(ImportError::NotAFile {
-            path: path.to_path_buf(),
-        });
-    }
-    let too_large = |size| ImportError::TooLarge {
-        path: path.to_path_buf(),
-        size,
-    };
-    if meta.len() > max_bytes {
-        return Err(too_large(meta.len()));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    std::fs::File::open(path)
-        .map_err(io)?
-        .take(max_bytes + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() as u64 > max_bytes {
-        // The file grew after the size check.
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
+    read_regular_file(path, max_bytes).map_err(|e| {
+        let inner = e.get_ref();
+        if let Some(big) = inner.and_then(|i| i.downcast_ref::<TooBig>()) {
+            ImportError::TooLarge {
+                path: path.to_path_buf(),
+                size: big.len,
+            }
+        } else if inner.is_some_and(|i| i.is::<NotRegular>()) {
+            ImportError::NotAFile {
+                path: path.to_path_buf(),
+            }
+        } else {
+            ImportError::Io {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            }
+        }
+    })
 }
 
 /// The canonical name of a tensor (`rnn.X` -> `lstm.X`).
