@@ -515,3 +515,52 @@ fn a_nan_rate_and_a_seed_beyond_the_largest_are_named_before_any_run() {
     );
     assert!(!results.exists(), "no run may start");
 }
+
+#[test]
+fn a_robot_reads_its_weight_file_before_building_a_net_the_manifest_sizes() {
+    use sha2::Digest;
+    let dir = tempfile::tempdir().unwrap();
+    let run = copy_of_tiny_run(dir.path());
+    let policy = run.join("policy");
+    // A custom domain with 90 000 observation values (within the 1 MiB description) and the
+    // widest layers: a net of 2.4 GB if built from the manifest, for a 10-byte weight file whose
+    // checksum the manifest states correctly.
+    let tiny_file = b"0123456789";
+    let sha: String = sha2::Sha256::digest(tiny_file)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    std::fs::write(policy.join("dec_agent_0.safetensors"), tiny_file).unwrap();
+    tamper_policy(&run, |v| {
+        let n = 90_000;
+        v["env"] = serde_json::json!({"env": "custom", "name": "wide", "horizon": 20});
+        for a in v["agents"].as_array_mut().unwrap() {
+            a["obs_size"] = n.into();
+            a["obs_names"] = vec!["o"; n].into();
+        }
+        let nets: Vec<serde_json::Value> = v["nets"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|net| net["role"] == "dec")
+            .cloned()
+            .map(|mut net| {
+                net["input"] = n.into();
+                net["architecture"]["mlp_layer_size"] = 2048.into();
+                if net["agent"] == 0 {
+                    net["sha256"] = sha.clone().into();
+                }
+                net
+            })
+            .collect();
+        v["nets"] = nets.into();
+        v["evaluated"] = "dec".into();
+    });
+    let out = macdec_within(
+        &["robot", "--policy", s(&policy), "--agent", "0"],
+        Duration::from_secs(30),
+        Some(512 << 20),
+    );
+    let err = refused(&out);
+    assert!(err.contains("dec_agent_0.safetensors"), "{err}");
+}
