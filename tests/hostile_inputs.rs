@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{ok, BIN};
+use common::{train_tiny_run, BIN};
 use std::os::unix::fs::FileTypeExt;
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
@@ -13,41 +13,12 @@ use std::process::{Command, Output, Stdio};
 use std::sync::OnceLock;
 use std::time::Duration;
 
-/// A tiny Box Pushing run: a second of training.
-const TINY: &str = r#"
-name = "tiny"
-methods = ["our1"]
-seeds = "1..2"
-
-[params]
-env_name = "BP_MA"
-grid_dim = 8
-env_terminate_step = 20
-total_epi = 20
-eps_l_d_steps = 10
-batch_size = 8
-replay_buffer_size = 500
-eval_freq = 10
-checkpoint_freq = 10
-"#;
-
 /// One trained tiny run shared by the tests of this file (read-only: tests copy it to tamper).
 fn tiny_run() -> &'static Path {
     static RUN: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
     let (_, run) = RUN.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let config = dir.path().join("tiny.toml");
-        std::fs::write(&config, TINY).unwrap();
-        let results = dir.path().join("results");
-        let out = Command::new(BIN)
-            .args(["train", "--quiet", "--no-plot", "--config"])
-            .arg(&config)
-            .arg("--out")
-            .arg(&results)
-            .output()
-            .unwrap();
-        ok(&out);
-        let run = results.join("tiny/our1/seed-1");
+        let run = train_tiny_run(dir.path());
         (dir, run)
     });
     run
@@ -152,6 +123,16 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// The tiny run's two agent weight files as `import --agents` takes them.
+fn tiny_agents() -> String {
+    let policy = tiny_run().join("policy");
+    format!(
+        "{},{}",
+        s(&policy.join("dec_agent_0.safetensors")),
+        s(&policy.join("dec_agent_1.safetensors"))
+    )
+}
+
 #[test]
 fn outputs_onto_fifos_devices_and_foreign_directories_are_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -194,12 +175,7 @@ fn outputs_onto_fifos_devices_and_foreign_directories_are_refused() {
     std::fs::create_dir(&foreign).unwrap();
     std::fs::write(foreign.join("notes.txt"), "mine").unwrap();
     refused(&macdec(&["export", "--run", s(run), "--out", s(&foreign)]));
-    let policy = run.join("policy");
-    let agents = format!(
-        "{},{}",
-        s(&policy.join("dec_agent_0.safetensors")),
-        s(&policy.join("dec_agent_1.safetensors"))
-    );
+    let agents = tiny_agents();
     let err = refused(&macdec(&[
         "import",
         "--env",
@@ -366,11 +342,7 @@ fn audit_refuses_a_committed_config_that_train_would_refuse() {
 fn sizes_from_flags_obey_the_config_limits() {
     let run = tiny_run();
     let policy = run.join("policy");
-    let agents = format!(
-        "{},{}",
-        s(&policy.join("dec_agent_0.safetensors")),
-        s(&policy.join("dec_agent_1.safetensors"))
-    );
+    let agents = tiny_agents();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("imported");
     for (args, flag) in [

@@ -4,44 +4,14 @@
 
 mod common;
 
-use common::{ok, run};
+use common::{ok, run, train_tiny_run};
 use std::path::Path;
-
-/// A tiny Box Pushing run: a second of training.
-const TINY: &str = r#"
-name = "tiny"
-methods = ["our1"]
-seeds = "1..2"
-
-[params]
-env_name = "BP_MA"
-grid_dim = 8
-env_terminate_step = 20
-total_epi = 20
-eps_l_d_steps = 10
-batch_size = 8
-replay_buffer_size = 500
-eval_freq = 10
-checkpoint_freq = 10
-"#;
 
 #[test]
 fn a_run_of_a_domain_render_cannot_draw_is_refused_naming_the_domain() {
     let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.toml");
-    std::fs::write(&config, TINY).unwrap();
-    let results = dir.path().join("results");
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    ok(&run(&[
-        "train",
-        "--quiet",
-        "--no-plot",
-        "--config",
-        &s(&config),
-        "--out",
-        &s(&results),
-    ]));
-    let trained = results.join("tiny/our1/seed-1");
+    let trained = train_tiny_run(dir.path());
     let gif = dir.path().join("ok.gif");
     ok(&run(&["render", "--run", &s(&trained), "--out", &s(&gif)]));
     assert!(gif.is_file());

@@ -21,6 +21,40 @@ use std::sync::Arc;
 /// The `macdec` binary under test.
 pub const BIN: &str = env!("CARGO_BIN_EXE_macdec");
 
+/// A tiny Box Pushing experiment, `tiny/our1/seed-1`: a second of training.
+pub const TINY_RUN: &str = r#"
+name = "tiny"
+methods = ["our1"]
+seeds = "1..2"
+
+[params]
+env_name = "BP_MA"
+grid_dim = 8
+env_terminate_step = 20
+total_epi = 20
+eps_l_d_steps = 10
+batch_size = 8
+replay_buffer_size = 500
+eval_freq = 10
+checkpoint_freq = 10
+"#;
+
+/// Train [`TINY_RUN`] into `dir/results` and return its run directory.
+pub fn train_tiny_run(dir: &Path) -> PathBuf {
+    let config = dir.join("tiny.toml");
+    std::fs::write(&config, TINY_RUN).unwrap();
+    let results = dir.join("results");
+    let out = Command::new(BIN)
+        .args(["train", "--quiet", "--no-plot", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&results)
+        .output()
+        .unwrap();
+    ok(&out);
+    results.join("tiny/our1/seed-1")
+}
+
 /// `macdec ARGS`, waited for; success is not checked.
 pub fn run(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().unwrap()
