@@ -245,17 +245,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
     use macdec::experiment::train_run::load_checkpoint;
 
     let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("tiny.toml");
-    std::fs::write(&config, TINY).unwrap();
-    let results = dir.path().join("results");
-    let out = Command::new(BIN)
-        .args(["train", "--quiet", "--no-plot", "--config"])
-        .arg(&config)
-        .arg("--out")
-        .arg(&results)
-        .output()
-        .unwrap();
-    ok(&out);
+    let results = common::train_config(dir.path(), TINY);
 
     // Cen-DDRQN has no decentralized nets: refused with the reason.
     let out = Command::new(BIN)
@@ -329,12 +319,12 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
 
 #[test]
 fn deploy_prints_each_episode_as_it_ends() {
-    // A million episodes would take hours: the first line must still arrive within seconds, so
-    // results are streamed, not kept until the end.
+    // A hundred thousand episodes (the most --episodes takes) would take hours: the first line
+    // must still arrive within seconds, so results are streamed, not kept until the end.
     let dir = tempfile::tempdir().unwrap();
     write_mock_policy(dir.path(), bp10()).unwrap();
     let mut child = Command::new(BIN)
-        .args(["deploy", "--mock", "--episodes", "1000000", "--policy"])
+        .args(["deploy", "--mock", "--episodes", "100000", "--policy"])
         .arg(dir.path())
         .stdout(Stdio::piped())
         .stderr(Stdio::null())

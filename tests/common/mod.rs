@@ -41,18 +41,24 @@ checkpoint_freq = 10
 
 /// Train [`TINY_RUN`] into `dir/results` and return its run directory.
 pub fn train_tiny_run(dir: &Path) -> PathBuf {
-    let config = dir.join("tiny.toml");
-    std::fs::write(&config, TINY_RUN).unwrap();
+    train_config(dir, TINY_RUN).join("tiny/our1/seed-1")
+}
+
+/// Train the experiment `config` (written to `dir/tiny.toml`) quietly into `dir/results`,
+/// asserting success, and return the results root.
+pub fn train_config(dir: &Path, config: &str) -> PathBuf {
+    let path = dir.join("tiny.toml");
+    std::fs::write(&path, config).unwrap();
     let results = dir.join("results");
     let out = Command::new(BIN)
         .args(["train", "--quiet", "--no-plot", "--config"])
-        .arg(&config)
+        .arg(&path)
         .arg("--out")
         .arg(&results)
         .output()
         .unwrap();
     ok(&out);
-    results.join("tiny/our1/seed-1")
+    results
 }
 
 /// `macdec ARGS`, waited for; success is not checked.
