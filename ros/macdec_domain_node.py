@@ -19,12 +19,20 @@ the node's answer back into a protocol reply:
 macdec's episode lines (the same as `macdec eval`/`deploy` print) go to stdout; the time from
 publishing a macro-observation to receiving its macro-action is summarised on stderr.
 
+Each robot's address is served only to the `macdec domain` process this node started: a
+connection from any other process (another local user's included) is refused and closed with a
+log line, and the listener keeps waiting for the expected one. Request lines are read up to
+--max-line-bytes (default 65536; raise it for observations of more than a few thousand numbers).
+The policy's policy.json (or manifest.json) is read only as a regular file of at most 1 MiB.
+
 Usage: macdec_domain_node.py --policy DIR [--episodes K] [--seed S] [--trajectories]
-       [--macdec PATH] [--namespace /macdec] [--timeout SECS] [--check-diagnostics]
+       [--macdec PATH] [--namespace /macdec] [--timeout SECS] [--max-line-bytes N]
+       [--check-diagnostics]
 """
 
 import argparse
 import json
+import math
 import os
 import queue
 import shutil
@@ -39,6 +47,8 @@ import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from std_msgs.msg import Float32MultiArray, Int32, String
 from std_srvs.srv import Trigger
+
+from macdec_io import DEFAULT_MAX_LINE_BYTES, LineChannel, LineTooLong, owns_connection, read_manifest
 
 
 class RobotBridge:
@@ -146,21 +156,42 @@ class RobotBridge:
             return {"ok": "continue"}
         return {"error": "the ROS bridge does not know request %r" % kind}
 
-    def serve(self, listener):
-        """Answer macdec's one connection for this robot, line by line."""
-        conn, _ = listener.accept()
+    def serve(self, listener, child, max_line_bytes):
+        """Answer macdec's one connection for this robot, line by line. `child` is an Event whose
+        `pid` is the `macdec domain` process: connections from any other process are refused."""
+        while True:
+            conn, peer = listener.accept()
+            child.wait()
+            if owns_connection(child.pid, conn):
+                break
+            rospy.logwarn(
+                "ROS bridge for %s: refused a connection from %s:%d: not the macdec domain "
+                "process this node started (pid %d)", self.ns, peer[0], peer[1], child.pid
+            )
+            conn.close()
         listener.close()
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        with conn, conn.makefile("r") as reader, conn.makefile("w") as writer:
-            for line in reader:
+        lines = LineChannel(conn.fileno(), max_line_bytes)
+        with conn:
+            while True:
+                try:
+                    line = lines.read_line()
+                except LineTooLong:
+                    reply = {
+                        "error": "ROS bridge for %s: request line longer than %d bytes; start "
+                        "the domain node with a larger --max-line-bytes" % (self.ns, max_line_bytes)
+                    }
+                    conn.sendall((json.dumps(reply, separators=(",", ":")) + "\n").encode())
+                    return
+                if line is None:
+                    return
                 if not line.strip():
                     continue
                 try:
                     reply = self.handle(json.loads(line))
                 except Exception as e:  # a bridge failure becomes macdec's named error
                     reply = {"error": "ROS bridge for %s: %s" % (self.ns, e)}
-                writer.write(json.dumps(reply, separators=(",", ":")) + "\n")
-                writer.flush()
+                conn.sendall((json.dumps(reply, separators=(",", ":")) + "\n").encode())
 
 
 def check_diagnostics(bridge, obs_size):
@@ -210,13 +241,23 @@ def main():
     )
     parser.add_argument("--namespace", default="/macdec", help="the robots' namespaces' parent")
     parser.add_argument("--timeout", type=float, default=20.0, help="seconds per ROS answer")
+    parser.add_argument(
+        "--max-line-bytes",
+        type=int,
+        default=DEFAULT_MAX_LINE_BYTES,
+        help="longest request line read from macdec domain",
+    )
     parser.add_argument("--check-diagnostics", action="store_true")
     args = parser.parse_args(rospy.myargv()[1:])
+    if not 0 < args.timeout <= 86400:
+        parser.error("--timeout must be more than 0 and at most 86400 seconds")
+    if args.max_line_bytes < 1:
+        parser.error("--max-line-bytes must be at least 1")
     policy = os.path.abspath(args.policy)
-    # policy.json since format_version 2; manifest.json in exports written before.
-    name = "policy.json" if os.path.exists(os.path.join(policy, "policy.json")) else "manifest.json"
-    with open(os.path.join(policy, name)) as f:
-        agents = json.load(f)["agents"]
+    try:
+        agents = read_manifest(policy)["agents"]
+    except ValueError as e:
+        raise SystemExit("macdec_domain_node: %s" % e)
 
     rospy.init_node("domain", anonymous=True)
     bridges = [
@@ -247,21 +288,30 @@ def main():
     if args.check_diagnostics:
         check_diagnostics(bridges[0], agents[0]["obs_size"])
 
+    # Set once macdec domain is started: each bridge serves only a connection from that process.
+    started = threading.Event()
     addresses = []
     for b in bridges:
         listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         listener.bind(("127.0.0.1", 0))
-        listener.listen(1)
+        listener.listen(8)
         addresses.append("127.0.0.1:%d" % listener.getsockname()[1])
-        threading.Thread(target=b.serve, args=(listener,), daemon=True).start()
+        threading.Thread(
+            target=b.serve, args=(listener, started, args.max_line_bytes), daemon=True
+        ).start()
     robots = ",".join(addresses)
     command = [args.macdec, "domain", "--policy", policy, "--robots", robots]
     command += ["--episodes", str(args.episodes)]
+    # macdec waits for each reply a little longer than this node waits for a ROS answer, so a
+    # silent robot node is reported by name (the bridge's error reply) rather than as a timeout.
+    command += ["--timeout-secs", str(min(86400, math.ceil(args.timeout) + 10))]
     if args.seed is not None:
         command += ["--seed", str(args.seed)]
     if args.trajectories:
         command.append("--trajectories")
     child = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
+    started.pid = child.pid
+    started.set()
     for line in child.stdout:
         sys.stdout.write(line)
         sys.stdout.flush()

@@ -19,90 +19,40 @@ Graph resources, relative to the node's namespace (the team launch uses /macdec/
               and the policy's manifest
   service     reset              std_srvs/Trigger            zero the LSTM state (new episode)
   published   /diagnostics       diagnostic_msgs/DiagnosticArray  OK when serving, ERROR for any
-              refused message (wrong length, non-finite values) or a restarted child; the node
+              refused message (wrong length, non-finite values), a reply not complete within
+              --timeout-secs (the child is killed and restarted) or a restarted child; the node
               keeps running and its state is unchanged by a refused message
 
-Usage: macdec_robot_node.py --policy DIR --agent I [--macdec PATH] [ROS remappings]
+Usage: macdec_robot_node.py --policy DIR --agent I [--macdec PATH] [--timeout-secs S]
+       [--max-line-bytes N] [ROS remappings]
+
+--timeout-secs (or the private parameter ~timeout_secs; default 30): writing one request to
+`macdec robot` and reading its whole reply must take at most this long. --max-line-bytes (or
+~max_line_bytes; default 65536): passed to `macdec robot --max-line-bytes`, the longest request
+line it reads; raise it for observations of more than a few thousand numbers. Replies are read up
+to 16 MiB.
 """
 
 import argparse
 import json
 import os
 import shutil
-import subprocess
-import sys
-import threading
 
 import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from std_msgs.msg import Float32MultiArray, Int32, String
 from std_srvs.srv import Trigger, TriggerResponse
 
-
-class PolicyProcess:
-    """`macdec robot` over stdin/stdout: one request line out, one reply line back, under a lock
-    (rospy runs each subscription's callbacks on its own thread)."""
-
-    def __init__(self, command):
-        self.command = command
-        self.lock = threading.Lock()
-        self.child = None
-        self.start()
-
-    def start(self):
-        self.child = subprocess.Popen(
-            self.command,
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            stderr=sys.stderr,
-            text=True,
-            bufsize=1,
-        )
-
-    def request(self, message, restart=True):
-        """The reply (a dict) to `message` (a dict). If the child is gone a RuntimeError says so,
-        and with `restart` the child is started again (its hidden state is then zero)."""
-        line = json.dumps(message, allow_nan=True) + "\n"
-        with self.lock:
-            try:
-                self.child.stdin.write(line)
-                self.child.stdin.flush()
-                reply = self.child.stdout.readline()
-            except (BrokenPipeError, OSError, ValueError):
-                reply = ""
-            if not reply:
-                self.stop()
-                code = self.child.returncode
-                if not restart:
-                    raise RuntimeError("macdec robot exited (status %s)" % code)
-                self.start()
-                raise RuntimeError(
-                    "macdec robot exited (status %s); restarted it, its hidden state is zero" % code
-                )
-        try:
-            return json.loads(reply)
-        except ValueError:
-            raise RuntimeError("macdec robot sent an unreadable reply: %r" % reply[:200])
-
-    def stop(self):
-        if self.child is None:
-            return
-        try:
-            self.child.stdin.close()
-        except OSError:
-            pass
-        try:
-            self.child.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            self.child.kill()
-            self.child.wait()
+from macdec_io import DEFAULT_MAX_LINE_BYTES, MAX_REPLY_BYTES, PolicyProcess
 
 
 class RobotNode:
-    def __init__(self, policy_dir, agent, macdec):
+    def __init__(self, policy_dir, agent, macdec, timeout_secs, max_line_bytes):
         self.agent = agent
         self.name = "macdec robot %d" % agent
-        self.policy = PolicyProcess([macdec, "robot", "--policy", policy_dir, "--agent", str(agent)])
+        command = [macdec, "robot", "--policy", policy_dir, "--agent", str(agent)]
+        command += ["--max-line-bytes", str(max_line_bytes)]
+        self.policy = PolicyProcess(command, timeout_secs, MAX_REPLY_BYTES)
         try:
             info = self.policy.request({"type": "info"}, restart=False)
         except RuntimeError as e:  # e.g. a bad policy directory: macdec said why on stderr
@@ -152,7 +102,9 @@ class RobotNode:
         array = DiagnosticArray(status=[status])
         array.header.stamp = rospy.Time.now()
         self.diagnostics.publish(array)
-        if level != DiagnosticStatus.OK:
+        if level == DiagnosticStatus.ERROR:
+            rospy.logerr("%s: %s", self.name, message)
+        elif level != DiagnosticStatus.OK:
             rospy.logwarn("%s: %s", self.name, message)
 
     def ask(self, message, what):
@@ -196,6 +148,28 @@ class RobotNode:
         self.policy.stop()
 
 
+def positive_seconds(text):
+    """A timeout flag: seconds, more than 0 and at most a day."""
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError("timeout %r: expected seconds" % (text,))
+    if not 0 < value <= 86400:
+        raise argparse.ArgumentTypeError("timeout %r: must be more than 0 and at most 86400" % (text,))
+    return value
+
+
+def positive_int(text):
+    """A byte-count flag: a whole number, at least 1."""
+    try:
+        value = int(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError("%r: expected a whole number of bytes" % (text,))
+    if value < 1:
+        raise argparse.ArgumentTypeError("%r: must be at least 1" % (text,))
+    return value
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--policy", required=True, help="policy directory (macdec export/import)")
@@ -205,9 +179,30 @@ def main():
         default=os.environ.get("MACDEC") or shutil.which("macdec") or "macdec",
         help="the macdec executable (default: $MACDEC, else macdec on PATH)",
     )
+    parser.add_argument(
+        "--timeout-secs",
+        type=positive_seconds,
+        help="longest wait for one reply of macdec robot (default: ~timeout_secs, else 30)",
+    )
+    parser.add_argument(
+        "--max-line-bytes",
+        type=positive_int,
+        help="macdec robot's longest request line (default: ~max_line_bytes, else %d)"
+        % DEFAULT_MAX_LINE_BYTES,
+    )
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node("policy_%d" % args.agent, disable_signals=False)
-    node = RobotNode(os.path.abspath(args.policy), args.agent, args.macdec)
+    try:
+        timeout_secs = args.timeout_secs or positive_seconds(rospy.get_param("~timeout_secs", 30))
+        max_line_bytes = args.max_line_bytes or positive_int(
+            rospy.get_param("~max_line_bytes", DEFAULT_MAX_LINE_BYTES)
+        )
+    except argparse.ArgumentTypeError as e:
+        rospy.logfatal("macdec robot %d: %s", args.agent, e)
+        raise SystemExit(1)
+    node = RobotNode(
+        os.path.abspath(args.policy), args.agent, args.macdec, timeout_secs, max_line_bytes
+    )
     rospy.on_shutdown(node.shutdown)
     rospy.spin()
 

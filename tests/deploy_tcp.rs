@@ -61,12 +61,7 @@ fn reference_episode(env_spec: EnvSpec, seed_rng: &mut EnvRng) -> (f64, Vec<Vec<
 }
 
 /// One robot server thread per agent, each with its own mock policy, and a link to each.
-fn tcp_robots(
-    env_spec: EnvSpec,
-) -> (
-    Vec<RobotServer>,
-    Vec<JsonLink<std::io::BufReader<std::net::TcpStream>, std::net::TcpStream>>,
-) {
+fn tcp_robots(env_spec: EnvSpec) -> (Vec<RobotServer>, Vec<macdec::deploy::link::TcpLink>) {
     let manifest = mock_manifest(env_spec.clone());
     let servers: Vec<RobotServer> = (0..manifest.agents.len())
         .map(|i| mock_robot_server(&manifest, i, i as u64))

@@ -323,8 +323,9 @@ struct EpisodeArgs {
 struct DeployArgs {
     #[command(flatten)]
     episodes: EpisodeArgs,
-    /// Seconds to wait for a robot to start or to answer one message.
-    #[arg(long, default_value_t = 30)]
+    /// Seconds to wait for a robot to start, and for each reply: the whole reply must arrive
+    /// within this many seconds of its request (1 to 86400).
+    #[arg(long, default_value_t = 30, value_parser = parse_timeout_secs)]
     timeout_secs: u64,
     /// Robots run the deterministic stand-in policy (tests).
     #[arg(long, hide = true)]
@@ -400,9 +401,22 @@ struct DomainArgs {
     // Listed right after --policy in the help, where it was before --policy moved to EpisodeArgs.
     #[arg(long, value_delimiter = ',', required = true, display_order = 0)]
     robots: Vec<std::net::SocketAddr>,
-    /// Seconds to wait for a robot to accept the connection or to answer one message.
-    #[arg(long, default_value_t = 30)]
+    /// Seconds to wait for a robot to accept the connection, and for each reply: the whole
+    /// reply must arrive within this many seconds of its request (1 to 86400).
+    #[arg(long, default_value_t = 30, value_parser = parse_timeout_secs)]
     timeout_secs: u64,
+}
+
+/// `--timeout-secs` of `deploy` and `domain`: a deadline per robot reply, 1 s to a day. 0
+/// would fail every reply at once (or, as a socket timeout, wait forever).
+fn parse_timeout_secs(text: &str) -> Result<u64, String> {
+    const DAY: u64 = 86_400;
+    match text.trim().parse::<u64>() {
+        Ok(0) => Err("a timeout of 0 s gives no robot time to answer: use 1 to 86400".into()),
+        Ok(s) if s > DAY => Err(format!("at most {DAY} s (one day), got {s}")),
+        Ok(s) => Ok(s),
+        Err(e) => Err(format!("expected whole seconds from 1 to {DAY}: {e}")),
+    }
 }
 
 /// A count flag that must be at least 1 (0 would do nothing useful, silently).

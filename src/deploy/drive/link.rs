@@ -3,6 +3,7 @@
 //! stream (a TCP connection to a robot process or thread), and [`LocalLink`] calls a policy
 //! directly (in-process greedy execution, the reference the protocol path must equal).
 
+use crate::deploy::deadline::{DeadlineStream, ReplyClock};
 use crate::deploy::line_reader::{LineEvent, LineReader};
 use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
@@ -10,6 +11,10 @@ use crate::policy_files::Manifest;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
+
+/// A [`JsonLink`] over TCP, as [`JsonLink::connect`] opens it: both halves of the connection
+/// keep the deadline of the reply being awaited.
+pub type TcpLink = JsonLink<BufReader<DeadlineStream>, DeadlineStream>;
 
 /// Longest reply line a client accepts (the `info` reply carries the whole manifest).
 pub const MAX_REPLY_BYTES: usize = 16 * 1024 * 1024;
@@ -43,6 +48,15 @@ pub enum LinkError {
     /// Connecting, reading or writing failed; the text names the address or error.
     #[error("connection to the robot failed: {0}")]
     Io(String),
+    /// The whole reply did not arrive within the timeout from when its request was sent (a
+    /// deadline per reply: a robot trickling bytes does not extend it).
+    #[error("no complete reply from {peer} within {} s of the request", timeout.as_secs_f64())]
+    Timeout {
+        /// The robot's address.
+        peer: String,
+        /// The deadline per reply.
+        timeout: Duration,
+    },
     /// The robot closed the connection before replying.
     #[error("the robot closed the connection")]
     Closed,
@@ -94,12 +108,17 @@ pub struct JsonLink<R, W> {
     reader: LineReader<R>,
     writer: W,
     n_actions: usize,
+    /// Who answers, for error messages: the address, or "the robot".
+    peer: String,
+    /// The clock the stream's deadlines read and the time each reply gets, if any.
+    deadline: Option<(ReplyClock, Duration)>,
 }
 
-impl JsonLink<BufReader<TcpStream>, TcpStream> {
+impl TcpLink {
     /// Connect to the robot serving agent `agent` of `manifest` at `addr` and check, with an
-    /// `info` request, that it runs that agent of that policy. Replies slower than `timeout`
-    /// fail the link (a hung robot must not hang the deployment).
+    /// `info` request, that it runs that agent of that policy. Connecting, and each request
+    /// with its whole reply, must take at most `timeout` (a deadline per reply, not per read: a
+    /// hung or trickling robot must not hang the deployment).
     pub fn connect(
         addr: SocketAddr,
         agent: usize,
@@ -109,25 +128,52 @@ impl JsonLink<BufReader<TcpStream>, TcpStream> {
         let io = |e: std::io::Error| LinkError::Io(format!("{addr}: {e}"));
         let stream = TcpStream::connect_timeout(&addr, timeout).map_err(io)?;
         stream.set_nodelay(true).map_err(io)?;
-        stream.set_read_timeout(Some(timeout)).map_err(io)?;
-        stream.set_write_timeout(Some(timeout)).map_err(io)?;
-        let reader = BufReader::new(stream.try_clone().map_err(io)?);
-        JsonLink::open(reader, stream, agent, manifest)
+        let clock = ReplyClock::new();
+        let reader = DeadlineStream::with_reply_clock(
+            stream.try_clone().map_err(io)?,
+            timeout,
+            clock.clone(),
+        );
+        let writer = DeadlineStream::with_reply_clock(stream, timeout, clock.clone());
+        JsonLink::open_as(
+            BufReader::new(reader),
+            writer,
+            agent,
+            manifest,
+            addr.to_string(),
+            Some((clock, timeout)),
+        )
     }
 }
 
 impl<R: BufRead, W: Write> JsonLink<R, W> {
-    /// Wrap a stream to a robot and check that it serves agent `agent` of `manifest`.
+    /// Wrap a stream to a robot and check that it serves agent `agent` of `manifest`. The
+    /// streams' own timeouts, if any, bound each read and write.
     pub fn open(
         reader: R,
         writer: W,
         agent: usize,
         manifest: &Manifest,
     ) -> Result<Self, LinkError> {
+        Self::open_as(reader, writer, agent, manifest, "the robot".into(), None)
+    }
+
+    /// [`JsonLink::open`] naming the robot `peer`, with a deadline per reply when `deadline`
+    /// holds the clock the streams read.
+    fn open_as(
+        reader: R,
+        writer: W,
+        agent: usize,
+        manifest: &Manifest,
+        peer: String,
+        deadline: Option<(ReplyClock, Duration)>,
+    ) -> Result<Self, LinkError> {
         let mut link = JsonLink {
             reader: LineReader::new(reader, MAX_REPLY_BYTES),
             writer,
             n_actions: 0,
+            peer,
+            deadline,
         };
         match link.request(&Request::Info)? {
             Reply::Info {
@@ -152,17 +198,22 @@ impl<R: BufRead, W: Write> JsonLink<R, W> {
 
     /// Send one request and read its reply. An `{"error": ...}` reply becomes
     /// [`LinkError::Refused`].
+    /// With a deadline (a link from [`JsonLink::connect`]), writing the request and reading its
+    /// whole reply must end within the timeout, or [`LinkError::Timeout`].
     pub fn request(&mut self, request: &Request) -> Result<Reply, LinkError> {
         let line = request.to_line() + "\n";
+        if let Some((clock, timeout)) = &self.deadline {
+            clock.start(*timeout);
+        }
         self.writer
             .write_all(line.as_bytes())
             .and_then(|()| self.writer.flush())
-            .map_err(|e| LinkError::Io(e.to_string()))?;
+            .map_err(|e| self.io_error(e))?;
         let reply = match self.reader.next_line() {
             Ok(LineEvent::Line(bytes)) => bytes,
             Ok(LineEvent::TooLong) => return Err(LinkError::ReplyTooLong),
             Ok(LineEvent::Eof { .. }) => return Err(LinkError::Closed),
-            Err(e) => return Err(LinkError::Io(e.to_string())),
+            Err(e) => return Err(self.io_error(e)),
         };
         match serde_json::from_slice::<Reply>(&reply) {
             Ok(Reply::Error { error }) => Err(LinkError::Refused(error)),
@@ -171,6 +222,21 @@ impl<R: BufRead, W: Write> JsonLink<R, W> {
                 line: String::from_utf8_lossy(&reply).chars().take(200).collect(),
                 reason: e.to_string(),
             }),
+        }
+    }
+}
+
+impl<R, W> JsonLink<R, W> {
+    /// A failed read or write: past the reply's deadline it is a [`LinkError::Timeout`] (a
+    /// socket timeout set from the deadline fires as `WouldBlock` on Linux, `TimedOut` elsewhere).
+    fn io_error(&self, e: std::io::Error) -> LinkError {
+        use std::io::ErrorKind::{TimedOut, WouldBlock};
+        match &self.deadline {
+            Some((_, timeout)) if matches!(e.kind(), TimedOut | WouldBlock) => LinkError::Timeout {
+                peer: self.peer.clone(),
+                timeout: *timeout,
+            },
+            _ => LinkError::Io(format!("{}: {e}", self.peer)),
         }
     }
 }

@@ -14,7 +14,8 @@ use std::time::Duration;
 
 /// Connect to one robot per agent of `manifest` (`robots[i]` serves agent i), check each one's
 /// `info`, and run `episodes` greedy episodes of the manifest's domain on `rng`, handing each
-/// episode to `on_episode` as it ends. `timeout` bounds the connection and every reply.
+/// episode to `on_episode` as it ends. `timeout` bounds the connection and each reply as a whole,
+/// counted from when its request is sent.
 pub fn run_with_robots_at(
     manifest: &Manifest,
     robots: &[SocketAddr],
