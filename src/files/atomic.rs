@@ -81,21 +81,32 @@ static TEMP_COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64
 /// A new temp file beside `path`, created exclusively and without following a link (a name
 /// someone planted is skipped, never written through): `.<name>.<pid>-<n>.tmp`.
 pub fn create_temp_beside(path: &Path) -> io::Result<(std::path::PathBuf, fs::File)> {
-    for _ in 0..64 {
-        let tmp = temp_name_beside(path)?;
-        match super::links::open_options_no_follow()
+    create_beside(path, |tmp| {
+        super::links::open_options_no_follow()
             .write(true)
             .create_new(true)
-            .open(&tmp)
-        {
-            Ok(f) => return Ok((tmp, f)),
+            .open(tmp)
+    })
+}
+
+/// Make something new at the next free temp name beside `path` ([`temp_name_beside`]) with
+/// `create`, which must fail with `AlreadyExists` where the name is taken (a file opened
+/// `create_new`, a directory): taken names, perhaps planted, are skipped.
+pub fn create_beside<T>(
+    path: &Path,
+    mut create: impl FnMut(&Path) -> io::Result<T>,
+) -> io::Result<(std::path::PathBuf, T)> {
+    for _ in 0..64 {
+        let tmp = temp_name_beside(path)?;
+        match create(&tmp) {
+            Ok(made) => return Ok((tmp, made)),
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
             Err(e) => return Err(e),
         }
     }
     Err(io::Error::new(
         io::ErrorKind::AlreadyExists,
-        format!("no free temp file name beside {}", path.display()),
+        format!("no free temp name beside {}", path.display()),
     ))
 }
 

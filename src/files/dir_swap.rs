@@ -100,18 +100,7 @@ fn exchange(a: &Path, b: &Path) -> io::Result<()> {
 /// A new empty directory beside `dir`, created exclusively (a planted name is skipped):
 /// `.<name>.<pid>-<n>.tmp`, the temp-name pattern of [`super::atomic`].
 fn create_temp_dir_beside(dir: &Path) -> io::Result<PathBuf> {
-    for _ in 0..64 {
-        let tmp = super::atomic::temp_name_beside(dir)?;
-        match std::fs::create_dir(&tmp) {
-            Ok(()) => return Ok(tmp),
-            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e),
-        }
-    }
-    Err(io::Error::new(
-        io::ErrorKind::AlreadyExists,
-        format!("no free temp directory name beside {}", dir.display()),
-    ))
+    super::atomic::create_beside(dir, |tmp| std::fs::create_dir(tmp)).map(|(tmp, ())| tmp)
 }
 
 /// Remove the generations of `name` in `parent` that a killed process left (directories only,

@@ -219,10 +219,9 @@ where
         };
         let start = std::time::Instant::now();
         // A panic is a bug, but it fails this run only, not its neighbours.
+        // The run checks its directories again as it creates them and takes its lock
+        // (`train_run`); it creates them only when it trains, so a stopped batch leaves none.
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            // Checked again as the run starts (the run creates its directory only when it
-            // trains: a stopped batch leaves no empty ones).
-            check_real_dirs(&opts.out, &dir).map_err(|e| e.to_string())?;
             run_one(spec, &dir, &progress)
         }))
         .unwrap_or_else(|panic| {

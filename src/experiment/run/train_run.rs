@@ -228,15 +228,7 @@ fn lock_run_dir(spec: &RunSpec, dir: &Path) -> Result<std::fs::File, RunError> {
             format!("{e}; a run directory and the directories above it must be real directories"),
         )
     };
-    match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => return Err(io(dir, e)),
-        Ok(m) if m.is_dir() => {}
-        Ok(_) => return Err(io(
-            dir,
-            "is not a directory (a symlink or a file); a run directory must be a real directory",
-        )),
-    }
+    // Refuses a link or a file at the run directory itself too.
     create_real_dirs(root, dir).map_err(not_real)?;
     let path = dir.join(LOCK);
     // Never through a link planted at `.lock`: creating or truncating its target elsewhere.
