@@ -43,8 +43,13 @@ fn rows(evals: &[EvalPoint]) -> Vec<String> {
         .iter()
         .map(|e| {
             format!(
-                "{} {} {} {:?} {:?}",
-                e.episode, e.env_steps, e.updates, e.eval_return, e.family
+                "{} {} {} {:?} {:?} {:?}",
+                e.episode,
+                e.env_steps,
+                e.updates,
+                e.eval_return,
+                e.eval_return_undiscounted,
+                e.family
             )
         })
         .collect()

@@ -94,7 +94,7 @@ fn plot_by_default_writes_beside_the_results_never_into_plots() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[0],
-        "experiment,method,variant,seed,episode,env_steps,updates,eval_return,epsilon,hysteresis,loss,wall_seconds"
+        "experiment,method,variant,seed,episode,env_steps,updates,eval_return,eval_return_undiscounted,epsilon,hysteresis,loss,wall_seconds"
     );
     assert_eq!(lines.len(), 1 + 2 * 9);
     assert!(lines[1].starts_with("tiny_plot,our1,,0,0,"), "{}", lines[1]);

@@ -17,8 +17,9 @@ def load_results(root: Union[str, os.PathLike] = "results", as_dict: bool = Fals
 
     Columns: ``experiment`` (its path below the root, ``fig4a_bp10`` or ``macromarl/bp6``),
     ``method`` and ``variant`` (the curve directory split at ``@``; empty without a sweep),
-    ``seed``, then every ``metrics.csv`` column (``episode, env_steps, updates, eval_return``,
-    the method families' own columns, NaN where a run's family has none, ``wall_seconds``).
+    ``seed``, then every ``metrics.csv`` column (``episode, env_steps, updates, eval_return,
+    eval_return_undiscounted`` (NaN for runs trained before it was recorded), the method
+    families' own columns, NaN where a run's family has none, ``wall_seconds``).
     Reads ``metrics.csv`` or ``metrics.csv.gz``, the same rows and values as
     ``macdec results``. Returns a pandas DataFrame when pandas is installed (the three name
     columns categorical), else (or with ``as_dict=True``) a dict of NumPy arrays.

@@ -1,7 +1,7 @@
 //! Every run of a results tree as columns for `macdec.load_results`: read by the same reader
 //! as `macdec results` ([`macdec::experiment::tidy_table`]), so the two give the same rows.
 
-use macdec::experiment::metrics::{LEADING_COLUMNS, WALL_SECONDS};
+use macdec::experiment::metrics::{EVAL_RETURN_UNDISCOUNTED, LEADING_COLUMNS, WALL_SECONDS};
 use macdec::experiment::tidy_table::{read_run, tidy_runs, TidyError};
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
@@ -19,6 +19,8 @@ struct Columns {
     env_steps: Vec<i64>,
     updates: Vec<i64>,
     eval_return: Vec<f64>,
+    /// NaN for runs trained before the column existed.
+    eval_return_undiscounted: Vec<f64>,
     /// Every family column of any run, in order of first appearance, NaN where a run lacks it.
     family: Vec<(String, Vec<f64>)>,
     wall_seconds: Vec<f64>,
@@ -33,6 +35,7 @@ fn read_all(root: &std::path::Path) -> Result<Columns, TidyError> {
         env_steps: Vec::new(),
         updates: Vec::new(),
         eval_return: Vec::new(),
+        eval_return_undiscounted: Vec::new(),
         family: Vec::new(),
         wall_seconds: Vec::new(),
     };
@@ -56,6 +59,8 @@ fn read_all(root: &std::path::Path) -> Result<Columns, TidyError> {
             c.env_steps.push(r.env_steps as i64);
             c.updates.push(r.updates as i64);
             c.eval_return.push(r.eval_return);
+            c.eval_return_undiscounted
+                .push(r.eval_return_undiscounted.unwrap_or(f64::NAN));
             c.wall_seconds.push(r.wall_seconds);
             for (_, col) in c.family.iter_mut() {
                 col.push(f64::NAN);
@@ -98,6 +103,11 @@ pub fn read_results<'py>(py: Python<'py>, root: PathBuf) -> PyResult<Bound<'py, 
     out.set_item("env_steps", c.env_steps.into_pyarray_bound(py))?;
     out.set_item("updates", c.updates.into_pyarray_bound(py))?;
     out.set_item("eval_return", c.eval_return.into_pyarray_bound(py))?;
+    out.set_item(
+        EVAL_RETURN_UNDISCOUNTED,
+        c.eval_return_undiscounted.into_pyarray_bound(py),
+    )?;
+    names.push(EVAL_RETURN_UNDISCOUNTED.to_string());
     for (name, col) in c.family {
         out.set_item(&name, col.into_pyarray_bound(py))?;
         names.push(name);

@@ -14,11 +14,12 @@ import pytest
 import macdec
 
 VALUE_RUN = "episode,env_steps,updates,eval_return,epsilon,hysteresis,loss,wall_seconds\n"
-AC_RUN = "episode,env_steps,updates,eval_return,critic_loss,wall_seconds\n"
+AC_RUN = "episode,env_steps,updates,eval_return,eval_return_undiscounted,critic_loss,wall_seconds\n"
 
 
 def write_tree(root):
-    """Three runs: two value-based (one gzip-compressed) and an actor-critic sweep point."""
+    """Three runs: two value-based (one gzip-compressed, both in the form of runs trained before
+    the undiscounted return was recorded) and an actor-critic sweep point."""
     a = root / "fig" / "our1" / "seed-0"
     a.mkdir(parents=True)
     (a / "metrics.csv").write_text(VALUE_RUN + "0,0,0,1.5,1.0,0.2,,0.1\n10,400,8,2.25,0.5,0.2,0.125,1.5\n")
@@ -27,7 +28,7 @@ def write_tree(root):
     (b / "metrics.csv.gz").write_bytes(gzip.compress((VALUE_RUN + "0,0,0,-3.0,1.0,0.2,,0.2\n").encode()))
     c = root / "group" / "ac" / "mac-iac@lr=0.01" / "seed-1"
     c.mkdir(parents=True)
-    (c / "metrics.csv").write_text(AC_RUN + "0,0,0,7.0,0.75,0.3\n5,100,1,8.5,0.5,0.9\n")
+    (c / "metrics.csv").write_text(AC_RUN + "0,0,0,7.0,9.0,0.75,0.3\n5,100,1,8.5,10.5,0.5,0.9\n")
     (root / "fig" / "our1" / "seed-9").mkdir()  # no metrics: not a run
 
 
@@ -36,7 +37,8 @@ def test_a_fixture_tree_loads_as_a_tidy_frame(tmp_path):
     df = macdec.load_results(tmp_path)
     assert list(df.columns) == [
         "experiment", "method", "variant", "seed", "episode", "env_steps", "updates",
-        "eval_return", "epsilon", "hysteresis", "loss", "critic_loss", "wall_seconds",
+        "eval_return", "eval_return_undiscounted", "epsilon", "hysteresis", "loss", "critic_loss",
+        "wall_seconds",
     ]
     assert len(df) == 5
     assert df["experiment"].tolist() == ["fig", "fig", "fig", "group/ac", "group/ac"]
@@ -46,6 +48,8 @@ def test_a_fixture_tree_loads_as_a_tidy_frame(tmp_path):
     assert df["eval_return"].tolist() == [1.5, 2.25, -3.0, 7.0, 8.5]
     assert df["episode"].dtype == np.int64
     assert math.isnan(df["loss"][0]) and df["loss"][1] == 0.125
+    assert df["eval_return_undiscounted"][:3].isna().all()
+    assert df["eval_return_undiscounted"][3:].tolist() == [9.0, 10.5]
     assert df["critic_loss"][:3].isna().all() and df["critic_loss"][3] == 0.75
     d = macdec.load_results(tmp_path, as_dict=True)
     assert isinstance(d["eval_return"], np.ndarray) and d["method"].tolist() == df["method"].tolist()

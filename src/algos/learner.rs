@@ -51,6 +51,19 @@ pub enum Schedule {
     },
 }
 
+/// What one evaluation measured: the evaluated policy's mean return over its episodes, both ways
+/// the field reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EvalReturns {
+    /// Discounted per primitive step with the training discount (`docs/ALGORITHMS.md` §7.1):
+    /// what the references plot and `metrics.csv`'s `eval_return` holds.
+    pub discounted: f64,
+    /// The plain sum over primitive steps of the team reward (the agents' mean reward where the
+    /// reference's rewards are per agent): what ACAC and later work report
+    /// (`eval_return_undiscounted`).
+    pub undiscounted: f64,
+}
+
 /// One training lane a learner asks for: an environment the loop steps and resets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LanePlan {
@@ -141,9 +154,10 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
     /// Copy the online nets into their targets.
     fn sync_targets(&mut self);
 
-    /// The evaluated policy's mean return over `config().eval_num_epi` episodes of `env`
-    /// (one if the domain is deterministic), discounted per primitive step.
-    fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng) -> Result<f64, EnvError>;
+    /// The evaluated policy's mean returns over `config().eval_num_epi` episodes of `env`
+    /// (one if the domain is deterministic).
+    fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng)
+        -> Result<EvalReturns, EnvError>;
 
     /// The evaluation of an [`Schedule::EpisodeBatches`] learner, on the training lanes'
     /// environments (MacroMARL evaluates on its workers; the lanes are reset before the next
@@ -152,7 +166,7 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
         &self,
         envs: &mut [&mut E],
         rng: &mut EnvRng,
-    ) -> Result<f64, EnvError> {
+    ) -> Result<EvalReturns, EnvError> {
         self.evaluate(&mut *envs[0], rng)
     }
 

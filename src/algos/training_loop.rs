@@ -47,6 +47,9 @@ pub struct EvalPoint {
     pub updates: u64,
     /// Mean evaluation return, discounted per primitive step (`docs/ALGORITHMS.md` §7.1).
     pub eval_return: f64,
+    /// Mean evaluation return, undiscounted ([`crate::algos::learner::EvalReturns`]); `None` in
+    /// the metrics files of runs trained before the column existed.
+    pub eval_return_undiscounted: Option<f64>,
     /// The family's own columns, in the order of [`Learner::metric_columns`] (value-based:
     /// `epsilon`, `hysteresis`, `loss`); `None` is an empty cell.
     pub family: Vec<Option<f64>>,
@@ -371,7 +374,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 
     /// Evaluate the learner's policy (`docs/ALGORITHMS.md` §7.1), appended to the curve.
     fn evaluate(&mut self) -> Result<(), TrainError> {
-        let eval_return = match self.learner.schedule() {
+        let returns = match self.learner.schedule() {
             Schedule::EveryStep { .. } => self
                 .learner
                 .evaluate(&mut self.eval_env, &mut self.eval_rng)?,
@@ -385,7 +388,8 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
             episode: self.episodes,
             env_steps: self.env_steps,
             updates: self.updates,
-            eval_return,
+            eval_return: returns.discounted,
+            eval_return_undiscounted: Some(returns.undiscounted),
             family,
             wall_seconds: self.wall_seconds(),
         });
@@ -396,7 +400,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::learner::LanePlan;
+    use crate::algos::learner::{EvalReturns, LanePlan};
     use crate::envs::StepOutcome;
     use crate::experiment::paper::value_paper_defaults;
     use crate::experiment::train_run::run_rngs;
@@ -483,8 +487,15 @@ mod tests {
         fn sync_targets(&mut self) {
             self.syncs += 1;
         }
-        fn evaluate<E: MacroEnv>(&self, _: &mut E, _: &mut EnvRng) -> Result<f64, EnvError> {
-            Ok(self.trains.len() as f64)
+        fn evaluate<E: MacroEnv>(
+            &self,
+            _: &mut E,
+            _: &mut EnvRng,
+        ) -> Result<EvalReturns, EnvError> {
+            Ok(EvalReturns {
+                discounted: self.trains.len() as f64,
+                undiscounted: -(self.trains.len() as f64),
+            })
         }
         fn metric_columns(&self) -> &'static [&'static str] {
             &["evals_before"]

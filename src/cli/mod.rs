@@ -790,7 +790,7 @@ fn audit(args: AuditArgs) -> Result<()> {
         Ok(a) => {
             println!("{}", a.line());
             if let Some(p) = &a.provenance {
-                if p.kernel_path != here.kernel_path {
+                if !crate::autograd::kernels::same_arithmetic(&p.kernel_path, &here.kernel_path) {
                     println!(
                         "  note: trained on the {} kernel path, retrained on {}: rounding may differ",
                         p.kernel_path, here.kernel_path

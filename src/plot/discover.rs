@@ -355,6 +355,7 @@ pub(crate) mod tests {
                 env_steps: episode * 50,
                 updates: episode / 2,
                 eval_return,
+                eval_return_undiscounted: Some(eval_return),
                 family: vec![Some(1.0), Some(1.0), None],
                 wall_seconds: episode as f64 * 0.5,
             })

@@ -8,6 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::algos::learner::EvalReturns;
 use crate::envs::{FirstRecordObs, MacroEnv, StepOutcome};
 
 /// One recorded episode: row t of the per-step fields is primitive step t; `obs` and `state`
@@ -92,6 +93,8 @@ pub struct EpisodeRecorder {
     joint_steps: i32,
     /// The episode's return: sum over primitive steps of gamma^t times the mean reward.
     ret: f64,
+    /// The undiscounted return so far.
+    plain: f64,
 }
 
 impl EpisodeRecorder {
@@ -128,6 +131,7 @@ impl EpisodeRecorder {
         self.acc_joint = 0.0;
         self.joint_steps = 0;
         self.ret = 0.0;
+        self.plain = 0.0;
     }
 
     fn push_observation<E: MacroEnv>(&mut self, env: &E) {
@@ -176,6 +180,7 @@ impl EpisodeRecorder {
         e.terminate.push(outcome.terminal());
         self.last_valid.copy_from_slice(done);
         self.ret += g.powf(e.steps as f64) * sum / n as f64;
+        self.plain += sum / n as f64;
         e.steps += 1;
         self.push_observation(env);
         // Quirk Q20 (`MacroEnv::first_record_obs`): the runner's first record holds the env's
@@ -198,9 +203,13 @@ impl EpisodeRecorder {
         &self.episode
     }
 
-    /// The episode's discounted return so far (the worker's `R`).
-    pub fn discounted_return(&self) -> f64 {
-        self.ret
+    /// The episode's returns so far: discounted (the worker's `R`) and undiscounted (the plain
+    /// sum of the agents' mean reward).
+    pub fn returns(&self) -> EvalReturns {
+        EvalReturns {
+            discounted: self.ret,
+            undiscounted: self.plain,
+        }
     }
 
     /// Which agents are free to choose (their macro-action ended at the last step, or the
@@ -224,9 +233,12 @@ mod tests {
         env.reset(&mut rng);
         let mut rec = EpisodeRecorder::new(&env, 0.9, true);
         let mut steps = 0;
+        let (mut discounted, mut plain) = (0.0, 0.0);
         loop {
             let o = env.step(&[0, 1], &mut rng).unwrap();
             rec.record(&env, o);
+            discounted += 0.9f64.powi(steps as i32) * o.reward;
+            plain += o.reward;
             steps += 1;
             if o.done || steps == 12 {
                 break;
@@ -243,8 +255,14 @@ mod tests {
                 assert_eq!(e.mac_start(t, i), e.valid(t - 1, i));
             }
         }
-        // The return is the discounted mean reward.
-        assert!(rec.discounted_return().is_finite());
+        // The returns are the discounted and the plain sums of the (team = mean) reward.
+        let r = rec.returns();
+        assert!(
+            (r.discounted - discounted).abs() < 1e-9,
+            "{r:?} {discounted}"
+        );
+        assert!((r.undiscounted - plain).abs() < 1e-9, "{r:?} {plain}");
+        assert!(plain < 0.0 && r.discounted != r.undiscounted, "{r:?}");
     }
 
     #[test]

@@ -14,7 +14,7 @@ use super::episode::{Episode, EpisodeRecorder};
 use super::nets::{AcNets, NetSizes};
 use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::hyper::RunConfig;
-use crate::algos::learner::{LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
+use crate::algos::learner::{EvalReturns, LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
 use crate::algos::method::{AcActor, AcCritic, AcDesign, Method};
 use crate::algos::training_loop::TrainError;
 use crate::autograd::Tape;
@@ -270,7 +270,7 @@ impl Learner for AcLearner {
         if !outcome.done {
             return Ok(false);
         }
-        self.return_sum += lane.recorder.discounted_return();
+        self.return_sum += lane.recorder.returns().discounted;
         self.return_count += 1;
         self.memory.push_back(lane.recorder.episode().clone());
         while self.memory.len() > self.c().train_freq {
@@ -328,7 +328,7 @@ impl Learner for AcLearner {
         &self,
         envs: &mut [&mut E],
         rng: &mut EnvRng,
-    ) -> Result<f64, EnvError> {
+    ) -> Result<EvalReturns, EnvError> {
         let c = self.c();
         let n_agents = envs[0].n_agents();
         let mut recorders = Vec::with_capacity(envs.len());
@@ -347,7 +347,7 @@ impl Learner for AcLearner {
                 let outcome = envs[k].step(&actions, rng)?;
                 recorders[k].record(&*envs[k], outcome);
                 if outcome.done {
-                    returns.push(recorders[k].discounted_return());
+                    returns.push(recorders[k].returns());
                     envs[k].reset(rng);
                     recorders[k].begin(&*envs[k]);
                     for s in &mut states[k] {
@@ -357,11 +357,19 @@ impl Learner for AcLearner {
             }
         }
         let last = &returns[returns.len() - c.eval_num_epi..];
-        Ok(last.iter().sum::<f64>() / last.len() as f64)
+        let n = last.len() as f64;
+        Ok(EvalReturns {
+            discounted: last.iter().map(|r| r.discounted).sum::<f64>() / n,
+            undiscounted: last.iter().map(|r| r.undiscounted).sum::<f64>() / n,
+        })
     }
 
     /// One environment: the lockstep evaluation with a single lane.
-    fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng) -> Result<f64, EnvError> {
+    fn evaluate<E: MacroEnv>(
+        &self,
+        env: &mut E,
+        rng: &mut EnvRng,
+    ) -> Result<EvalReturns, EnvError> {
         self.evaluate_lanes(&mut [env], rng)
     }
 

@@ -1,6 +1,7 @@
 //! Greedy evaluation (`docs/ALGORITHMS.md` §7.1): the learned policies on a separate env copy, no
 //! exploration, hidden state carried through the episode, return discounted per primitive step.
 
+use crate::algos::learner::EvalReturns;
 use crate::algos::value::acting::{select_cen, select_dec, ActScratch};
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use crate::nn::{LstmState, QNet};
@@ -75,8 +76,9 @@ impl<'a> GreedyActor<'a> {
     }
 }
 
-/// Mean greedy return over `episodes` episodes. When the env draws no random numbers the
-/// episodes are identical (`docs/ALGORITHMS.md` §7.1), so one is run and its return used for all.
+/// Mean greedy returns over `episodes` episodes. When the env draws no random numbers the
+/// episodes are identical (`docs/ALGORITHMS.md` §7.1), so one is run and its returns used for
+/// all.
 pub fn evaluate<E: MacroEnv + ?Sized>(
     env: &mut E,
     policy: GreedyPolicy<'_>,
@@ -84,11 +86,17 @@ pub fn evaluate<E: MacroEnv + ?Sized>(
     episodes: usize,
     deterministic: bool,
     rng: &mut EnvRng,
-) -> Result<f64, EnvError> {
+) -> Result<EvalReturns, EnvError> {
     let runs = if deterministic { 1 } else { episodes.max(1) };
-    let mut total = 0.0;
+    let mut discounted = 0.0;
+    let mut undiscounted = 0.0;
     for _ in 0..runs {
-        total += greedy_episode(env, policy, discount, rng, |_, _, _| {})?;
+        let mut plain = 0.0;
+        discounted += greedy_episode(env, policy, discount, rng, |_, _, r| plain += r)?;
+        undiscounted += plain;
     }
-    Ok(total / runs as f64)
+    Ok(EvalReturns {
+        discounted: discounted / runs as f64,
+        undiscounted: undiscounted / runs as f64,
+    })
 }

@@ -3,7 +3,7 @@
 //! Where the methods differ, [`Method`]'s exhaustive `match`es decide.
 
 use crate::algos::hyper::{RunConfig, ValueConfig};
-use crate::algos::learner::{LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
+use crate::algos::learner::{EvalReturns, LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
 use crate::algos::method::{EvaluatedPolicy, Exploration, HysteresisRule, Method};
 use crate::algos::training_loop::TrainError;
 use crate::algos::value::acting::{select_cen, select_dec, ActScratch, Explore};
@@ -330,7 +330,11 @@ impl Learner for ValueLearner {
         }
     }
 
-    fn evaluate<E: MacroEnv>(&self, env: &mut E, rng: &mut EnvRng) -> Result<f64, EnvError> {
+    fn evaluate<E: MacroEnv>(
+        &self,
+        env: &mut E,
+        rng: &mut EnvRng,
+    ) -> Result<EvalReturns, EnvError> {
         let dec: Vec<&QNet> = self.dec.iter().map(|n| &n.policy).collect();
         let policy = match self.method.evaluated_policy() {
             EvaluatedPolicy::Centralized => GreedyPolicy::Cen(

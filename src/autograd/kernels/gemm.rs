@@ -1,14 +1,23 @@
 //! Matrix products, the bulk of every update's arithmetic.
 //!
-//! One entry point, [`gemm`]. On x86-64 CPUs with AVX-512 it runs our own kernel (`avx512`
-//! below), which reaches ~110 GFLOP/s on one core here at every shape the Q-nets use, against
-//! 45-105 for `matrixmultiply` (whose packing dominates the small per-step recurrent products);
-//! elsewhere it calls `matrixmultiply`. Both run on the calling thread only, so thread count
-//! never changes a number. The two backends round differently, so bits are reproducible on
-//! one machine, not across CPU families.
+//! One entry point, [`gemm`], and one arithmetic whatever the CPU: every output element is,
+//! for each block of [`K_BLOCK`] consecutive k (in order), a chain of fused multiply-adds
+//! `acc = fma(a[i][k], b[k][j], acc)` from `acc = 0`, after which the block's sum is added to
+//! what the element holds (`acc + c`, skipped for the first block of an overwrite). Vector
+//! width, tile shape and row/column order change nothing in that per-element sequence, so the
+//! three kernels give the same bits and a run trained on one CPU family retrains exactly on
+//! another: `avx512` (ours, ~110 GFLOP/s on one core at every shape the Q-nets use, against
+//! 45-105 for `matrixmultiply`, whose packing dominates the small per-step recurrent products),
+//! `avx2` (the same tiles, 8 lanes, with FMA) and `portable` (element by element with
+//! `f32::mul_add`: any layout, any CPU). All run on the calling thread only, so thread count
+//! never changes a number.
 
-use ndarray::linalg::general_mat_mul;
 use ndarray::{Array2, ArrayView2, ArrayViewMut2};
+
+/// Consecutive k summed in one chain before the chain's sum is added into the output: part of
+/// the arithmetic every kernel shares (it also keeps the slices of A and B a tile row walks in
+/// L2).
+pub const K_BLOCK: usize = 384;
 
 /// How a product lands in its destination.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,29 +45,61 @@ pub fn gemm(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, m
         return;
     }
     #[cfg(target_arch = "x86_64")]
-    if avx512::available() && c.strides()[1] == 1 && c.strides()[0] >= 0 {
+    {
+        let simd = if avx512::available() {
+            Some(avx512::gemm_views as SimdKernel)
+        } else if avx2::available() {
+            Some(avx2::gemm_views as SimdKernel)
+        } else {
+            None
+        };
         let nonneg = a.strides().iter().chain(b.strides()).all(|&s| s >= 0);
-        if nonneg {
+        if let Some(kernel) = simd.filter(|_| nonneg && c.strides()[1] == 1 && c.strides()[0] >= 0)
+        {
             if b.strides()[1] == 1 {
-                // SAFETY: the views describe valid memory for their shapes and strides (all
-                // non-negative), b and c have unit column stride, and c does not alias a or b
-                // (it is borrowed mutably while they are borrowed).
-                unsafe { avx512::gemm_views(a, b, c, mode) };
+                // SAFETY: the CPU has the kernel's features (checked above), the views describe
+                // valid memory for their shapes and strides (all non-negative), b and c have
+                // unit column stride, and c does not alias a or b (it is borrowed mutably while
+                // they are borrowed).
+                unsafe { kernel(a, b, c, mode) };
             } else {
                 // b in standard layout, as the transpose of b^T: x · W^T passes W.t(), so
                 // W is contiguous and takes the register-block path of `transposed`.
                 let bt = transposed(b.t());
                 // SAFETY: as above; `bt` is a fresh standard-layout array.
-                unsafe { avx512::gemm_views(a, bt.view(), c, mode) };
+                unsafe { kernel(a, bt.view(), c, mode) };
             }
             return;
         }
     }
-    let beta = match mode {
-        Mode::Overwrite => 0.0,
-        Mode::Accumulate => 1.0,
-    };
-    general_mat_mul(1.0, &a, &b, beta, &mut c);
+    portable(a, b, c.view_mut(), mode);
+}
+
+/// A vector kernel's entry point (`avx512::gemm_views`, `avx2::gemm_views`).
+#[cfg(target_arch = "x86_64")]
+type SimdKernel = unsafe fn(ArrayView2<f32>, ArrayView2<f32>, ArrayViewMut2<f32>, Mode);
+
+/// The shared arithmetic element by element, for any layout and CPU: the definition the vector
+/// kernels reproduce.
+fn portable(a: ArrayView2<f32>, b: ArrayView2<f32>, mut c: ArrayViewMut2<f32>, mode: Mode) {
+    let (m, k, n) = (a.nrows(), a.ncols(), b.ncols());
+    for i in 0..m {
+        for j in 0..n {
+            let mut k0 = 0;
+            while k0 < k {
+                let end = (k0 + K_BLOCK).min(k);
+                let mut acc = 0.0f32;
+                for q in k0..end {
+                    acc = a[[i, q]].mul_add(b[[q, j]], acc);
+                }
+                if mode == Mode::Accumulate || k0 > 0 {
+                    acc += c[[i, j]];
+                }
+                c[[i, j]] = acc;
+                k0 = end;
+            }
+        }
+    }
 }
 
 /// src^T as a standard-layout array (e.g. a weight W [out, in] into W^T, the right operand of
@@ -109,7 +150,7 @@ mod avx512 {
 
     const MR: usize = 8;
     const NR: usize = 32;
-    const KC: usize = 384;
+    const KC: usize = super::K_BLOCK;
 
     /// Whether this CPU runs the kernel (checked once).
     pub fn available() -> bool {
@@ -383,6 +424,166 @@ mod avx512 {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    //! The `avx512` kernel's arithmetic on CPUs with AVX2 and FMA but not AVX-512: register
+    //! tile 4 rows x 16 columns (8 ymm accumulators), one A entry broadcast per row into two
+    //! 8-lane vectors of a B row. Columns past n are masked (masked lanes load zeros and are
+    //! never stored).
+
+    use std::arch::x86_64::*;
+    use std::sync::OnceLock;
+
+    use super::Mode;
+    use ndarray::{ArrayView2, ArrayViewMut2};
+
+    const MR: usize = 4;
+    const NR: usize = 16;
+    const KC: usize = super::K_BLOCK;
+
+    /// Whether this CPU runs the kernel (checked once).
+    pub fn available() -> bool {
+        static HAS: OnceLock<bool> = OnceLock::new();
+        *HAS.get_or_init(|| {
+            std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+        })
+    }
+
+    /// # Safety
+    /// The CPU supports AVX2 and FMA; the views are valid with non-negative strides; b and c
+    /// have unit column stride; c does not overlap a or b.
+    pub unsafe fn gemm_views(
+        a: ArrayView2<f32>,
+        b: ArrayView2<f32>,
+        mut c: ArrayViewMut2<f32>,
+        mode: Mode,
+    ) {
+        let (m, k, n) = (a.nrows(), a.ncols(), b.ncols());
+        let (rsa, csa) = (a.strides()[0], a.strides()[1]);
+        let rsb = b.strides()[0];
+        let rsc = c.strides()[0];
+        gemm(
+            m,
+            n,
+            k,
+            a.as_ptr(),
+            rsa,
+            csa,
+            b.as_ptr(),
+            rsb,
+            c.as_mut_ptr(),
+            rsc,
+            mode == Mode::Accumulate,
+        );
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn gemm(
+        m: usize,
+        n: usize,
+        k: usize,
+        a: *const f32,
+        rsa: isize,
+        csa: isize,
+        b: *const f32,
+        rsb: isize,
+        c: *mut f32,
+        rsc: isize,
+        accumulate: bool,
+    ) {
+        let mut k0 = 0;
+        while k0 < k {
+            let kc = (k - k0).min(KC);
+            let (ak, bk) = (a.offset(k0 as isize * csa), b.offset(k0 as isize * rsb));
+            let acc = accumulate || k0 > 0;
+            let mut i = 0;
+            while i < m {
+                let rows = (m - i).min(MR);
+                let (ai, ci) = (ak.offset(i as isize * rsa), c.offset(i as isize * rsc));
+                let mut j = 0;
+                while j < n {
+                    let cols = (n - j).min(NR);
+                    let t = Tile {
+                        k: kc,
+                        a: ai,
+                        rsa,
+                        csa,
+                        b: bk.add(j),
+                        rsb,
+                        c: ci.add(j),
+                        rsc,
+                        m0: lane_mask(cols),
+                        m1: lane_mask(cols.saturating_sub(8)),
+                    };
+                    match rows {
+                        4 => t.run::<4>(acc),
+                        3 => t.run::<3>(acc),
+                        2 => t.run::<2>(acc),
+                        _ => t.run::<1>(acc),
+                    }
+                    j += NR;
+                }
+                i += MR;
+            }
+            k0 += kc;
+        }
+    }
+
+    /// All lanes below min(cols, 8) set (as `maskload`/`maskstore` read them: the sign bit).
+    #[inline(always)]
+    unsafe fn lane_mask(cols: usize) -> __m256i {
+        let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        _mm256_cmpgt_epi32(_mm256_set1_epi32(cols.min(8) as i32), lanes)
+    }
+
+    /// One register tile's operands.
+    #[derive(Clone, Copy)]
+    struct Tile {
+        k: usize,
+        a: *const f32,
+        rsa: isize,
+        csa: isize,
+        b: *const f32,
+        rsb: isize,
+        c: *mut f32,
+        rsc: isize,
+        m0: __m256i,
+        m1: __m256i,
+    }
+
+    impl Tile {
+        /// C[0..R, 0..16] (=|+=) A[0..R, 0..k] · B[0..k, 0..16] under the column masks.
+        #[inline(always)]
+        unsafe fn run<const R: usize>(&self, accumulate: bool) {
+            let mut acc0 = [_mm256_setzero_ps(); R];
+            let mut acc1 = [_mm256_setzero_ps(); R];
+            let (mut ap, mut bp) = (self.a, self.b);
+            for _ in 0..self.k {
+                let b0 = _mm256_maskload_ps(bp, self.m0);
+                let b1 = _mm256_maskload_ps(bp.add(8), self.m1);
+                for r in 0..R {
+                    let av = _mm256_set1_ps(*ap.offset(r as isize * self.rsa));
+                    acc0[r] = _mm256_fmadd_ps(av, b0, acc0[r]);
+                    acc1[r] = _mm256_fmadd_ps(av, b1, acc1[r]);
+                }
+                ap = ap.offset(self.csa);
+                bp = bp.offset(self.rsb);
+            }
+            for r in 0..R {
+                let cp = self.c.offset(r as isize * self.rsc);
+                if accumulate {
+                    acc0[r] = _mm256_add_ps(acc0[r], _mm256_maskload_ps(cp, self.m0));
+                    acc1[r] = _mm256_add_ps(acc1[r], _mm256_maskload_ps(cp.add(8), self.m1));
+                }
+                _mm256_maskstore_ps(cp, self.m0, acc0[r]);
+                _mm256_maskstore_ps(cp.add(8), self.m1, acc1[r]);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -468,6 +669,83 @@ mod tests {
             for ((i, j), &w) in want.indexed_iter() {
                 assert!((c[[i, j]] as f64 - w).abs() < 1e-4 * (1.0 + w.abs()));
             }
+        }
+    }
+
+    /// Every kernel this CPU can run, by name, as `gemm` would call it (b and c contiguous).
+    fn kernels() -> Vec<(&'static str, GemmFn)> {
+        #[allow(unused_mut)]
+        let mut all: Vec<(&'static str, GemmFn)> =
+            vec![("portable", |a, b, c, mode| portable(a, b, c, mode))];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if avx2::available() {
+                // SAFETY (in the closure): the CPU has AVX2 and FMA; the test passes standard-
+                // layout b and c that do not alias a.
+                all.push(("avx2", |a, b, c, mode| unsafe {
+                    avx2::gemm_views(a, b, c, mode)
+                }));
+            }
+            if avx512::available() {
+                // SAFETY: as above, with AVX-512F.
+                all.push(("avx512", |a, b, c, mode| unsafe {
+                    avx512::gemm_views(a, b, c, mode)
+                }));
+            }
+        }
+        all
+    }
+
+    type GemmFn = fn(ArrayView2<f32>, ArrayView2<f32>, ArrayViewMut2<f32>, Mode);
+
+    #[test]
+    fn every_kernel_gives_the_portable_arithmetic_bit_for_bit() {
+        // Shapes around every kernel's tiles (4 x 16, 8 x 32, 16 x 16) and the k block, values
+        // whose products round, overwrite then accumulate (a second k block adds into c).
+        let shapes = [
+            (1, 1, 1),
+            (3, 7, 5),
+            (4, 16, 16),
+            (5, 33, 17),
+            (9, 17, 16),
+            (17, 400, 47),
+            (3, 800, 65),
+            (31, 9, 3),
+            (16, 5, 8),
+            (45, 390, 16),
+            (64, 64, 96),
+        ];
+        let kernels = kernels();
+        for (m, k, n) in shapes {
+            let a = Array2::from_shape_fn((m, k), |(i, j)| {
+                ((i * 31 + j * 17) % 101) as f32 * 0.013_7 - 0.61
+            });
+            let b = Array2::from_shape_fn((k, n), |(i, j)| {
+                ((i * 7 + j * 29) % 89) as f32 * -0.021_3 + 0.97
+            });
+            let start = Array2::from_shape_fn((m, n), |(i, j)| (i + 3 * j) as f32 * 0.1);
+            let run = |f: GemmFn| {
+                let mut c = start.clone();
+                f(a.view(), b.view(), c.view_mut(), Mode::Accumulate);
+                let acc = c.clone();
+                f(a.view(), b.view(), c.view_mut(), Mode::Overwrite);
+                (acc, c)
+            };
+            let want = run(kernels[0].1);
+            for (name, f) in &kernels[1..] {
+                let got = run(*f);
+                let bits = |x: &Array2<f32>| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&got.0), bits(&want.0), "{name} {m}x{k}x{n} accumulate");
+                assert_eq!(bits(&got.1), bits(&want.1), "{name} {m}x{k}x{n} overwrite");
+            }
+            // The dispatching entry point, with a transposed right operand too.
+            let mut c = start.clone();
+            gemm(a.view(), b.view(), c.view_mut(), Mode::Accumulate);
+            assert_eq!(c, want.0);
+            let bt = b.t().as_standard_layout().into_owned();
+            let mut c = start.clone();
+            gemm(a.view(), bt.t(), c.view_mut(), Mode::Overwrite);
+            assert_eq!(c, want.1);
         }
     }
 

@@ -4,11 +4,12 @@
 //! provenance), its metrics (`metrics.csv` or `metrics.csv.gz`) and `finished`. Auditing a run
 //! retrains it from that config alone in a scratch directory and compares the metrics row by row,
 //! byte for byte, with the `wall_seconds` column (the only one that depends on the machine's
-//! speed) left out. Every committed run must pass at HEAD; a change that alters numerics must
+//! speed) left out, and `eval_return_undiscounted` too where the committed run was trained
+//! before that column existed. Every committed run must pass at HEAD; a change that alters numerics must
 //! recompute the results it affects.
 
 use crate::experiment::config::RunSpec;
-use crate::experiment::metrics::{self, MetricsError};
+use crate::experiment::metrics::{self, MetricsError, EVAL_RETURN_UNDISCOUNTED};
 use crate::experiment::provenance::Provenance;
 use crate::experiment::results_tree::{self, CONFIG};
 use crate::experiment::runner::Progress;
@@ -169,7 +170,10 @@ pub fn audit_run(dir: &Path, scratch: &Path) -> Result<RunAudit, AuditError> {
     train_run(&spec, &run_dir, &Progress::hidden(), true)?;
     let retrained_path = run_dir.join(metrics::METRICS_FILE);
     let committed = rows_without_wall(&committed_path)?;
-    let retrained = rows_without_wall(&retrained_path)?;
+    let mut retrained = rows_without_wall(&retrained_path)?;
+    if !has_column(&committed, EVAL_RETURN_UNDISCOUNTED) {
+        drop_column(&mut retrained, EVAL_RETURN_UNDISCOUNTED);
+    }
     Ok(RunAudit {
         dir: dir.to_path_buf(),
         provenance: manifest.provenance,
@@ -192,6 +196,32 @@ fn rows_without_wall(path: &Path) -> Result<Vec<String>, AuditError> {
         .chain(lines)
         .map(|l| l.rsplit_once(',').map_or(l, |(rest, _)| rest).to_string())
         .collect())
+}
+
+/// Whether the header (the first of `lines`) names `column`.
+fn has_column(lines: &[String], column: &str) -> bool {
+    lines
+        .first()
+        .is_some_and(|h| h.split(',').any(|c| c == column))
+}
+
+/// Remove `column` (if the header names it) from every line.
+fn drop_column(lines: &mut [String], column: &str) {
+    let Some(at) = lines
+        .first()
+        .and_then(|h| h.split(',').position(|c| c == column))
+    else {
+        return;
+    };
+    for line in lines.iter_mut() {
+        let kept: Vec<&str> = line
+            .split(',')
+            .enumerate()
+            .filter(|&(i, _)| i != at)
+            .map(|(_, cell)| cell)
+            .collect();
+        *line = kept.join(",");
+    }
 }
 
 /// Compare two metrics files' lines (header first): identical, or the first data row that differs.
@@ -276,6 +306,35 @@ mod tests {
         assert!(matches!(
             rows_without_wall(&p),
             Err(AuditError::BadHeader { .. })
+        ));
+    }
+
+    #[test]
+    fn a_run_committed_before_the_undiscounted_column_is_compared_without_it() {
+        let old = lines(&["episode,eval_return,loss", "0,1.5,", "10,2.5,0.3"]);
+        let mut new = lines(&[
+            "episode,eval_return,eval_return_undiscounted,loss",
+            "0,1.5,2,",
+            "10,2.5,3,0.3",
+        ]);
+        assert!(!has_column(&old, EVAL_RETURN_UNDISCOUNTED));
+        assert!(has_column(&new, EVAL_RETURN_UNDISCOUNTED));
+        assert!(matches!(
+            compare(&old, &new),
+            AuditOutcome::Differs { row: 0, .. }
+        ));
+        drop_column(&mut new, EVAL_RETURN_UNDISCOUNTED);
+        assert_eq!(compare(&old, &new), AuditOutcome::Identical { rows: 2 });
+        // A moved number in a kept column still differs.
+        let mut moved = lines(&[
+            "episode,eval_return,eval_return_undiscounted,loss",
+            "0,1.5,2,",
+            "10,2.5,3,0.4",
+        ]);
+        drop_column(&mut moved, EVAL_RETURN_UNDISCOUNTED);
+        assert!(matches!(
+            compare(&old, &moved),
+            AuditOutcome::Differs { row: 2, .. }
         ));
     }
 

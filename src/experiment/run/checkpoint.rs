@@ -20,9 +20,10 @@ use sha2::{Digest, Sha256};
 /// First bytes of every checkpoint.
 pub const MAGIC: &[u8; 8] = b"MACDECCK";
 /// The format version this build writes and reads.
+/// Version 3: evaluation points and actor-critic recorders carry the undiscounted return.
 /// Version 2: the payload is the family-tagged training loop (`AnyLoop`); version 1 held the
 /// value-based trainer alone.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 /// Longest identity header accepted (names are at most 200 bytes each).
 const MAX_IDENTITY_BYTES: usize = 4096;
 
@@ -293,8 +294,9 @@ mod tests {
         assert_eq!(e, CheckpointError::NoHeader);
         assert!(e.to_string().contains("older macdec"), "{e}");
         assert!(e.to_string().contains("delete it"), "{e}");
-        // Version 1 (the value-based trainer before the learner seam) and any future version.
-        for found in [1, 3] {
+        // Versions 1 (the value-based trainer before the learner seam) and 2 (before the
+        // undiscounted return), and any future version.
+        for found in [1, 2, 4] {
             let mut other = encode(&tiny().0, &t).unwrap();
             other[8] = found as u8;
             assert_eq!(

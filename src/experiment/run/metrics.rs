@@ -3,7 +3,9 @@
 //! Columns (stable names other tools read): `episode` (training episodes completed),
 //! `env_steps` (primitive steps taken by the training env(s)), `updates` (training iterations),
 //! `eval_return` (mean return of the evaluated policy, discounted per primitive step, spec
-//! `algorithms.md` 7.1), then the method family's own columns, then `wall_seconds` (time since
+//! `algorithms.md` 7.1), `eval_return_undiscounted` (the same episodes' mean undiscounted return,
+//! as ACAC and later work report it; absent from runs trained before it existed, whose files
+//! readers still take), then the method family's own columns, then `wall_seconds` (time since
 //! the run started, including resumed segments; the only column that is not reproducible bit for
 //! bit). The value-based family's columns are `epsilon`, `hysteresis` and `loss` (mean total TD
 //! loss over the iterations since the previous row; empty before the first), see
@@ -21,6 +23,8 @@ pub const METRICS_FILE_GZ: &str = "metrics.csv.gz";
 
 /// The columns every family writes before its own.
 pub const LEADING_COLUMNS: [&str; 4] = ["episode", "env_steps", "updates", "eval_return"];
+/// The column written after the leading ones since it exists; files of older runs lack it.
+pub const EVAL_RETURN_UNDISCOUNTED: &str = "eval_return_undiscounted";
 /// The column every family writes after its own.
 pub const WALL_SECONDS: &str = "wall_seconds";
 
@@ -39,6 +43,8 @@ pub use crate::algos::training_loop::EvalPoint as MetricsRow;
 /// A whole metrics file: the family's column names and every row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MetricsTable {
+    /// Whether the file has the `eval_return_undiscounted` column (runs trained since it exists).
+    pub has_undiscounted: bool,
     /// The names of the rows' [`MetricsRow::family`] values, in order.
     pub family_columns: Vec<String>,
     /// One row per evaluation point, in file order.
@@ -59,6 +65,14 @@ impl MetricsTable {
         };
         if let Some(value) = common {
             return Some(self.rows.iter().map(|r| Some(value(r))).collect());
+        }
+        if name == EVAL_RETURN_UNDISCOUNTED {
+            return self.has_undiscounted.then(|| {
+                self.rows
+                    .iter()
+                    .map(|r| r.eval_return_undiscounted)
+                    .collect()
+            });
         }
         let at = self.family_columns.iter().position(|c| c == name)?;
         Some(self.rows.iter().map(|r| r.family[at]).collect())
@@ -109,6 +123,7 @@ pub fn to_csv(family_columns: &[&str], rows: &[MetricsRow]) -> Result<Vec<u8>, c
     let mut w = csv::Writer::from_writer(Vec::new());
     let header: Vec<&str> = LEADING_COLUMNS
         .iter()
+        .chain(std::iter::once(&EVAL_RETURN_UNDISCOUNTED))
         .chain(family_columns)
         .chain(std::iter::once(&WALL_SECONDS))
         .copied()
@@ -125,6 +140,7 @@ pub fn to_csv(family_columns: &[&str], rows: &[MetricsRow]) -> Result<Vec<u8>, c
             Cell::Count(r.env_steps),
             Cell::Count(r.updates),
             Cell::Value(Some(r.eval_return)),
+            Cell::Value(r.eval_return_undiscounted),
         ];
         cells.extend(r.family.iter().map(|&v| Cell::Value(v)));
         cells.push(Cell::Value(Some(r.wall_seconds)));
@@ -161,8 +177,9 @@ pub fn read_text(path: &Path) -> Result<Vec<u8>, MetricsError> {
 }
 
 /// Read a curve written by [`fn@write`] (or its gzip-compressed copy), whatever the family: the
-/// columns between `eval_return` and `wall_seconds` are the family's. A missing leading column,
-/// a cell that is not a number, or a row of the wrong length is an error naming it.
+/// columns between `eval_return` (or `eval_return_undiscounted`, where the file has it) and
+/// `wall_seconds` are the family's. A missing leading column, a cell that is not a number, or a
+/// row of the wrong length is an error naming it.
 pub fn read(path: &Path) -> Result<MetricsTable, MetricsError> {
     let p = || path.display().to_string();
     let text = read_text(path)?;
@@ -189,7 +206,9 @@ pub fn read(path: &Path) -> Result<MetricsTable, MetricsError> {
             header.join(",")
         )));
     }
-    let family_columns = header[LEADING_COLUMNS.len()..n - 1].to_vec();
+    let has_undiscounted = header[LEADING_COLUMNS.len()] == EVAL_RETURN_UNDISCOUNTED;
+    let first_family = LEADING_COLUMNS.len() + usize::from(has_undiscounted);
+    let family_columns = header[first_family..n - 1].to_vec();
     let mut rows = Vec::new();
     for (i, record) in r.records().enumerate() {
         let record = record.map_err(csv_err)?;
@@ -213,22 +232,25 @@ pub fn read(path: &Path) -> Result<MetricsTable, MetricsError> {
                 ))
             })
         };
-        let family = (LEADING_COLUMNS.len()..n - 1)
-            .map(|k| match cell(k) {
-                "" => Ok(None),
-                _ => number(k).map(Some),
-            })
+        let optional = |k: usize| match cell(k) {
+            "" => Ok(None),
+            _ => number(k).map(Some),
+        };
+        let family = (first_family..n - 1)
+            .map(optional)
             .collect::<Result<Vec<_>, _>>()?;
         rows.push(MetricsRow {
             episode: count(0)?,
             env_steps: count(1)?,
             updates: count(2)?,
             eval_return: number(3)?,
+            eval_return_undiscounted: if has_undiscounted { optional(4)? } else { None },
             family,
             wall_seconds: number(n - 1)?,
         });
     }
     Ok(MetricsTable {
+        has_undiscounted,
         family_columns,
         rows,
     })
@@ -246,6 +268,7 @@ mod tests {
                 env_steps: 0,
                 updates: 0,
                 eval_return: -4.5,
+                eval_return_undiscounted: Some(-6.0),
                 family: vec![Some(1.0), Some(1.0), None],
                 wall_seconds: 0.1,
             },
@@ -254,6 +277,7 @@ mod tests {
                 env_steps: 900,
                 updates: 50,
                 eval_return: 80.7,
+                eval_return_undiscounted: Some(92.0),
                 family: vec![Some(0.99), Some(1.0), Some(0.25)],
                 wall_seconds: 1.5,
             },
@@ -270,8 +294,12 @@ mod tests {
         assert_eq!(table.column("q_loss"), None);
         let text = std::fs::read_to_string(&p).unwrap();
         assert!(text.starts_with(
-            "episode,env_steps,updates,eval_return,epsilon,hysteresis,loss,wall_seconds\n"
+            "episode,env_steps,updates,eval_return,eval_return_undiscounted,epsilon,hysteresis,loss,wall_seconds\n"
         ));
+        assert_eq!(
+            table.column(EVAL_RETURN_UNDISCOUNTED),
+            Some(vec![Some(-6.0), Some(92.0)])
+        );
         assert_eq!(locate(dir.path()), Some(p.clone()));
 
         // The committed form: gzip only, read back to the same rows.
@@ -293,13 +321,14 @@ mod tests {
         write(&p, &["actor_loss", "critic_loss"], &[]).unwrap();
         assert_eq!(
             std::fs::read_to_string(&p).unwrap(),
-            "episode,env_steps,updates,eval_return,actor_loss,critic_loss,wall_seconds\n"
+            "episode,env_steps,updates,eval_return,eval_return_undiscounted,actor_loss,critic_loss,wall_seconds\n"
         );
         let row = MetricsRow {
             episode: 96,
             env_steps: 9600,
             updates: 12,
             eval_return: 1e20,
+            eval_return_undiscounted: Some(3.5),
             family: vec![None, Some(-0.5)],
             wall_seconds: 2.0,
         };
@@ -310,10 +339,46 @@ mod tests {
         )
         .unwrap();
         let text = std::fs::read_to_string(&p).unwrap();
-        assert!(text.ends_with("\n96,9600,12,1e20,,-0.5,2.0\n"), "{text}");
+        assert!(
+            text.ends_with("\n96,9600,12,1e20,3.5,,-0.5,2.0\n"),
+            "{text}"
+        );
         let table = read(&p).unwrap();
         assert_eq!(table.family_columns, ["actor_loss", "critic_loss"]);
         assert_eq!(table.rows, vec![row]);
+    }
+
+    #[test]
+    fn a_file_of_a_run_trained_before_the_undiscounted_column_reads_as_before() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("metrics.csv");
+        std::fs::write(
+            &p,
+            "episode,env_steps,updates,eval_return,eps,critic_loss,wall_seconds\n0,0,0,1.5,1,,0.1\n",
+        )
+        .unwrap();
+        let table = read(&p).unwrap();
+        assert!(!table.has_undiscounted);
+        assert_eq!(table.family_columns, ["eps", "critic_loss"]);
+        assert_eq!(table.rows[0].eval_return_undiscounted, None);
+        assert_eq!(table.column(EVAL_RETURN_UNDISCOUNTED), None);
+        assert_eq!(table.column("eps"), Some(vec![Some(1.0)]));
+        // With the column, an empty cell is a missing value and a bad one is named.
+        std::fs::write(
+            &p,
+            "episode,env_steps,updates,eval_return,eval_return_undiscounted,wall_seconds\n0,0,0,1.5,,0.1\n",
+        )
+        .unwrap();
+        let table = read(&p).unwrap();
+        assert!(table.has_undiscounted && table.family_columns.is_empty());
+        assert_eq!(table.column(EVAL_RETURN_UNDISCOUNTED), Some(vec![None]));
+        std::fs::write(
+            &p,
+            "episode,env_steps,updates,eval_return,eval_return_undiscounted,wall_seconds\n0,0,0,1.5,x,0.1\n",
+        )
+        .unwrap();
+        let e = read(&p).unwrap_err().to_string();
+        assert!(e.contains("`eval_return_undiscounted`"), "{e}");
     }
 
     #[test]

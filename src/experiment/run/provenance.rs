@@ -12,7 +12,8 @@ pub struct Provenance {
     pub macdec_version: String,
     /// The commit hash, `<hash>-dirty` if the code differed from it, or `unknown`.
     pub git_commit: String,
-    /// `avx512`, `avx2` or `portable` (see [`crate::autograd::kernels::kernel_path`]).
+    /// `avx512`, `avx2-fma` or `portable-fma`, or, from builds before 2026-12-04, `avx2` or
+    /// `portable` (see [`crate::autograd::kernels::kernel_path`]).
     pub kernel_path: String,
     /// The CPU's model name with its family (see [`cpu_model`]), or `unknown`.
     pub cpu_model: String,
@@ -57,7 +58,7 @@ mod tests {
         let p = Provenance::current();
         assert_eq!(p.macdec_version, env!("CARGO_PKG_VERSION"));
         assert!(p.git_commit == "unknown" || p.git_commit.len() >= 40);
-        assert!(["avx512", "avx2", "portable"].contains(&p.kernel_path.as_str()));
+        assert!(["avx512", "avx2-fma", "portable-fma"].contains(&p.kernel_path.as_str()));
         assert!(!p.cpu_model.is_empty());
     }
 }

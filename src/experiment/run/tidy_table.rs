@@ -10,7 +10,9 @@
 //! The tree is read twice (headers first, to know every column, then rows), so memory stays at
 //! one run's curve however large the tree is.
 
-use super::metrics::{self, MetricsError, MetricsTable, LEADING_COLUMNS, WALL_SECONDS};
+use super::metrics::{
+    self, MetricsError, MetricsTable, EVAL_RETURN_UNDISCOUNTED, LEADING_COLUMNS, WALL_SECONDS,
+};
 use super::results_tree;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -103,8 +105,9 @@ fn name_run(root: &Path, dir: PathBuf) -> Option<TidyRun> {
     })
 }
 
-/// The table's header: [`RUN_COLUMNS`], the leading metrics columns, every family column of
-/// the runs in order of first appearance, `wall_seconds`.
+/// The table's header: [`RUN_COLUMNS`], the leading metrics columns, `eval_return_undiscounted`
+/// (empty for runs trained before it existed), every family column of the runs in order of first
+/// appearance, `wall_seconds`.
 fn header<'a>(family_lists: impl Iterator<Item = &'a [String]>) -> Vec<String> {
     let mut family: Vec<String> = Vec::new();
     for list in family_lists {
@@ -117,6 +120,7 @@ fn header<'a>(family_lists: impl Iterator<Item = &'a [String]>) -> Vec<String> {
     RUN_COLUMNS
         .iter()
         .chain(LEADING_COLUMNS.iter())
+        .chain(std::iter::once(&EVAL_RETURN_UNDISCOUNTED))
         .map(|s| s.to_string())
         .chain(family)
         .chain(std::iter::once(WALL_SECONDS.to_string()))
@@ -131,7 +135,7 @@ pub fn write_tidy_table(root: &Path, out: &mut dyn Write) -> Result<(usize, usiz
         family_lists.push(read_run(run)?.family_columns);
     }
     let header = header(family_lists.iter().map(Vec::as_slice));
-    let family_header = &header[RUN_COLUMNS.len() + LEADING_COLUMNS.len()..header.len() - 1];
+    let family_header = &header[RUN_COLUMNS.len() + LEADING_COLUMNS.len() + 1..header.len() - 1];
     let io = |source| TidyError::Write {
         path: PathBuf::from("<output>"),
         source,
@@ -157,6 +161,7 @@ pub fn write_tidy_table(root: &Path, out: &mut dyn Write) -> Result<(usize, usiz
                 Cell::Count(r.env_steps),
                 Cell::Count(r.updates),
                 Cell::Value(Some(r.eval_return)),
+                Cell::Value(r.eval_return_undiscounted),
             ];
             cells.extend(at.iter().map(|k| Cell::Value(k.and_then(|k| r.family[k]))));
             cells.push(Cell::Value(Some(r.wall_seconds)));
@@ -210,6 +215,7 @@ mod tests {
             env_steps: episode * 7,
             updates: episode / 2,
             eval_return: ret,
+            eval_return_undiscounted: Some(ret * 2.0),
             family,
             wall_seconds: 0.5,
         }
@@ -282,11 +288,11 @@ mod tests {
         assert_eq!(
             lines,
             [
-                "experiment,method,variant,seed,episode,env_steps,updates,eval_return,epsilon,hysteresis,loss,actor_loss,wall_seconds",
-                "fig4a,our1,,1,0,0,0,-4.25,1.0,0.2,,,0.5",
-                "fig4a,our1,,1,10,70,5,0.30000000000000004,0.9,0.3,2.5,,0.5",
-                "fig4a,our1,l_rate=0.001,0,0,0,0,1.0,1.0,0.2,,,0.5",
-                "macromarl/bp6,mac-iac,,3,0,0,0,2.0,,,,-0.5,0.5",
+                "experiment,method,variant,seed,episode,env_steps,updates,eval_return,eval_return_undiscounted,epsilon,hysteresis,loss,actor_loss,wall_seconds",
+                "fig4a,our1,,1,0,0,0,-4.25,-8.5,1.0,0.2,,,0.5",
+                "fig4a,our1,,1,10,70,5,0.30000000000000004,0.6000000000000001,0.9,0.3,2.5,,0.5",
+                "fig4a,our1,l_rate=0.001,0,0,0,0,1.0,2.0,1.0,0.2,,,0.5",
+                "macromarl/bp6,mac-iac,,3,0,0,0,2.0,4.0,,,,-0.5,0.5",
             ]
         );
         // The file form is the same bytes, written atomically.

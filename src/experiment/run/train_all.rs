@@ -65,7 +65,7 @@ checkpoint_freq = 20
     }
 
     /// A metrics row without its wall-clock column, floats as bits.
-    type Row = (u64, u64, u64, u64, Vec<Option<u64>>);
+    type Row = (u64, u64, u64, u64, Option<u64>, Vec<Option<u64>>);
 
     /// Every metrics row without its wall-clock column.
     fn rows(dir: &Path) -> Vec<Row> {
@@ -80,6 +80,7 @@ checkpoint_freq = 20
                     r.env_steps,
                     r.updates,
                     r.eval_return.to_bits(),
+                    r.eval_return_undiscounted.map(f64::to_bits),
                     family,
                 )
             })
