@@ -8,6 +8,10 @@
 #   scripts/campaign.sh macromarl # MacroMARL's actor-critic campaign (issue 28) into
 #                                 # reproduction/macromarl: Box Pushing 6..14 at 20 seeds, then
 #                                 # Warehouse A and B seeds 0..5, then their seeds 5..20
+#   scripts/campaign.sh macromarl-rest # the rest of MacroMARL's actor-critic figure set (issue
+#                                 # 42) into reproduction/macromarl: Warehouse C, D, E and the
+#                                 # ablation, then Overcooked A, B, C, all 20 seeds, five seeds at
+#                                 # a time so every block fills evenly
 #   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
 #                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
@@ -46,6 +50,20 @@ macromarl_lane() {
     done
 }
 
+macromarl_rest_lane() {
+    set -e
+    for first in 0 5 10 15; do
+        for block in wh_c wh_d wh_e wh_ablation; do
+            train_macromarl "$block" --seeds "$first..$((first + 5))"
+        done
+    done
+    for first in 0 5 10 15; do
+        for block in overcooked_a overcooked_b overcooked_c; do
+            train_macromarl "$block" --seeds "$first..$((first + 5))"
+        done
+    done
+}
+
 lanes() {
     pids=()
     for _ in $(seq "$JOBS"); do
@@ -80,6 +98,9 @@ run)
 macromarl)
     lanes macromarl_lane
     ;;
+macromarl-rest)
+    lanes macromarl_rest_lane
+    ;;
 collect)
     find "$OUT" -name finished -type f | sort | while read -r marker; do
         dir=$(dirname "$marker")
@@ -100,7 +121,7 @@ status)
     done
     ;;
 *)
-    echo "usage: $0 run|macromarl|collect|status" >&2
+    echo "usage: $0 run|macromarl|macromarl-rest|collect|status" >&2
     exit 2
     ;;
 esac
