@@ -426,10 +426,13 @@ mod avx512 {
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    //! The `avx512` kernel's arithmetic on CPUs with AVX2 and FMA but not AVX-512: register
-    //! tile 4 rows x 16 columns (8 ymm accumulators), one A entry broadcast per row into two
-    //! 8-lane vectors of a B row. Columns past n are masked (masked lanes load zeros and are
-    //! never stored).
+    //! The `avx512` kernel's arithmetic on CPUs with AVX2 and FMA but not AVX-512. Register
+    //! tiles of R rows x V vectors of 8 columns: 4 x 2 for whole row blocks, 3 x 2, and 2 x 4 or
+    //! 1 x 4 for the last rows, so even a single row (acting on one observation) keeps four
+    //! independent FMA chains in flight. Each step broadcasts one A entry per row into the
+    //! tile's B vectors. Whole tiles load and store plainly; the ragged right edge loads B under
+    //! a lane mask (masked lanes read zeros and never fault) and writes C through a buffer
+    //! (masked stores are slow on some AVX2 CPUs).
 
     use std::arch::x86_64::*;
     use std::sync::OnceLock;
@@ -438,7 +441,6 @@ mod avx2 {
     use ndarray::{ArrayView2, ArrayViewMut2};
 
     const MR: usize = 4;
-    const NR: usize = 16;
     const KC: usize = super::K_BLOCK;
 
     /// Whether this CPU runs the kernel (checked once).
@@ -501,10 +503,12 @@ mod avx2 {
             let mut i = 0;
             while i < m {
                 let rows = (m - i).min(MR);
+                // Vectors per tile row: 2 for 3-4 rows, 4 for 1-2 (enough independent chains).
+                let nr = if rows >= 3 { 16 } else { 32 };
                 let (ai, ci) = (ak.offset(i as isize * rsa), c.offset(i as isize * rsc));
                 let mut j = 0;
                 while j < n {
-                    let cols = (n - j).min(NR);
+                    let cols = (n - j).min(nr);
                     let t = Tile {
                         k: kc,
                         a: ai,
@@ -514,16 +518,15 @@ mod avx2 {
                         rsb,
                         c: ci.add(j),
                         rsc,
-                        m0: lane_mask(cols),
-                        m1: lane_mask(cols.saturating_sub(8)),
+                        cols,
                     };
                     match rows {
-                        4 => t.run::<4>(acc),
-                        3 => t.run::<3>(acc),
-                        2 => t.run::<2>(acc),
-                        _ => t.run::<1>(acc),
+                        4 => t.run::<4, 2>(acc),
+                        3 => t.run::<3, 2>(acc),
+                        2 => t.run::<2, 4>(acc),
+                        _ => t.run::<1, 4>(acc),
                     }
-                    j += NR;
+                    j += nr;
                 }
                 i += MR;
             }
@@ -531,7 +534,7 @@ mod avx2 {
         }
     }
 
-    /// All lanes below min(cols, 8) set (as `maskload`/`maskstore` read them: the sign bit).
+    /// All lanes below min(cols, 8) set (as `maskload` reads them: the sign bit).
     #[inline(always)]
     unsafe fn lane_mask(cols: usize) -> __m256i {
         let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -549,36 +552,79 @@ mod avx2 {
         rsb: isize,
         c: *mut f32,
         rsc: isize,
-        m0: __m256i,
-        m1: __m256i,
+        /// Columns of the tile inside the product (at most 8 V).
+        cols: usize,
     }
 
     impl Tile {
-        /// C[0..R, 0..16] (=|+=) A[0..R, 0..k] · B[0..k, 0..16] under the column masks.
+        /// C[0..R, 0..cols] (=|+=) A[0..R, 0..k] · B[0..k, 0..cols], cols <= 8 V <= 32.
         #[inline(always)]
-        unsafe fn run<const R: usize>(&self, accumulate: bool) {
-            let mut acc0 = [_mm256_setzero_ps(); R];
-            let mut acc1 = [_mm256_setzero_ps(); R];
+        unsafe fn run<const R: usize, const V: usize>(&self, accumulate: bool) {
+            let full = self.cols == 8 * V;
+            let mut acc = [[_mm256_setzero_ps(); V]; R];
             let (mut ap, mut bp) = (self.a, self.b);
-            for _ in 0..self.k {
-                let b0 = _mm256_maskload_ps(bp, self.m0);
-                let b1 = _mm256_maskload_ps(bp.add(8), self.m1);
-                for r in 0..R {
-                    let av = _mm256_set1_ps(*ap.offset(r as isize * self.rsa));
-                    acc0[r] = _mm256_fmadd_ps(av, b0, acc0[r]);
-                    acc1[r] = _mm256_fmadd_ps(av, b1, acc1[r]);
+            if full {
+                for _ in 0..self.k {
+                    let mut b = [_mm256_setzero_ps(); V];
+                    for (v, bv) in b.iter_mut().enumerate() {
+                        *bv = _mm256_loadu_ps(bp.add(8 * v));
+                    }
+                    self.step::<R, V>(ap, &b, &mut acc);
+                    ap = ap.offset(self.csa);
+                    bp = bp.offset(self.rsb);
                 }
-                ap = ap.offset(self.csa);
-                bp = bp.offset(self.rsb);
+            } else {
+                let mut masks = [_mm256_setzero_si256(); V];
+                for (v, mask) in masks.iter_mut().enumerate() {
+                    *mask = lane_mask(self.cols.saturating_sub(8 * v));
+                }
+                for _ in 0..self.k {
+                    let mut b = [_mm256_setzero_ps(); V];
+                    for (v, bv) in b.iter_mut().enumerate() {
+                        *bv = _mm256_maskload_ps(bp.add(8 * v), masks[v]);
+                    }
+                    self.step::<R, V>(ap, &b, &mut acc);
+                    ap = ap.offset(self.csa);
+                    bp = bp.offset(self.rsb);
+                }
             }
-            for r in 0..R {
+            for (r, row) in acc.iter().enumerate() {
                 let cp = self.c.offset(r as isize * self.rsc);
-                if accumulate {
-                    acc0[r] = _mm256_add_ps(acc0[r], _mm256_maskload_ps(cp, self.m0));
-                    acc1[r] = _mm256_add_ps(acc1[r], _mm256_maskload_ps(cp.add(8), self.m1));
+                if full {
+                    for (v, &x) in row.iter().enumerate() {
+                        let x = if accumulate {
+                            _mm256_add_ps(x, _mm256_loadu_ps(cp.add(8 * v)))
+                        } else {
+                            x
+                        };
+                        _mm256_storeu_ps(cp.add(8 * v), x);
+                    }
+                } else {
+                    let mut buf = [0.0f32; 32];
+                    for (v, &x) in row.iter().enumerate() {
+                        _mm256_storeu_ps(buf.as_mut_ptr().add(8 * v), x);
+                    }
+                    for (q, &x) in buf.iter().take(self.cols).enumerate() {
+                        let out = cp.add(q);
+                        *out = if accumulate { x + *out } else { x };
+                    }
                 }
-                _mm256_maskstore_ps(cp, self.m0, acc0[r]);
-                _mm256_maskstore_ps(cp.add(8), self.m1, acc1[r]);
+            }
+        }
+
+        /// One k: every row's A entry times the tile's B vectors, into the accumulators.
+        #[inline(always)]
+        unsafe fn step<const R: usize, const V: usize>(
+            &self,
+            ap: *const f32,
+            b: &[__m256; V],
+            acc: &mut [[__m256; V]; R],
+        ) {
+            for (r, row) in acc.iter_mut().enumerate() {
+                let av = _mm256_set1_ps(*ap.offset(r as isize * self.rsa));
+                for (x, &bv) in row.iter_mut().zip(b) {
+                    *x = _mm256_fmadd_ps(av, bv, *x);
+                }
             }
         }
     }
