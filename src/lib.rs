@@ -44,8 +44,11 @@
 //!    [`experiment::audit`], and [`mod@bench`] for timings. [`files`] is the ground floor every layer
 //!    writes through (atomic writes, bounded reads).
 //!
-//! Lower layers never name higher ones: `autograd` knows no layers, `envs` no nets, `algos` no
-//! runner, `deploy` no learner.
+//! Lower layers never name higher ones: `autograd` knows no layers, `envs` no nets and no
+//! learner (a family's published settings for a domain live in the family's folder), `algos` no
+//! runner, `deploy` no learner. `tests/file_circles.rs` holds the order (files, draw,
+//! curve_stats < autograd < nn < envs < algos, policy_files < experiment, deploy, plot, render <
+//! cli, api, bench) and fails on an import against it.
 //!
 //! # Your own domain or program
 //!

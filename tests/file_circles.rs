@@ -1,5 +1,8 @@
 //! No two source files name each other in a circle, except autograd's tape and its ops (the
 //! tape records ops, ops push onto the tape): README "Where the code lives" (issue 26 item 6).
+//! And no lower layer names a higher one (issue 40 item 2): the ground floor (files, drawing,
+//! curve statistics) < autograd < nn < envs < algos and policy files < experiment, deploy, plot,
+//! render < cli, api, bench.
 //!
 //! A file names another when its code outside `#[cfg(test)]` holds a `crate::`, `super::` or
 //! `self::` path (in a `use`, grouped `use` items included, or inline) that resolves to an item
@@ -153,4 +156,80 @@ fn no_two_files_name_each_other_in_a_circle_but_the_tape_and_its_ops() {
     );
     // The check sees circles: the tape and its ops are one.
     assert_eq!(on_circles, allowed);
+}
+
+/// The layers, lowest first: a file may name its own layer's modules and lower ones.
+const LAYERS: [&[&str]; 7] = [
+    &["files", "draw", "curve_stats"],
+    &["autograd"],
+    &["nn"],
+    &["envs"],
+    &["algos", "policy_files"],
+    &["experiment", "deploy", "plot", "render"],
+    &["cli", "api", "bench", "lib", "main"],
+];
+
+/// The layer of a top-level module (`lib` and `main` for the crate's root files).
+fn layer(top: &str) -> Option<usize> {
+    LAYERS.iter().position(|l| l.contains(&top))
+}
+
+/// Every `crate::` path in `code` (a file of top-level module `top`) that names a higher layer's
+/// module, as "top -> module (path)"; an unplaced top-level module is an error too.
+fn layer_violations(top: &str, code: &str) -> Vec<String> {
+    let Some(mine) = layer(top) else {
+        return vec![format!(
+            "{top}: not in LAYERS (place the new module in a layer)"
+        )];
+    };
+    let mut out = Vec::new();
+    for (head, segs) in paths(code) {
+        let Some(target) = segs.first().filter(|_| head == "crate") else {
+            continue;
+        };
+        match layer(target) {
+            Some(theirs) if theirs <= mine => {}
+            Some(_) => out.push(format!("{top} -> {target} (crate::{})", segs.join("::"))),
+            None => out.push(format!("{target}: not in LAYERS (named by {top})")),
+        }
+    }
+    out
+}
+
+#[test]
+fn no_lower_layer_names_a_higher_one() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut violations = Vec::new();
+    for path in &files {
+        let name = path.strip_prefix(&src).unwrap().display().to_string();
+        let top = name.split('/').next().unwrap().trim_end_matches(".rs");
+        let text = code(&std::fs::read_to_string(path).unwrap());
+        violations.extend(
+            layer_violations(top, &text)
+                .into_iter()
+                .map(|v| format!("{name}: {v}")),
+        );
+    }
+    assert!(violations.is_empty(), "{violations:#?}");
+}
+
+#[test]
+fn the_layer_check_sees_a_domain_naming_a_learner() {
+    let envs = "use crate::algos::actor_critic::published::settings;\nuse crate::nn::Mlp;";
+    assert_eq!(
+        layer_violations("envs", envs),
+        ["envs -> algos (crate::algos::actor_critic::published::settings)"]
+    );
+    let grouped = "use crate::{autograd::Tape, deploy::Manifest};";
+    assert_eq!(
+        layer_violations("nn", grouped),
+        ["nn -> deploy (crate::deploy::Manifest)"]
+    );
+    assert!(layer_violations("cli", envs).is_empty());
+    assert_eq!(layer_violations("newthing", "").len(), 1);
+    // Test code is not held to it (the circles check's `code` keeps only what precedes it).
+    let test_only = code("fn f() {}\n#[cfg(test)]\nmod tests { use crate::cli::main; }");
+    assert!(layer_violations("envs", &test_only).is_empty());
 }

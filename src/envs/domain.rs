@@ -129,21 +129,14 @@ pub trait Domain: Send + Sync + 'static {
     /// Build the environment, in its reset state, from keys [`Self::keys`] returned.
     fn build(&self, keys: &toml::Table) -> Result<Self::Env, KeyError>;
 
-    /// The hyperparameters a paper used on this setting, as config keys (`trace_len`,
-    /// `discount`, ...), applied over the engine's base settings (the ICRA paper's common ones)
-    /// before the user's keys. Empty (the default) for a domain no paper trained on.
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
+    /// The discount per primitive step the papers that trained on this setting report its
+    /// returns under (and state its optimum for): a fact of the benchmark, not of a learner.
+    /// Methods take it as their default discount where their family publishes none; `None`
+    /// (the default) for a domain no paper trained on. Learners' other published settings live
+    /// in their family's folder (`src/algos/<family>/published*`), never in a domain's.
+    fn paper_discount(&self, keys: &toml::Table) -> Option<f64> {
         let _ = keys;
-        toml::Table::new()
-    }
-
-    /// The settings MacroMARL published for actor-critic method `alg` (the reference's `--alg`:
-    /// `MacIAC`, `MacCAC`, `NaiveMacIACC`, `NaiveMacIASC`, `MacIAICC`, `MacIAISC`) on this
-    /// setting, as config keys (`a_lr`, `n_env`, ...), applied over the reference's argparse
-    /// defaults before the user's keys. Empty (the default) for a domain it was not published on.
-    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
-        let _ = (keys, alg);
-        toml::Table::new()
+        None
     }
 
     /// A short label for tables, benchmarks and file names (`bp10`, `wtd`); the name by default.

@@ -36,10 +36,8 @@ pub trait DomainEntry: Send + Sync + 'static {
     fn build_any(&self, keys: &toml::Table) -> Result<AnyEnv, KeyError>;
     /// Rebuild an environment [`AnyEnv::Custom`] saved (bincode of [`Domain::Env`]).
     fn restore(&self, bytes: &[u8]) -> Result<AnyEnv, String>;
-    /// See [`Domain::paper_settings`].
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table;
-    /// See [`Domain::actor_critic_settings`].
-    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table;
+    /// See [`Domain::paper_discount`].
+    fn paper_discount(&self, keys: &toml::Table) -> Option<f64>;
     /// See [`Domain::short_name`].
     fn short_name(&self, keys: &toml::Table) -> String;
     /// See [`Domain::tag`].
@@ -70,11 +68,8 @@ impl<D: Domain> DomainEntry for D {
         let env: D::Env = bincode::deserialize(bytes).map_err(|e| e.to_string())?;
         Ok(AnyEnv::hold(Domain::name(self), env))
     }
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
-        Domain::paper_settings(self, keys)
-    }
-    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
-        Domain::actor_critic_settings(self, keys, alg)
+    fn paper_discount(&self, keys: &toml::Table) -> Option<f64> {
+        Domain::paper_discount(self, keys)
     }
     fn short_name(&self, keys: &toml::Table) -> String {
         Domain::short_name(self, keys)

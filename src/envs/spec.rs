@@ -114,26 +114,12 @@ impl EnvSpec {
         self.domain.short_name(&self.keys)
     }
 
-    /// The hyperparameters a paper used on this setting ([`super::domain::Domain::paper_settings`]).
-    pub fn paper_settings(&self) -> toml::Table {
-        self.domain.paper_settings(&self.keys)
-    }
-
-    /// MacroMARL's published actor-critic settings for `alg` on this setting
-    /// ([`super::domain::Domain::actor_critic_settings`]).
-    pub fn actor_critic_settings(&self, alg: &str) -> toml::Table {
-        self.domain.actor_critic_settings(&self.keys, alg)
-    }
-
-    /// The discount per primitive step the paper trains and evaluates this setting under (Box
-    /// Pushing 0.98, Warehouse 1.0; `docs/ALGORITHMS.md` §10), the one its known optimum is stated for; `None`
-    /// for a domain no paper trained on.
+    /// The discount per primitive step the papers train and evaluate this setting under (Box
+    /// Pushing 0.98, Warehouse 1.0; `docs/ALGORITHMS.md` §10), the one its known optimum is
+    /// stated for ([`super::domain::Domain::paper_discount`]); `None` for a domain no paper
+    /// trained on.
     pub fn paper_discount(&self) -> Option<f64> {
-        match self.paper_settings().get("discount")? {
-            toml::Value::Float(d) => Some(*d),
-            toml::Value::Integer(d) => Some(*d as f64),
-            _ => None,
-        }
+        self.domain.paper_discount(&self.keys)
     }
 
     /// Build the environment, in its reset state. Errors name the bad key.

@@ -1,7 +1,7 @@
 //! The actor-critic methods' hyperparameters, under MacroMARL's flag names
 //! (`scripts/pg_based_main.py`; `docs/MACROMARL.md` §1.4), with the reference's argparse defaults
-//! where no published experiment sets a key. A domain's published values per method live in its
-//! folder ([`crate::envs::Domain::actor_critic_settings`]).
+//! where no published experiment sets a key. The published values per domain and method are
+//! [`super::published`].
 
 use serde::{Deserialize, Serialize};
 
@@ -110,46 +110,6 @@ impl AcConfig {
 
 /// Environments one run may step in lockstep (published: at most 48).
 pub const MAX_N_ENV: usize = 4096;
-
-/// One published experiment block's settings (a row of `docs/MACROMARL.md` §1.4), as
-/// config keys. Widths are (a_rnn, c_rnn, c_mlp).
-#[allow(clippy::too_many_arguments)]
-pub fn published_row(
-    a_lr: f64,
-    c_lr: f64,
-    n_env: i64,
-    train_freq: i64,
-    c_target_update_freq: i64,
-    n_step_td: i64,
-    eps_end: f64,
-    eps_stable_at: i64,
-    total_epi: i64,
-    gamma: f64,
-    widths: (i64, i64, [i64; 2]),
-) -> toml::Table {
-    let (a_rnn, c_rnn, c_mlp) = widths;
-    let mut t = toml::Table::new();
-    let mut put = |k: &str, v: toml::Value| {
-        t.insert(k.to_string(), v);
-    };
-    put("a_lr", a_lr.into());
-    put("c_lr", c_lr.into());
-    put("n_env", n_env.into());
-    put("train_freq", train_freq.into());
-    put("c_target_update_freq", c_target_update_freq.into());
-    put("n_step_TD", n_step_td.into());
-    put("eps_end", eps_end.into());
-    put("eps_stable_at", eps_stable_at.into());
-    put("total_epi", total_epi.into());
-    put("gamma", gamma.into());
-    put("a_rnn_layer_size", a_rnn.into());
-    put("c_rnn_layer_size", c_rnn.into());
-    put(
-        "c_mlp_layer_size",
-        toml::Value::Array(c_mlp.iter().map(|&w| w.into()).collect()),
-    );
-    t
-}
 
 #[cfg(test)]
 mod tests {

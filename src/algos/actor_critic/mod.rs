@@ -12,6 +12,7 @@ pub mod config;
 pub mod episode;
 pub mod learner;
 pub mod nets;
+pub mod published;
 pub mod returns;
 pub mod squeeze;
 pub mod update;

@@ -16,6 +16,7 @@ pub mod cond_argmax;
 pub mod episode_buffer;
 pub mod evaluate;
 pub mod learner;
+pub mod published;
 pub mod record;
 pub mod recorder;
 pub mod replay;

@@ -85,16 +85,9 @@ impl Domain for BoxPushingDomain {
         BoxPushing::new(key_usize(keys, "grid_dim")?, key_usize(keys, HORIZON_KEY)?).map_err(key_of)
     }
 
-    /// Figure 4's settings differ by grid only in the window length (10 x 10: 15, 30 x 30: 45,
-    /// also the training period); both discount by 0.98 (`docs/ALGORITHMS.md` §10.1, 10.2).
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
-        let grid = key_usize(keys, "grid_dim").unwrap_or(DEFAULT_GRID_DIM);
-        let trace_len: i64 = if grid >= 30 { 45 } else { 15 };
-        key_table([
-            ("discount", 0.98.into()),
-            ("trace_len", trace_len.into()),
-            ("train_freq", trace_len.into()),
-        ])
+    /// Figure 4 discounts by 0.98 at every grid (`docs/ALGORITHMS.md` §10.1, 10.2).
+    fn paper_discount(&self, _keys: &toml::Table) -> Option<f64> {
+        Some(0.98)
     }
 
     fn short_name(&self, keys: &toml::Table) -> String {
@@ -157,9 +150,8 @@ mod tests {
     }
 
     #[test]
-    fn paper_settings_follow_the_grid() {
-        let s = paper_spec(30).paper_settings();
-        assert_eq!(s["trace_len"].as_integer(), Some(45));
+    fn figure_4_discounts_by_0_98() {
         assert_eq!(paper_spec(10).paper_discount(), Some(0.98));
+        assert_eq!(paper_spec(30).paper_discount(), Some(0.98));
     }
 }

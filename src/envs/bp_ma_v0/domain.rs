@@ -30,6 +30,14 @@ const USED: [&str; 5] = [
 ];
 
 /// The grid side of `grid_dim`: an integer N or the reference's pair `[N, N]`.
+/// The grid side of a setting's checked keys (the default grid's when `grid_dim` is unreadable,
+/// which checked keys never are): what MacroMARL's published settings are chosen by.
+pub fn grid_of(keys: &toml::Table) -> usize {
+    keys.get("grid_dim")
+        .and_then(|v| grid_side(v).ok())
+        .unwrap_or(DEFAULT_GRID)
+}
+
 fn grid_side(value: &toml::Value) -> Result<usize, KeyError> {
     let bad = |why: String| KeyError::new("grid_dim", why);
     let side = |v: &toml::Value| {
@@ -125,29 +133,10 @@ impl Domain for BpMaV0Domain {
         .map_err(key_of)
     }
 
-    /// The value-based settings of MacroMARL's `mac_dec_q.sh` for the grid: discount 0.98 and a
-    /// training window (also the training period) of 10, 14, 20, 35 or 45 steps for grids 6 to
-    /// 14 (larger grids take the 14 x 14 window).
-    fn paper_settings(&self, keys: &toml::Table) -> toml::Table {
-        let grid = grid_side(&keys["grid_dim"]).unwrap_or(DEFAULT_GRID);
-        let trace_len: i64 = match grid {
-            ..=6 => 10,
-            7..=8 => 14,
-            9..=10 => 20,
-            11..=12 => 35,
-            _ => 45,
-        };
-        key_table([
-            ("discount", 0.98.into()),
-            ("trace_len", trace_len.into()),
-            ("train_freq", trace_len.into()),
-        ])
-    }
-
-    /// The grid's published rows ([`super::actor_critic`]).
-    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
-        let grid = grid_side(&keys["grid_dim"]).unwrap_or(DEFAULT_GRID);
-        super::actor_critic::settings(grid, alg)
+    /// MacroMARL's Box Pushing runs discount by 0.98 per primitive step (every published
+    /// block, actor-critic and value-based alike).
+    fn paper_discount(&self, _keys: &toml::Table) -> Option<f64> {
+        Some(0.98)
     }
 
     fn short_name(&self, keys: &toml::Table) -> String {

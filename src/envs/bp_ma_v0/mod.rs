@@ -8,9 +8,8 @@
 //! opposite of the ICRA code's Q7). The environment type is [`super::box_pushing::BoxPushing`];
 //! this folder holds what configs, runs and files know of the domain.
 
-pub mod actor_critic;
 mod domain;
 mod spec;
 
-pub use domain::BpMaV0Domain;
+pub use domain::{grid_of, BpMaV0Domain};
 pub use spec::spec;

@@ -11,9 +11,7 @@
 
 use super::layout::{LAYOUTS, N_WORK_STEPS};
 use super::{Osd, OsdParams, D7, F0, T0, T1};
-use crate::envs::domain::{
-    fill_keys, key_f64, key_table, key_usize, Domain, KeyError, HORIZON_KEY,
-};
+use crate::envs::domain::{fill_keys, key_f64, key_usize, Domain, KeyError, HORIZON_KEY};
 use crate::envs::macromarl::without_ignored_kwargs;
 use crate::envs::EnvError;
 
@@ -178,21 +176,8 @@ impl<const V: usize> Domain for OsdDomain<V> {
 
     /// MacroMARL's Warehouse runs are undiscounted (`gamma` 1.0 in every published block, for
     /// the actor-critic and the value-based methods alike); its returns are reported so.
-    fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
-        key_table([("discount", 1.0.into())])
-    }
-
-    /// Warehouse A or B on `OSD-D-v7` (by the humans' speeds), C on `OSD-T-v0`, D on
-    /// `OSD-T-v1`, E on `OSD-F-v0` ([`super::actor_critic`]).
-    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
-        use super::actor_critic::{double_room_block, settings, Block};
-        let block = match LAYOUTS[V].gym_id {
-            "OSD-D-v7" => double_room_block(keys.get(HUMAN_SPEEDS)),
-            "OSD-T-v0" => Block::C,
-            "OSD-T-v1" => Block::D,
-            _ => Block::E,
-        };
-        settings(block, alg)
+    fn paper_discount(&self, _keys: &toml::Table) -> Option<f64> {
+        Some(1.0)
     }
 }
 

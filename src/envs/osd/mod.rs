@@ -21,7 +21,6 @@
 //! The published settings draw nothing; with `TB_move_noisy` or `fetch_manip_noisy` set, steps
 //! draw from the caller's [`EnvRng`] (same distributions as the reference, not its numbers).
 
-pub mod actor_critic;
 mod domain;
 pub mod draw;
 mod fetch;

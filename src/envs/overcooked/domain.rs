@@ -97,6 +97,12 @@ fn side(keys: &toml::Table) -> Result<usize, KeyError> {
 }
 
 /// The parameters the keys describe.
+/// The map letter (`A`, `B`, `C`, ...) of a setting's checked keys (`A` when unreadable, which
+/// checked keys never are): what MacroMARL's published settings are chosen by.
+pub fn map_letter(keys: &toml::Table) -> char {
+    params(keys).map_or('A', |p| p.map.letter().chars().next().unwrap_or('A'))
+}
+
 fn params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
     let string = |k: &str| keys.get(k).and_then(|v| v.as_str()).map(str::to_string);
     let map_letter = string("map_type").unwrap_or_default();
@@ -173,14 +179,8 @@ impl Domain for OvercookedDomain {
 
     /// MacroMARL's Overcooked runs discount by 0.99 per primitive step (every published block);
     /// the shipped policies' returns are reported so.
-    fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
-        key_table([("discount", 0.99.into())])
-    }
-
-    /// The map's published rows ([`super::actor_critic`]).
-    fn actor_critic_settings(&self, keys: &toml::Table, alg: &str) -> toml::Table {
-        let map = params(keys).map_or('A', |p| p.map.letter().chars().next().unwrap_or('A'));
-        super::actor_critic::settings(map, alg)
+    fn paper_discount(&self, _keys: &toml::Table) -> Option<f64> {
+        Some(0.99)
     }
 
     /// `overcooked-a`, with the agent count and grid when not the paper's (`overcooked-b-n2`).

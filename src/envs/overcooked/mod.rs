@@ -18,7 +18,6 @@
 //! (the primitive step), [`astar`] (navigation with Python's heap order), [`macro_actions`]
 //! and [`observe`] (belief and macro-observations); `domain` holds the config keys.
 
-pub mod actor_critic;
 pub mod astar;
 mod domain;
 pub mod draw;
@@ -32,7 +31,7 @@ pub mod world;
 #[cfg(test)]
 mod scenarios;
 
-pub use domain::{OvercookedDomain, PAPER_N_AGENT, REFERENCE_N_AGENT};
+pub use domain::{map_letter, OvercookedDomain, PAPER_N_AGENT, REFERENCE_N_AGENT};
 
 use self::astar::PyHeap;
 use self::layout::{belief_base, start_map, Cells, MapType};

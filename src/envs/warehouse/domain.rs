@@ -74,20 +74,9 @@ impl Domain for WarehouseDomain {
         Warehouse::new(params(keys)?).map_err(key_of)
     }
 
-    /// Figure 5's commands differ from Box Pushing's only in these keys (`docs/ALGORITHMS.md` §10.3).
-    fn paper_settings(&self, _keys: &toml::Table) -> toml::Table {
-        key_table([
-            ("total_epi", 40000.into()),
-            ("replay_buffer_size", 1000.into()),
-            ("sample_epi", true.into()),
-            ("h_explore", true.into()),
-            ("l_rate", 0.0006.into()),
-            ("discount", 1.0.into()),
-            ("train_freq", 30.into()),
-            ("trace_len", 10.into()),
-            ("batch_size", 16.into()),
-            ("dec_rnn_h_size", 64.into()),
-        ])
+    /// Figure 5 is undiscounted (`docs/ALGORITHMS.md` §10.3).
+    fn paper_discount(&self, _keys: &toml::Table) -> Option<f64> {
+        Some(1.0)
     }
 
     fn short_name(&self, _keys: &toml::Table) -> String {

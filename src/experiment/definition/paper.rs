@@ -5,12 +5,11 @@
 //!
 //! Value methods (`docs/ALGORITHMS.md` §10), three layers: the ICRA paper's common settings (its
 //! Box Pushing 10 x 10 runs), the method's own values (hysteresis, centralized exploration,
-//! evaluation episodes), and the keys the domain's paper setting changes
-//! ([`crate::envs::Domain::paper_settings`], in the domain's folder). A domain no paper trained
-//! on gets the first two.
+//! evaluation episodes), and the keys the papers set on the domain
+//! ([`crate::algos::value::published`]). A domain no paper trained on gets the first two.
 //!
 //! Actor-critic methods (`docs/MACROMARL.md` §1.4): the reference's argparse defaults, then the
-//! domain's published row for the method ([`crate::envs::Domain::actor_critic_settings`]). A
+//! domain's published row for the method ([`crate::algos::actor_critic::published`]). A
 //! domain MacroMARL did not publish on keeps the defaults, with the discount of its paper
 //! setting when it has one.
 
@@ -71,7 +70,7 @@ pub fn actor_critic_defaults(env: &EnvSpec, method: Method) -> AcConfig {
         .actor_critic()
         .map_or("", |design| design.reference_alg);
     let mut table = toml::Table::try_from(AcConfig::reference_defaults()).expect("a table");
-    let published = env.actor_critic_settings(alg);
+    let published = crate::algos::actor_critic::published::settings(env, alg);
     if published.is_empty() {
         if let Some(d) = env.paper_discount() {
             table.insert("gamma".into(), d.into());
@@ -97,7 +96,7 @@ pub fn actor_critic_defaults(env: &EnvSpec, method: Method) -> AcConfig {
 /// keys: [`base_settings`] with the domain's paper keys over them.
 pub fn value_paper_defaults(env: &EnvSpec, method: Method) -> ValueConfig {
     let mut table = toml::Table::try_from(base_settings(method)).expect("a table");
-    for (key, value) in env.paper_settings() {
+    for (key, value) in crate::algos::value::published::settings(env) {
         assert!(
             table.contains_key(&key),
             "{}'s paper settings name `{key}`, which is not a hyperparameter",

@@ -7,7 +7,7 @@
 //! Mac-IACC and Mac-IAICC ran on `OSD-T-v1`, Naive Mac-IACC's "Warehouse B" used A's speeds), the
 //! rows are each script's own: a config that wants the other reading sets its keys.
 
-use crate::algos::actor_critic::config::published_row;
+use super::published_row;
 
 /// Which published block a Warehouse setting is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -26,6 +26,9 @@ pub enum Block {
     /// Warehouse E (`OSD-F-v0`).
     E,
 }
+
+/// The key of the humans' speeds, which tells Warehouse A, B and the ablation apart.
+pub const HUMAN_SPEEDS: &str = "human_speed_per_step";
 
 /// Warehouse B's human speeds (`--h0_speed_ps`, `--h1_speed_ps`).
 const B_SPEEDS: [[i64; 4]; 2] = [[18, 15, 15, 15], [48, 18, 15, 15]];

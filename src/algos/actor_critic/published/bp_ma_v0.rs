@@ -3,7 +3,7 @@
 //! widths 32. The published Naive Mac-IACC and Mac-IAICC runs use the state critics
 //! (`NaiveMacIASC`, `MacIAISC`); their history-critic variants take the same rows.
 
-use crate::algos::actor_critic::config::published_row;
+use super::published_row;
 
 /// The row for `alg` on a `grid` x `grid` world (grids between the published 6..14 take the
 /// next smaller published one, larger ones the 14 x 14 row); empty for an unknown `alg`.

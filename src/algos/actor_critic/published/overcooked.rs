@@ -3,7 +3,7 @@
 //! over 20 000 episodes, 100 000 episodes (120 000 on map B). The critics of Mac-CAC, Naive
 //! Mac-IACC and Mac-IAICC are wider (MLP [128, 64], GRU 64).
 
-use crate::algos::actor_critic::config::published_row;
+use super::published_row;
 
 /// The row for `alg` on map `map` ('A', 'B' or 'C'); empty for an unknown `alg`.
 pub fn settings(map: char, alg: &str) -> toml::Table {
