@@ -148,7 +148,7 @@ fn policy_files_outlive_the_checkpoint_and_tolerate_added_and_missing_keys() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("has no decentralized Q-net (method cen-ddrqn)"),
+        err.contains("has no decentralized net (method cen-ddrqn)"),
         "{err}"
     );
     let out = render_net(&our1, &dir.path().join("x.gif"), &["--net", "joint"]);

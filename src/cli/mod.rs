@@ -545,8 +545,10 @@ fn run() -> Result<()> {
             net,
         } => {
             refuse_policy_dir_as_run(&run)?;
-            let returns = crate::render::rollout::render_run(&run, net, episodes, &out, frame_ms)
-                .with_context(|| format!("rendering {}", run.display()))?;
+            let choice = crate::deploy::drive::local_eval::Choice::Greedy;
+            let returns =
+                crate::render::rollout::render_run(&run, net, choice, episodes, &out, frame_ms)
+                    .with_context(|| format!("rendering {}", run.display()))?;
             eprintln!(
                 "wrote {} ({} episode(s), team returns {})",
                 out.display(),

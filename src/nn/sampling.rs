@@ -37,6 +37,60 @@ pub fn mixture(logp: &[f32], eps: Option<f64>, out: &mut Vec<f64>) {
     }
 }
 
+/// How [`conditioned_joint`] picks among the allowed joint macro-actions.
+pub enum Pick<'a> {
+    /// A draw from their probabilities (MacroMARL's acting and evaluation).
+    Sample(&'a mut ChaCha8Rng),
+    /// The most probable (the first on ties): greedy execution.
+    MostProbable,
+}
+
+/// Mac-CAC's joint macro-action (spec `macromarl.md` 2.5, P4): the probabilities of the
+/// centralized actor's log-probabilities `logp` under `eps` ([`mixture`], into `probs`), zeroed
+/// for every joint macro-action in which a busy agent's part differs from its running
+/// macro-action (`running[i]` where `!free[i]`), then picked by `pick` and unravelled in C order
+/// (agent 0 most significant) into `actions`.
+#[allow(clippy::too_many_arguments)]
+pub fn conditioned_joint(
+    logp: &[f32],
+    eps: Option<f64>,
+    free: &[bool],
+    running: &[usize],
+    n_actions: &[usize],
+    pick: Pick<'_>,
+    probs: &mut Vec<f64>,
+    actions: &mut [usize],
+) {
+    mixture(logp, eps, probs);
+    for (j, p) in probs.iter_mut().enumerate() {
+        let mut rest = j;
+        for i in (0..n_actions.len()).rev() {
+            let a = rest % n_actions[i];
+            rest /= n_actions[i];
+            if !free[i] && a != running[i] {
+                *p = 0.0;
+                break;
+            }
+        }
+    }
+    let mut j = match pick {
+        Pick::Sample(rng) => sample_weighted(probs, rng),
+        Pick::MostProbable => {
+            let mut best = 0;
+            for (j, &p) in probs.iter().enumerate() {
+                if p > probs[best] {
+                    best = j;
+                }
+            }
+            best
+        }
+    };
+    for i in (0..n_actions.len()).rev() {
+        actions[i] = j % n_actions[i];
+        j /= n_actions[i];
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -52,6 +106,53 @@ mod tests {
         }
         assert_eq!((counts[0], counts[2]), (0, 0));
         assert!((2800..3200).contains(&counts[1]), "{counts:?}");
+    }
+
+    #[test]
+    fn the_joint_choice_keeps_busy_agents_and_greedy_takes_the_most_probable_allowed() {
+        // Two agents with 2 and 3 macro-actions: joint j = 3 a0 + a1.
+        let p = [0.05f32, 0.1, 0.05, 0.4, 0.3, 0.1];
+        let logp: Vec<f32> = p.iter().map(|x| x.ln()).collect();
+        let (mut probs, mut actions) = (Vec::new(), [9, 9]);
+        let both = [true, true];
+        conditioned_joint(
+            &logp,
+            None,
+            &both,
+            &[0, 0],
+            &[2, 3],
+            Pick::MostProbable,
+            &mut probs,
+            &mut actions,
+        );
+        assert_eq!(actions, [1, 0]);
+        // Agent 0 busy on 0: only j in 0..3 allowed, the best of them is (0, 1).
+        let busy0 = [false, true];
+        conditioned_joint(
+            &logp,
+            None,
+            &busy0,
+            &[0, 2],
+            &[2, 3],
+            Pick::MostProbable,
+            &mut probs,
+            &mut actions,
+        );
+        assert_eq!(actions, [0, 1]);
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..200 {
+            conditioned_joint(
+                &logp,
+                Some(0.2),
+                &busy0,
+                &[0, 2],
+                &[2, 3],
+                Pick::Sample(&mut rng),
+                &mut probs,
+                &mut actions,
+            );
+            assert_eq!(actions[0], 0);
+        }
     }
 
     #[test]

@@ -695,6 +695,30 @@ impl Manifest {
             })
     }
 
+    /// Net `index` read from `dir` and checked ([`Self::read_net`]), as the net it is: a Q-net
+    /// or an actor.
+    ///
+    /// Panics if `index` is not an index of `nets`.
+    pub fn load_acting_net(&self, dir: &Path, index: usize) -> Result<ActingNet, PolicyError> {
+        let bytes = self.read_net(dir, index)?;
+        let entry = &self.nets[index];
+        entry
+            .architecture
+            .acting_net(&bytes, entry.input, entry.output)
+            .map_err(|source| PolicyError::Weights {
+                path: dir.join(&entry.file),
+                source,
+            })
+    }
+
+    /// The index in `nets` of the centralized net that acts (a Q-net or Mac-CAC's actor; not a
+    /// critic), if the policy has one.
+    pub fn cen_net(&self) -> Option<usize> {
+        self.nets
+            .iter()
+            .position(|n| matches!(n.kind, NetKind::Q | NetKind::Actor) && n.role == NetRole::Cen)
+    }
+
     /// The index in `nets` of agent `agent`'s decentralized Q-net: the net a robot runs.
     pub fn agent_net(&self, agent: usize) -> Result<usize, PolicyError> {
         if agent >= self.agents.len() {

@@ -57,6 +57,15 @@ pub enum RenderError {
         /// The domain's name.
         domain: String,
     },
+    /// The policy could not choose the actions of a step (a net answered with a non-finite score,
+    /// or an observation of the wrong length).
+    #[error("step {t}: the policy could not act: {message}")]
+    Policy {
+        /// Primitive step it was to choose for.
+        t: usize,
+        /// Why.
+        message: String,
+    },
     /// The environment refused a step of the recorded episode.
     #[error("step {t} of the recorded episode was refused: {source}")]
     Env {

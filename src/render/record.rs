@@ -16,9 +16,13 @@ use crate::envs::{EnvRng, MacroEnv};
 pub fn record_episode<E: MacroEnv>(
     env: &mut E,
     rng: &mut EnvRng,
-    choose: impl FnMut(&E, &mut [usize]),
+    mut choose: impl FnMut(&E, &mut [usize]),
 ) -> Result<Vec<Frame>, RenderError> {
     let mut frames = Vec::new();
+    let choose = |env: &E, actions: &mut [usize]| {
+        choose(env, actions);
+        Ok::<(), String>(())
+    };
     play_episode(env, rng, choose, |frame| {
         frames.push(frame);
         Ok(())
@@ -32,7 +36,7 @@ pub fn record_episode<E: MacroEnv>(
 pub fn play_episode<E: MacroEnv>(
     env: &mut E,
     rng: &mut EnvRng,
-    mut choose: impl FnMut(&E, &mut [usize]),
+    mut choose: impl FnMut(&E, &mut [usize]) -> Result<(), String>,
     mut each: impl FnMut(Frame) -> Result<(), RenderError>,
 ) -> Result<f64, RenderError> {
     env.reset(rng);
@@ -40,7 +44,10 @@ pub fn play_episode<E: MacroEnv>(
     let mut team_return = 0.0;
     let mut pending = Frame::capture(env, team_return)?;
     for _ in 0..env.horizon() {
-        choose(env, &mut actions);
+        choose(env, &mut actions).map_err(|message| RenderError::Policy {
+            t: env.t() + 1,
+            message,
+        })?;
         let out = env.step(&actions, rng).map_err(|source| RenderError::Env {
             t: env.t() + 1,
             source,

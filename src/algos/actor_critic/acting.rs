@@ -6,7 +6,7 @@
 
 use rand_chacha::ChaCha8Rng;
 
-use crate::nn::sampling::{mixture, sample_weighted};
+use crate::nn::sampling::{conditioned_joint, mixture, sample_weighted, Pick};
 use crate::nn::{GruActor, GruActorState};
 
 /// Decentralized actors: each free agent, in index order, samples from its actor on its own
@@ -56,23 +56,16 @@ pub fn act_centralized(
     }
     let logp = actor.act_step(joint_obs, state);
     let mut probs = Vec::new();
-    mixture(logp, eps, &mut probs);
-    for (j, p) in probs.iter_mut().enumerate() {
-        let mut rest = j;
-        for i in (0..n_actions.len()).rev() {
-            let a = rest % n_actions[i];
-            rest /= n_actions[i];
-            if !free[i] && a != running[i] {
-                *p = 0.0;
-                break;
-            }
-        }
-    }
-    let mut j = sample_weighted(&probs, rng);
-    for i in (0..n_actions.len()).rev() {
-        actions[i] = j % n_actions[i];
-        j /= n_actions[i];
-    }
+    conditioned_joint(
+        logp,
+        eps,
+        free,
+        running,
+        n_actions,
+        Pick::Sample(rng),
+        &mut probs,
+        actions,
+    );
 }
 
 #[cfg(test)]

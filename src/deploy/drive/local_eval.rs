@@ -39,12 +39,7 @@ pub fn local_links(
                 Choice::Sampled if net.as_q().is_some() => {
                     return Err(PolicyError::NotAnActor { agent: v.index })
                 }
-                Choice::Sampled => {
-                    let mut s = rng.clone();
-                    s.set_stream(SAMPLING_STREAMS + i as u64);
-                    s.set_word_pos(0);
-                    Some(s)
-                }
+                Choice::Sampled => Some(sampler(rng, SAMPLING_STREAMS + i as u64)),
             };
             Ok(LocalLink::with_sampler(
                 NetPolicy::new(Arc::new(net)),
@@ -56,6 +51,18 @@ pub fn local_links(
 
 /// Stream ids of the agents' sampling streams: clear of the evaluation env's own.
 const SAMPLING_STREAMS: u64 = 1 << 33;
+
+/// The stream a team policy (Mac-CAC's centralized actor) samples from: clear of the agents'.
+pub const TEAM_STREAM: u64 = SAMPLING_STREAMS - 1;
+
+/// Stream `id` of `rng`'s key, from its start: the draws of one sampler, independent of the
+/// environment's and of every other sampler's.
+pub fn sampler(rng: &EnvRng, id: u64) -> EnvRng {
+    let mut s = rng.clone();
+    s.set_stream(id);
+    s.set_word_pos(0);
+    s
+}
 
 /// Run `episodes` episodes of the manifest's domain on one random stream (`rng`, the caller's
 /// choice of seed; deploy uses the evaluation stream of the run's seed), each agent choosing by
