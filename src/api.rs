@@ -16,7 +16,7 @@ use crate::envs::{EnvError, MacroEnv};
 use crate::experiment::config::validate;
 use crate::experiment::run_settings::RunSettings;
 use crate::experiment::train_run::run_rngs;
-use crate::nn::QNet;
+use crate::nn::ActingNet;
 use crate::policy_files::policy_env::PolicyEnv;
 use crate::policy_files::{Manifest, RunInfo};
 use std::path::Path;
@@ -76,10 +76,13 @@ pub struct TrainedPolicy {
     pub evals: Vec<EvalPoint>,
     /// The names of the evaluation points' family columns ([`EvalPoint::family`]).
     pub metric_columns: &'static [&'static str],
-    /// Agent i's decentralized Q-net is `dec[i]` (empty for Cen-DDRQN, which has none).
-    pub dec: Vec<QNet>,
-    /// The centralized Q-net, for the methods that train one.
-    pub cen: Option<QNet>,
+    /// Agent i's decentralized net is `agents[i]`, whatever the family: a Q-net (the ICRA
+    /// methods) or an actor (the decentralized actor-critic methods). Empty for the methods
+    /// that act only centrally (Cen-DDRQN, Mac-CAC).
+    pub agents: Vec<ActingNet>,
+    /// The centralized net that can act for the whole team, when the method trains one: the
+    /// Q-net of Cen-DDRQN, Our-1, Our-1-R and Our-2, or Mac-CAC's actor (critics are not kept).
+    pub team: Option<ActingNet>,
 }
 
 /// [`train`], keeping the trained nets: the same trainer, the same numbers.
@@ -99,6 +102,15 @@ pub fn train_policy<E: MacroEnv>(
         on_episode(&trainer);
     }
     let nets = trainer.saved_nets();
+    let actors = nets.actors.iter().map(|&a| ActingNet::Actor(a.clone()));
+    let (agents, team): (Vec<ActingNet>, Option<ActingNet>) = if nets.actors.is_empty() {
+        let agents = nets.dec.iter().map(|&q| ActingNet::Q(q.clone())).collect();
+        (agents, nets.cen.map(|q| ActingNet::Q(q.clone())))
+    } else if nets.evaluated_is_centralized {
+        (Vec::new(), actors.into_iter().next())
+    } else {
+        (actors.collect(), None)
+    };
     Ok(TrainedPolicy {
         method,
         seed,
@@ -106,13 +118,13 @@ pub fn train_policy<E: MacroEnv>(
         config: config.clone(),
         evals: trainer.evals().to_vec(),
         metric_columns: trainer.metric_columns(),
-        dec: nets.dec.into_iter().cloned().collect(),
-        cen: nets.cen.cloned(),
+        agents,
+        team,
     })
 }
 
 impl TrainedPolicy {
-    /// Write the decentralized nets as an exported policy directory `out` (`policy.json` and
+    /// Write the decentralized nets (Q-nets or actors) as an exported policy directory `out` (`policy.json` and
     /// `agent-<i>.safetensors`) that `macdec robot --policy OUT --agent I` serves. The layout
     /// (observation sizes and names, macro-action names) comes from `env` through its
     /// [`MacroEnv`] methods; `domain` names it: [`PolicyEnv::custom`] for a domain of your own
@@ -143,8 +155,8 @@ impl TrainedPolicy {
             episodes_trained: self.episodes_trained,
             config,
         };
-        let dec: Vec<&QNet> = self.dec.iter().collect();
-        export_nets(out, domain, env, self.config.discount(), run, &dec)
+        let agents: Vec<&ActingNet> = self.agents.iter().collect();
+        export_nets(out, domain, env, self.config.discount(), run, &agents)
     }
 }
 
@@ -205,7 +217,8 @@ mod tests {
                 .collect()
         };
         assert_eq!(no_wall(&trained.evals), no_wall(&evals));
-        assert_eq!((trained.dec.len(), trained.episodes_trained), (2, 12));
+        assert_eq!((trained.agents.len(), trained.episodes_trained), (2, 12));
+        assert!(matches!(trained.team, Some(ActingNet::Q(_))));
         let env = spec.build().unwrap();
         let dir = tempfile::tempdir().unwrap();
         for (sub, domain) in [
@@ -222,8 +235,8 @@ mod tests {
                 let (manifest, verified) = load_agent(&out, agent).unwrap();
                 assert_eq!(manifest, written);
                 assert_eq!(
-                    load_net(&manifest, &verified).unwrap().as_q(),
-                    Some(&trained.dec[agent])
+                    load_net(&manifest, &verified).unwrap(),
+                    trained.agents[agent]
                 );
             }
         }
@@ -237,6 +250,57 @@ mod tests {
         .unwrap();
         let err = cen
             .export(&dir.path().join("cen"), &env, spec.into())
+            .unwrap_err();
+        assert!(err.to_string().contains("no decentralized nets"), "{err}");
+    }
+
+    #[test]
+    fn an_actor_critic_policy_keeps_its_actors_and_exports_the_decentralized_ones() {
+        use crate::deploy::net_policy::load_net;
+        use crate::experiment::paper::actor_critic_defaults;
+        use crate::policy_files::load_agent;
+        let spec = crate::envs::bp_ma_v0::spec(4, 20);
+        let short = |method| -> RunConfig {
+            let mut c = actor_critic_defaults(&spec, method);
+            c.total_epi = 8;
+            c.n_env = 4;
+            c.train_freq = 4;
+            c.eval_freq = 4;
+            c.eval_num_epi = 2;
+            c.into()
+        };
+        let iac = train_policy(
+            || spec.build(),
+            &short(Method::MacIac),
+            Method::MacIac,
+            1,
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(iac.agents.len(), 2);
+        assert!(iac.agents.iter().all(|a| matches!(a, ActingNet::Actor(_))));
+        assert!(iac.team.is_none());
+        let env = spec.build().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        iac.export(dir.path(), &env, spec.clone().into()).unwrap();
+        for agent in 0..2 {
+            let (manifest, verified) = load_agent(dir.path(), agent).unwrap();
+            assert_eq!(load_net(&manifest, &verified).unwrap(), iac.agents[agent]);
+        }
+        let cac = train_policy(
+            || spec.build(),
+            &short(Method::MacCac),
+            Method::MacCac,
+            1,
+            |_| {},
+        )
+        .unwrap();
+        assert!(cac.agents.is_empty());
+        let team = cac.team.as_ref().expect("the centralized actor");
+        assert_eq!(team.obs_len(), env.joint_obs_size());
+        assert_eq!(team.n_actions(), env.n_joint_actions());
+        let err = cac
+            .export(&dir.path().join("cac"), &env, spec.into())
             .unwrap_err();
         assert!(err.to_string().contains("no decentralized nets"), "{err}");
     }

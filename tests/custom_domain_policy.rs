@@ -177,7 +177,9 @@ fn a_robot_serves_a_custom_domain_policy_exactly_as_the_library_net_answers() {
         other => panic!("{other:?}"),
     }
     // Two decisions in a row: the second depends on the hidden state the first left.
-    let net = &trained.dec[agent];
+    let net = trained.agents[agent]
+        .as_q()
+        .expect("Our-1's agents have Q-nets");
     let mut state = net.zero_state();
     for obs in [[0.5f32, 1.0, 0.0], [1.5, 0.0, -2.0]] {
         let expected_q = net.act_step(&obs, &mut state).to_vec();
@@ -245,7 +247,7 @@ fn your_own_program_runs_the_custom_domain_against_its_robots_as_the_learner_eva
         &mut EnvRng::seed_from_u64(0),
     )
     .unwrap();
-    let nets: Vec<_> = trained.dec.iter().collect();
+    let nets: Vec<_> = trained.agents.iter().filter_map(|a| a.as_q()).collect();
     let mut steps = Vec::new();
     let learner = greedy_episode(
         &mut env,

@@ -204,6 +204,14 @@ impl NetFile {
         }
     }
 
+    /// The file of an acting net of either kind ([`Self::qnet`], [`Self::actor`]).
+    pub fn acting(role: NetRole, agent: Option<usize>, file: String, net: &ActingNet) -> NetFile {
+        match net {
+            ActingNet::Q(q) => NetFile::qnet(role, agent, file, q),
+            ActingNet::Actor(a) => NetFile::actor(role, agent, file, a),
+        }
+    }
+
     /// The entry and weights of a trained MacroMARL actor: agent `agent`'s (role `dec`) or the
     /// centralized one over joint macro-actions (role `cen`, Mac-CAC), under its `state_dict`
     /// names.

@@ -7,7 +7,7 @@
 //! binary (the library's `TrainedPolicy::export`).
 
 use crate::envs::MacroEnv;
-use crate::nn::QNet;
+use crate::nn::ActingNet;
 use crate::policy_files::{
     weights_file_name, AgentLayout, Manifest, NetFile, NetRole, PolicyEnv, PolicyError, RunInfo,
     POLICY_DIR, POLICY_FILE,
@@ -122,7 +122,7 @@ pub fn export_nets(
     domain: &impl MacroEnv,
     discount: f64,
     run: RunInfo,
-    nets: &[&QNet],
+    nets: &[&ActingNet],
 ) -> Result<Manifest, ExportError> {
     if nets.is_empty() {
         return Err(ExportError::NotDecentralized {
@@ -141,7 +141,7 @@ pub fn export_nets(
     let files: Vec<NetFile> = nets
         .iter()
         .enumerate()
-        .map(|(i, n)| NetFile::qnet(NetRole::Dec, Some(i), weights_file_name(i), n))
+        .map(|(i, n)| NetFile::acting(NetRole::Dec, Some(i), weights_file_name(i), n))
         .collect();
     write_files(out, env, agents, discount, run, files)
 }
