@@ -1,0 +1,147 @@
+//! `macdec import`: a policy directory from the references' PyTorch state_dicts.
+
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+use std::path::PathBuf;
+
+use super::bounds::bounded_count;
+
+/// Whose trained nets `macdec import` reads.
+#[derive(Clone, Copy, ValueEnum)]
+enum ImportReference {
+    /// The ICRA code's DDRQN Q-nets (`--env box-pushing` or `warehouse`).
+    Icra,
+    /// MacroMARL's GRU actors (`--env` a gym id such as `BP-MA-v0`, `--params`).
+    Macromarl,
+}
+
+#[derive(clap::Args)]
+pub(super) struct ImportArgs {
+    /// Whose nets: the ICRA code's Q-nets or MacroMARL's actors.
+    #[arg(long, value_enum, default_value = "icra")]
+    reference: ImportReference,
+    /// The domain the policy was trained on: `box-pushing` or `warehouse` (icra); the gym id,
+    /// e.g. `BP-MA-v0`, `OSD-T-v0`, `Overcooked-MA-v1` (macromarl).
+    #[arg(long)]
+    env: String,
+    /// MacroMARL: a JSON object of the reference's keyword arguments for `gym.make` (e.g.
+    /// `{"grid_dim": [14, 14]}`); the published values where absent.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// ICRA Box Pushing grid size N (N x N); the paper uses 10 and 30.
+    #[arg(long, value_parser = |t: &str| bounded_count(t, crate::experiment::limits::MAX_GRID_DIM))]
+    grid: Option<usize>,
+    /// Episode length in primitive steps (ICRA paper: Box Pushing 100 on 10x10, 200 on 30x30,
+    /// Warehouse 150; required for icra). MacroMARL: the published horizon by default.
+    #[arg(long, value_parser = |t: &str| bounded_count(t, crate::experiment::limits::MAX_HORIZON))]
+    horizon: Option<usize>,
+    /// ICRA Warehouse: std of the Turtlebots' movement noise (paper 0).
+    #[arg(long, default_value_t = 0.0)]
+    tb_m_noisy: f64,
+    /// Comma-separated state_dict safetensors files, one per agent, in agent order.
+    #[arg(long, value_delimiter = ',', required = true)]
+    agents: Vec<PathBuf>,
+    /// Discount per primitive step of the reported return (default: the paper's, e.g. Box
+    /// Pushing 0.98, Warehouse 1.0).
+    #[arg(long)]
+    discount: Option<f64>,
+    /// The policy directory to write.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Build the policy directory from the reference's state_dicts and say what was imported.
+pub(super) fn run(args: ImportArgs) -> Result<()> {
+    use crate::deploy::import::{import_policy, ImportRequest};
+    use crate::deploy::import_actors::import_actors;
+    let env = import_env(&args)?;
+    let request = ImportRequest {
+        discount: args
+            .discount
+            .or_else(|| env.paper_discount())
+            .unwrap_or(1.0),
+        env,
+        agents: args.agents,
+    };
+    let manifest = match args.reference {
+        ImportReference::Icra => import_policy(&request, &args.out),
+        ImportReference::Macromarl => import_actors(&request, &args.out),
+    }
+    .with_context(|| format!("importing into {}", args.out.display()))?;
+    let arch = &manifest.nets[0].architecture;
+    eprintln!(
+        "imported {} agent(s) of {} ({} {} / {}, discount {}) to {}",
+        manifest.agents.len(),
+        manifest.env.name(),
+        arch.kind,
+        arch.mlp_out_size
+            .map_or(arch.mlp_layer_size.to_string(), |m1| format!(
+                "[{}, {m1}]",
+                arch.mlp_layer_size
+            )),
+        arch.rnn_h_size,
+        manifest.discount,
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The domain `macdec import` names: ICRA's by `--env`, `--grid`, `--horizon`, `--tb-m-noisy`;
+/// MacroMARL's by its gym id, `--params` (the reference's keyword arguments) and `--horizon`.
+fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
+    use crate::envs::domain::{json_to_toml, key_table, HORIZON_KEY};
+    use crate::envs::EnvSpec;
+    let horizon = |h: usize| (HORIZON_KEY, toml::Value::from(h as i64));
+    match args.reference {
+        ImportReference::Icra => {
+            let Some(h) = args.horizon else {
+                bail!("--reference icra needs --horizon (the episode length in primitive steps)")
+            };
+            if args.params.is_some() {
+                bail!("--params is for --reference macromarl");
+            }
+            Ok(match (args.env.as_str(), args.grid) {
+                ("box-pushing", Some(grid)) => EnvSpec::new(
+                    "box-pushing",
+                    &key_table([("grid_dim", (grid as i64).into()), horizon(h)]),
+                ),
+                ("box-pushing", None) => bail!("--env box-pushing needs --grid N"),
+                ("warehouse", None) => EnvSpec::new(
+                    "warehouse",
+                    &key_table([horizon(h), ("tb_m_noisy", args.tb_m_noisy.into())]),
+                ),
+                ("warehouse", Some(_)) => bail!("--grid is for box-pushing; warehouse has none"),
+                (other, _) => {
+                    bail!("--reference icra: --env must be box-pushing or warehouse, got `{other}`")
+                }
+            }?)
+        }
+        ImportReference::Macromarl => {
+            if args.grid.is_some() {
+                bail!("--grid is for --reference icra; MacroMARL's grid is `grid_dim` in --params");
+            }
+            let mut given = toml::Table::new();
+            if let Some(path) = &args.params {
+                let text = crate::files::bounded_read::read_regular_file(path, 1 << 20)
+                    .with_context(|| format!("reading {}", path.display()))?;
+                let value: serde_json::Value = serde_json::from_slice(&text)
+                    .with_context(|| format!("parsing {}", path.display()))?;
+                let serde_json::Value::Object(map) = value else {
+                    bail!(
+                        "{}: expected a JSON object of keyword arguments",
+                        path.display()
+                    );
+                };
+                for (k, v) in map {
+                    let v = json_to_toml(&v)
+                        .with_context(|| format!("{}: `{k}` holds a null", path.display()))?;
+                    given.insert(k, v);
+                }
+            }
+            if let Some(h) = args.horizon {
+                given.insert(HORIZON_KEY.into(), (h as i64).into());
+            }
+            Ok(EnvSpec::new(&args.env, &given)?)
+        }
+    }
+}

@@ -1,0 +1,60 @@
+//! `macdec plot`: learning curves (PNG + SVG) and summary tables from a results tree.
+
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub(super) struct PlotArgs {
+    /// Results root: <results>/<experiment>/<curve>/seed-<k>/metrics.csv.
+    #[arg(long, default_value = "results")]
+    results: PathBuf,
+    /// Where the figures and <experiment>_summary.csv files go (default: the results root,
+    /// as `train` does; only an explicit `--out plots` redraws the committed figures).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// The metrics.csv column to plot: eval_return, or any other (env_steps, updates, a
+    /// method family's own such as loss or epsilon); files become <experiment>_<metric>.*.
+    #[arg(long, default_value = "eval_return")]
+    metric: String,
+    /// Centred moving average before drawing and reading "95% of optimal first at":
+    /// `auto` (half window = evaluation points / 40, at most 10: 21 points on long runs,
+    /// none under 40 points), `0` (none), an odd number of evaluation points (`21`), or
+    /// training episodes (`2000ep`).
+    #[arg(long, default_value = "auto", value_parser = crate::curve_stats::Smoothing::parse)]
+    smooth: crate::curve_stats::Smoothing,
+}
+
+/// Draw the figures (into the results root unless `--out` says otherwise) and print the tables.
+pub(super) fn run(args: PlotArgs) -> Result<()> {
+    let PlotArgs {
+        results,
+        out,
+        metric,
+        smooth,
+    } = args;
+    let out = out.unwrap_or_else(|| results.clone());
+    let options = crate::plot::PlotOptions {
+        metric,
+        smoothing: smooth,
+    };
+    plot(&results, &out, &options)
+}
+
+fn plot(results: &Path, out: &Path, options: &crate::plot::PlotOptions) -> Result<()> {
+    let report = crate::plot::plot_results_with(results, out, options)
+        .with_context(|| format!("plotting {} into {}", results.display(), out.display()))?;
+    for note in &report.notes {
+        eprintln!("{note}");
+    }
+    for p in &report.plots {
+        eprintln!(
+            "wrote {}, {}, {}, {}",
+            p.png.display(),
+            p.svg.display(),
+            p.summary_csv.display(),
+            p.tests_csv.display()
+        );
+    }
+    print!("{}", report.markdown());
+    Ok(())
+}

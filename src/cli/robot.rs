@@ -1,0 +1,97 @@
+//! `macdec robot`: serve one agent of an exported policy over stdin/stdout or TCP.
+
+use anyhow::{Context, Result};
+use std::io::Write;
+use std::path::PathBuf;
+
+use super::bounds::bounded_count;
+
+#[derive(clap::Args)]
+pub(super) struct RobotArgs {
+    /// Exported policy directory (policy.json and one safetensors file per agent).
+    #[arg(long)]
+    policy: PathBuf,
+    /// Which agent this robot is (0-based).
+    #[arg(long)]
+    agent: usize,
+    /// Serve TCP on this address (e.g. 127.0.0.1:7000; port 0 picks a free one) instead of
+    /// stdin/stdout. The first stdout line is {"listening": "ADDR"}.
+    #[arg(long)]
+    listen: Option<std::net::SocketAddr>,
+    /// With --listen: connections served at once (one more is refused with an error line).
+    #[arg(long, default_value_t = 16, value_parser = |t: &str| bounded_count(t, 4096))]
+    max_connections: usize,
+    /// Longest request line in bytes, at most 64 MiB; a longer one gets an error reply and is
+    /// discarded.
+    #[arg(long, default_value_t = crate::deploy::line_reader::MAX_LINE_BYTES,
+          value_parser = |t: &str| bounded_count(t, 64 << 20))]
+    max_line_bytes: usize,
+    /// With --listen: close a connection silent between requests for this many seconds.
+    #[arg(long, default_value_t = crate::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS,
+          value_parser = clap::value_parser!(u64).range(1..=86_400))]
+    idle_timeout_secs: u64,
+    /// Run a deterministic stand-in policy instead of the weights (tests).
+    #[arg(long, hide = true)]
+    mock: bool,
+    /// Exit when stdin closes (set by `macdec deploy`, so robots never outlive it).
+    #[arg(long, hide = true)]
+    exit_on_stdin_close: bool,
+}
+
+/// Fresh policies (zero hidden state) for agent `agent`'s robot, one per connection.
+fn policy_factory(
+    manifest: &crate::deploy::Manifest,
+    verified: &crate::deploy::VerifiedAgent,
+    mock: bool,
+) -> Result<crate::deploy::server::PolicyFactory> {
+    use crate::deploy::{mock::MockPolicy, AgentPolicy};
+    let entry = &manifest.agents[verified.index];
+    if mock {
+        let (obs, n, salt) = (entry.obs_size, entry.n_actions, entry.index as u64);
+        return Ok(std::sync::Arc::new(move || {
+            Box::new(MockPolicy::new(obs, n, salt)) as Box<dyn AgentPolicy>
+        }));
+    }
+    let net = crate::deploy::net_policy::load_net(manifest, verified)?;
+    Ok(crate::deploy::net_policy::net_factory(net))
+}
+
+/// Serve the agent's policy on stdin/stdout, or on TCP with `--listen`.
+pub(super) fn run(args: RobotArgs) -> Result<()> {
+    use crate::deploy::{manifest::load_agent, processes, RobotSpec};
+    let (manifest, verified) = load_agent(&args.policy, args.agent)
+        .with_context(|| format!("loading agent {} of {}", args.agent, args.policy.display()))?;
+    let spec = std::sync::Arc::new(RobotSpec::new(&manifest, args.agent)?);
+    let factory = policy_factory(&manifest, &verified, args.mock)?;
+    if args.exit_on_stdin_close && args.listen.is_some() {
+        processes::exit_when_stdin_closes();
+    }
+    match args.listen {
+        None => {
+            crate::deploy::serve_stdio(factory(), spec, args.max_line_bytes)?;
+        }
+        Some(addr) => {
+            let listener = std::net::TcpListener::bind(addr)
+                .with_context(|| format!("listening on {addr}"))?;
+            let bound = listener.local_addr()?;
+            {
+                let mut out = std::io::stdout().lock();
+                writeln!(out, "{}", processes::announcement(bound))?;
+                out.flush()?;
+            }
+            eprintln!(
+                "robot for agent {} of {} listening on {bound}",
+                args.agent,
+                args.policy.display()
+            );
+            let limits = crate::deploy::Limits {
+                max_line_bytes: args.max_line_bytes,
+                max_connections: args.max_connections,
+                idle_timeout: Some(std::time::Duration::from_secs(args.idle_timeout_secs)),
+                ..Default::default()
+            };
+            crate::deploy::serve_tcp(listener, factory, spec, limits)?;
+        }
+    }
+    Ok(())
+}
