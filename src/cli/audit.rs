@@ -85,3 +85,44 @@ pub(super) fn run(args: AuditArgs) -> Result<()> {
     println!("all {} audited run(s) identical", results.len());
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused, error_text};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> AuditArgs {
+        match accepted("audit", flags) {
+            Command::Audit(args) => args,
+            _ => unreachable!("`audit` parses as Command::Audit"),
+        }
+    }
+
+    #[test]
+    fn audit_retrains_three_runs_of_reproduction_by_default() {
+        let args = parse(&[]);
+        assert_eq!(args.results, PathBuf::from("reproduction"));
+        assert_eq!(args.runs, 3);
+        assert!(args.run.is_empty());
+        assert_eq!((args.seed, args.jobs), (None, None));
+        let args = parse(&["--run", "a/seed-0", "--run", "b/seed-1", "--seed", "5"]);
+        assert_eq!(
+            args.run,
+            [PathBuf::from("a/seed-0"), PathBuf::from("b/seed-1")]
+        );
+        assert_eq!(args.seed, Some(5));
+        assert_refused("audit", &["--runs", "x"], ErrorKind::ValueValidation, "'x'");
+    }
+
+    #[test]
+    fn audit_of_a_tree_without_finished_runs_fails_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let args = parse(&["--results", dir.path().to_str().unwrap()]);
+        assert_eq!(
+            error_text(run(args)),
+            format!("Error: {}: no finished runs to audit", dir.path().display())
+        );
+    }
+}

@@ -121,3 +121,43 @@ fn bench_envs() -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> BenchArgs {
+        match accepted("bench", flags) {
+            Command::Bench(args) => args,
+            _ => unreachable!("`bench` parses as Command::Bench"),
+        }
+    }
+
+    #[test]
+    fn bench_names_what_to_measure() {
+        assert_refused("bench", &[], ErrorKind::MissingRequiredArgument, "<WHAT>");
+        assert!(matches!(parse(&["envs"]).what, BenchTarget::Envs));
+        assert!(matches!(parse(&["nets"]).what, BenchTarget::Nets));
+        assert!(matches!(parse(&["train"]).what, BenchTarget::Train));
+        assert!(matches!(parse(&["gru"]).what, BenchTarget::Gru));
+        assert_refused("bench", &["lstm"], ErrorKind::InvalidValue, "'lstm'");
+    }
+
+    #[test]
+    fn bench_times_200_iterations_and_200_episodes_of_everything_by_default() {
+        let args = parse(&["nets"]);
+        assert_eq!((args.iters, args.episodes, args.only), (200, 200, None));
+        let args = parse(&["train", "--only", "bp10 our1", "--episodes", "20"]);
+        assert_eq!(args.only.as_deref(), Some("bp10 our1"));
+        assert_eq!(args.episodes, 20);
+        assert_refused(
+            "bench",
+            &["nets", "--iters", "x"],
+            ErrorKind::ValueValidation,
+            "'x'",
+        );
+    }
+}

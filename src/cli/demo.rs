@@ -36,3 +36,39 @@ pub(super) fn run(args: DemoArgs) -> Result<()> {
     println!("done in {:.1} s", t0.elapsed().as_secs_f64());
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> DemoArgs {
+        match accepted("demo", flags) {
+            Command::Demo(args) => args,
+            _ => unreachable!("`demo` parses as Command::Demo"),
+        }
+    }
+
+    #[test]
+    fn demo_defaults_to_the_demo_config_s_steps_and_seed_0() {
+        let args = parse(&[]);
+        assert_eq!(args.steps, demo::DemoConfig::default().steps);
+        assert_eq!(args.steps, 1500);
+        assert_eq!(args.seed, 0);
+        let args = parse(&["--steps", "20", "--seed", "7"]);
+        assert_eq!((args.steps, args.seed), (20, 7));
+    }
+
+    #[test]
+    fn demo_refuses_steps_and_seeds_that_are_not_whole_numbers() {
+        assert_refused("demo", &["--steps", "x"], ErrorKind::ValueValidation, "'x'");
+        assert_refused(
+            "demo",
+            &["--seed", "1.5"],
+            ErrorKind::ValueValidation,
+            "'1.5'",
+        );
+    }
+}

@@ -48,3 +48,88 @@ pub(super) fn run(args: DomainArgs) -> Result<()> {
     eprintln!("{}", printer.summary(&run, &place));
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::{Cli, Command};
+    use clap::error::ErrorKind;
+    use clap::CommandFactory;
+    use std::path::PathBuf;
+
+    fn parse(flags: &[&str]) -> DomainArgs {
+        let argv = [&["--policy", "p", "--robots", "127.0.0.1:7000"], flags].concat();
+        match accepted("domain", &argv) {
+            Command::Domain(args) => args,
+            _ => unreachable!("`domain` parses as Command::Domain"),
+        }
+    }
+
+    #[test]
+    fn domain_needs_a_policy_and_its_robots() {
+        let missing = ErrorKind::MissingRequiredArgument;
+        assert_refused("domain", &["--policy", "p"], missing, "--robots <ROBOTS>");
+        assert_refused(
+            "domain",
+            &["--robots", "127.0.0.1:7000"],
+            missing,
+            "--policy <POLICY>",
+        );
+        let args = parse(&[]);
+        assert_eq!(args.episodes.policy, PathBuf::from("p"));
+        assert_eq!(args.episodes.episodes, 1);
+        assert_eq!(args.episodes.seed, None);
+        assert_eq!(args.timeout_secs, 30);
+    }
+
+    #[test]
+    fn domain_robots_are_comma_separated_addresses_in_agent_order() {
+        let argv = ["--policy", "p", "--robots", "10.0.0.2:7001,10.0.0.1:7000"];
+        let Command::Domain(args) = accepted("domain", &argv) else {
+            unreachable!("`domain` parses as Command::Domain")
+        };
+        let expected: Vec<std::net::SocketAddr> = vec![
+            "10.0.0.2:7001".parse().unwrap(),
+            "10.0.0.1:7000".parse().unwrap(),
+        ];
+        assert_eq!(args.robots, expected);
+        let argv = ["--policy", "p", "--robots", "127.0.0.1:7000,robot1"];
+        assert_refused("domain", &argv, ErrorKind::ValueValidation, "'robot1'");
+    }
+
+    #[test]
+    fn domain_timeout_is_one_second_to_a_day() {
+        assert_eq!(parse(&["--timeout-secs", "86400"]).timeout_secs, 86_400);
+        let argv = [
+            "--policy",
+            "p",
+            "--robots",
+            "127.0.0.1:7000",
+            "--timeout-secs",
+            "0",
+        ];
+        let message = "a timeout of 0 s gives no robot time to answer: use 1 to 86400";
+        assert_refused("domain", &argv, ErrorKind::ValueValidation, message);
+    }
+
+    #[test]
+    fn domain_says_the_robots_must_serve_this_policy_and_lists_robots_after_it() {
+        let cmd = Cli::command();
+        let domain = cmd.find_subcommand("domain").unwrap();
+        let policy = domain
+            .get_arguments()
+            .find(|a| a.get_id() == "policy")
+            .unwrap();
+        assert_eq!(
+            policy.get_help().unwrap().to_string(),
+            "Policy directory the robots run (their `info` must report its manifest)"
+        );
+        let mut domain = domain.clone();
+        let usage = domain.render_usage().to_string();
+        assert!(
+            usage.contains("--policy <POLICY> --robots <ROBOTS>"),
+            "{usage}"
+        );
+    }
+}

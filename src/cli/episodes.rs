@@ -105,3 +105,54 @@ impl EpisodePrinter {
         self.undiscounted / self.count.max(1) as f64
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::Cli;
+    use clap::CommandFactory;
+
+    /// How `subcommand` declares `flag`: its default and help text.
+    fn declared(subcommand: &str, flag: &str) -> (Vec<String>, String) {
+        let cmd = Cli::command();
+        let arg = cmd
+            .find_subcommand(subcommand)
+            .unwrap()
+            .get_arguments()
+            .find(|a| a.get_id() == flag)
+            .unwrap_or_else(|| panic!("`{subcommand}` has no --{flag}"))
+            .clone();
+        let defaults = arg
+            .get_default_values()
+            .iter()
+            .map(|v| v.to_string_lossy().into_owned());
+        (defaults.collect(), arg.get_help().unwrap().to_string())
+    }
+
+    #[test]
+    fn deploy_eval_and_domain_take_the_episode_flags_alike() {
+        for flag in ["episodes", "seed", "trajectories"] {
+            let deploy = declared("deploy", flag);
+            assert_eq!(declared("eval", flag), deploy, "--{flag}");
+            assert_eq!(declared("domain", flag), deploy, "--{flag}");
+        }
+        assert_eq!(declared("eval", "episodes").0, ["1"]);
+        assert_eq!(declared("eval", "policy"), declared("deploy", "policy"));
+    }
+
+    #[test]
+    fn a_missing_policy_directory_is_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let args = EpisodeArgs {
+            policy: dir.path().join("none"),
+            episodes: 1,
+            seed: None,
+            trajectories: false,
+        };
+        let e = args.load().err().expect("no policy there");
+        assert_eq!(
+            e.to_string(),
+            format!("loading policy {}", args.policy.display())
+        );
+    }
+}

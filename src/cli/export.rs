@@ -38,3 +38,34 @@ pub(super) fn run(args: ExportArgs) -> Result<()> {
     );
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    #[test]
+    fn export_needs_a_run_and_an_out_directory() {
+        assert_refused(
+            "export",
+            &["--out", "p"],
+            ErrorKind::MissingRequiredArgument,
+            "--run <RUN>",
+        );
+        assert_refused(
+            "export",
+            &["--run", "r"],
+            ErrorKind::MissingRequiredArgument,
+            "--out <OUT>",
+        );
+        let Command::Export(args) = accepted("export", &["--run", "r", "--out", "p"]) else {
+            unreachable!("`export` parses as Command::Export")
+        };
+        assert_eq!(
+            (args.run, args.out),
+            (PathBuf::from("r"), PathBuf::from("p"))
+        );
+    }
+}

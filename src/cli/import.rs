@@ -145,3 +145,175 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    /// `import --agents a.safetensors --out o` with `flags`.
+    fn parse(flags: &[&str]) -> ImportArgs {
+        let argv = [&["--agents", "a.safetensors", "--out", "o"], flags].concat();
+        match accepted("import", &argv) {
+            Command::Import(args) => args,
+            _ => unreachable!("`import` parses as Command::Import"),
+        }
+    }
+
+    fn refused(flags: &[&str], kind: ErrorKind, message: &str) {
+        let argv = [&["--agents", "a.safetensors", "--out", "o"], flags].concat();
+        assert_refused("import", &argv, kind, message);
+    }
+
+    /// The message `import_env` fails with for these flags.
+    fn env_error(flags: &[&str]) -> String {
+        match import_env(&parse(flags)) {
+            Ok(spec) => panic!("{flags:?} named a domain: {}", spec.name()),
+            Err(e) => format!("{e:#}"),
+        }
+    }
+
+    #[test]
+    fn import_reads_the_icra_reference_by_default() {
+        let args = parse(&["--env", "warehouse"]);
+        assert!(matches!(args.reference, ImportReference::Icra));
+        assert_eq!(args.env, "warehouse");
+        assert_eq!(args.agents, [PathBuf::from("a.safetensors")]);
+        assert_eq!(args.out, PathBuf::from("o"));
+        assert_eq!((args.params, args.grid, args.horizon), (None, None, None));
+        assert_eq!(args.tb_m_noisy, 0.0);
+        assert_eq!(args.discount, None);
+        let args = parse(&["--env", "BP-MA-v0", "--reference", "macromarl"]);
+        assert!(matches!(args.reference, ImportReference::Macromarl));
+        refused(
+            &["--env", "x", "--reference", "pymarl"],
+            ErrorKind::InvalidValue,
+            "'pymarl'",
+        );
+    }
+
+    #[test]
+    fn import_needs_env_agents_and_out() {
+        let missing = ErrorKind::MissingRequiredArgument;
+        assert_refused(
+            "import",
+            &["--env", "warehouse", "--out", "o"],
+            missing,
+            "--agents <AGENTS>",
+        );
+        assert_refused(
+            "import",
+            &["--agents", "a", "--out", "o"],
+            missing,
+            "--env <ENV>",
+        );
+        assert_refused(
+            "import",
+            &["--env", "warehouse", "--agents", "a"],
+            missing,
+            "--out <OUT>",
+        );
+        let argv = [
+            "--env",
+            "warehouse",
+            "--agents",
+            "a0.st,a1.st",
+            "--out",
+            "o",
+        ];
+        let Command::Import(args) = accepted("import", &argv) else {
+            unreachable!("`import` parses as Command::Import")
+        };
+        assert_eq!(
+            args.agents,
+            [PathBuf::from("a0.st"), PathBuf::from("a1.st")]
+        );
+    }
+
+    #[test]
+    fn import_grid_and_horizon_are_bounded_like_a_config() {
+        let v = ErrorKind::ValueValidation;
+        assert_eq!(parse(&["--env", "e", "--grid", "1000"]).grid, Some(1000));
+        refused(&["--env", "e", "--grid", "0"], v, "must be at least 1");
+        refused(
+            &["--env", "e", "--grid", "1001"],
+            v,
+            "must be at most 1000, got 1001",
+        );
+        assert_eq!(
+            parse(&["--env", "e", "--horizon", "100000"]).horizon,
+            Some(100_000)
+        );
+        refused(&["--env", "e", "--horizon", "0"], v, "must be at least 1");
+        refused(
+            &["--env", "e", "--horizon", "100001"],
+            v,
+            "must be at most 100000, got 100001",
+        );
+    }
+
+    #[test]
+    fn icra_imports_name_box_pushing_by_grid_and_warehouse_without_one() {
+        let spec = import_env(&parse(&[
+            "--env",
+            "box-pushing",
+            "--grid",
+            "10",
+            "--horizon",
+            "100",
+        ]))
+        .unwrap();
+        assert_eq!(spec.name(), "box-pushing");
+        let spec = import_env(&parse(&["--env", "warehouse", "--horizon", "150"])).unwrap();
+        assert_eq!(spec.name(), "warehouse");
+    }
+
+    #[test]
+    fn icra_imports_refuse_what_the_reference_cannot_have() {
+        assert_eq!(
+            env_error(&["--env", "box-pushing", "--grid", "10"]),
+            "--reference icra needs --horizon (the episode length in primitive steps)"
+        );
+        assert_eq!(
+            env_error(&["--env", "warehouse", "--horizon", "9", "--params", "p.json"]),
+            "--params is for --reference macromarl"
+        );
+        assert_eq!(
+            env_error(&["--env", "box-pushing", "--horizon", "100"]),
+            "--env box-pushing needs --grid N"
+        );
+        assert_eq!(
+            env_error(&["--env", "warehouse", "--horizon", "150", "--grid", "3"]),
+            "--grid is for box-pushing; warehouse has none"
+        );
+        assert_eq!(
+            env_error(&["--env", "BP-MA-v0", "--horizon", "100"]),
+            "--reference icra: --env must be box-pushing or warehouse, got `BP-MA-v0`"
+        );
+    }
+
+    #[test]
+    fn macromarl_imports_take_keyword_arguments_as_a_json_object() {
+        let mm = ["--reference", "macromarl", "--env", "BP-MA-v0"];
+        assert_eq!(
+            env_error(&[&mm[..], &["--grid", "6"]].concat()),
+            "--grid is for --reference icra; MacroMARL's grid is `grid_dim` in --params"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let params = dir.path().join("params.json");
+        let p = params.to_str().unwrap();
+        std::fs::write(&params, "[6, 6]").unwrap();
+        assert_eq!(
+            env_error(&[&mm[..], &["--params", p]].concat()),
+            format!("{p}: expected a JSON object of keyword arguments")
+        );
+        std::fs::write(&params, r#"{"grid_dim": null}"#).unwrap();
+        assert!(env_error(&[&mm[..], &["--params", p]].concat())
+            .starts_with(&format!("{p}: `grid_dim` holds a null")));
+        std::fs::write(&params, r#"{"grid_dim": [6, 6]}"#).unwrap();
+        let spec = import_env(&parse(&[&mm[..], &["--params", p]].concat())).unwrap();
+        assert_eq!(spec.name(), "BP-MA-v0");
+    }
+}

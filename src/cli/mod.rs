@@ -162,3 +162,89 @@ fn run() -> Result<()> {
         Command::Bench(args) => bench::run(args),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::error::ErrorKind;
+    use clap::CommandFactory;
+
+    /// `macdec <subcommand> <flags>` parsed as the binary parses it.
+    pub(super) fn parse(subcommand: &str, flags: &[&str]) -> Result<Command, clap::Error> {
+        let argv = ["macdec", subcommand]
+            .into_iter()
+            .chain(flags.iter().copied());
+        Cli::try_parse_from(argv).map(|cli| cli.command)
+    }
+
+    /// The parsed subcommand. Panics with clap's message if the command line is refused.
+    pub(super) fn accepted(subcommand: &str, flags: &[&str]) -> Command {
+        parse(subcommand, flags).unwrap_or_else(|e| {
+            panic!("`macdec {subcommand} {}` was refused: {e}", flags.join(" "))
+        })
+    }
+
+    /// Asserts that the command line is refused with an error of `kind` whose message contains
+    /// `message`. Panics if it is accepted.
+    pub(super) fn assert_refused(subcommand: &str, flags: &[&str], kind: ErrorKind, message: &str) {
+        let shown = format!("`macdec {subcommand} {}`", flags.join(" "));
+        let e = match parse(subcommand, flags) {
+            Ok(_) => panic!("{shown} was accepted"),
+            Err(e) => e,
+        };
+        let text = e.to_string();
+        assert_eq!(e.kind(), kind, "{shown}: {text}");
+        assert!(
+            text.contains(message),
+            "{shown}: `{message}` is not in: {text}"
+        );
+    }
+
+    /// The message of a handler's error, with its causes as `main` prints them.
+    pub(super) fn error_text(result: Result<()>) -> String {
+        error_report(&result.expect_err("the handler should have failed"))
+    }
+
+    #[test]
+    fn the_command_line_passes_clap_s_own_checks() {
+        // Duplicate flags, a `mut_arg` naming no argument, a default its parser refuses, ...
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn the_subcommands_keep_their_names_and_help_order() {
+        let names: Vec<String> = Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "demo", "train", "replay", "results", "plot", "render", "slurm", "export", "robot",
+                "deploy", "audit", "import", "eval", "domain", "bench"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_subcommand_is_required_and_an_unknown_one_refused() {
+        let none = Cli::try_parse_from(["macdec"]).map(|_| ()).unwrap_err();
+        assert_eq!(
+            none.kind(),
+            ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+        );
+        assert_refused("nosuch", &[], ErrorKind::InvalidSubcommand, "'nosuch'");
+    }
+
+    #[test]
+    fn error_report_shows_a_cause_once() {
+        let inner = anyhow::anyhow!("disk full");
+        assert_eq!(
+            error_report(&inner.context("writing results/x")),
+            "Error: writing results/x\n  caused by: disk full"
+        );
+        // A library error that prints its source inline: the cause adds nothing.
+        let inline = anyhow::anyhow!("disk full").context("writing results/x: disk full");
+        assert_eq!(error_report(&inline), "Error: writing results/x: disk full");
+    }
+}

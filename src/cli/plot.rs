@@ -58,3 +58,50 @@ fn plot(results: &Path, out: &Path, options: &crate::plot::PlotOptions) -> Resul
     print!("{}", report.markdown());
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use crate::curve_stats::Smoothing;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> PlotArgs {
+        match accepted("plot", flags) {
+            Command::Plot(args) => args,
+            _ => unreachable!("`plot` parses as Command::Plot"),
+        }
+    }
+
+    #[test]
+    fn plot_draws_eval_return_of_results_with_auto_smoothing_by_default() {
+        let args = parse(&[]);
+        assert_eq!(args.results, PathBuf::from("results"));
+        assert_eq!(args.out, None);
+        assert_eq!(args.metric, "eval_return");
+        assert_eq!(args.smooth, Smoothing::Auto);
+    }
+
+    #[test]
+    fn plot_smooth_takes_none_odd_points_or_episodes() {
+        assert_eq!(parse(&["--smooth", "0"]).smooth, Smoothing::NONE);
+        assert_eq!(parse(&["--smooth", "21"]).smooth, Smoothing::Points(21));
+        assert_eq!(
+            parse(&["--smooth", "2000ep"]).smooth,
+            Smoothing::Episodes(2000)
+        );
+        assert_refused(
+            "plot",
+            &["--smooth", "4"],
+            ErrorKind::ValueValidation,
+            "`4` is even (use 3 or 5)",
+        );
+        assert_refused(
+            "plot",
+            &["--smooth", "foo"],
+            ErrorKind::ValueValidation,
+            "`foo` is not a smoothing",
+        );
+    }
+}

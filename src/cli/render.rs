@@ -93,3 +93,93 @@ fn refuse_policy_dir_as_run(dir: &Path) -> Result<()> {
         dir.display()
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> RenderArgs {
+        match accepted("render", flags) {
+            Command::Render(args) => args,
+            _ => unreachable!("`render` parses as Command::Render"),
+        }
+    }
+
+    #[test]
+    fn render_defaults_to_one_episode_at_150_ms_into_rollout_gif() {
+        assert_refused(
+            "render",
+            &[],
+            ErrorKind::MissingRequiredArgument,
+            "--run <RUN>",
+        );
+        let args = parse(&["--run", "r"]);
+        assert_eq!(args.run, PathBuf::from("r"));
+        assert_eq!(args.episodes, 1);
+        assert_eq!(args.out, PathBuf::from("rollout.gif"));
+        assert_eq!(args.frame_ms, 150);
+        assert_eq!(args.net, None);
+    }
+
+    #[test]
+    fn render_net_is_cen_or_dec_exactly() {
+        assert_eq!(
+            parse(&["--run", "r", "--net", "cen"]).net,
+            Some(NetRole::Cen)
+        );
+        assert_eq!(
+            parse(&["--run", "r", "--net", "dec"]).net,
+            Some(NetRole::Dec)
+        );
+        for bad in ["CEN", "actor", ""] {
+            assert_refused(
+                "render",
+                &["--run", "r", "--net", bad],
+                ErrorKind::ValueValidation,
+                &format!("expected `cen` or `dec`, got `{bad}`"),
+            );
+        }
+    }
+
+    #[test]
+    fn render_episodes_are_bounded_like_eval_num_epi() {
+        assert_eq!(
+            parse(&["--run", "r", "--episodes", "100000"]).episodes,
+            100_000
+        );
+        assert_refused(
+            "render",
+            &["--run", "r", "--episodes", "0"],
+            ErrorKind::ValueValidation,
+            "must be at least 1",
+        );
+        assert_refused(
+            "render",
+            &["--run", "r", "--episodes", "100001"],
+            ErrorKind::ValueValidation,
+            "must be at most 100000, got 100001",
+        );
+    }
+
+    #[test]
+    fn returns_are_listed_up_to_ten_then_summarized() {
+        assert_eq!(summarize_returns(&[1.0, -2.5]), "[1.0, -2.5]");
+        let ten = [0.5; 10];
+        assert_eq!(summarize_returns(&ten), format!("{ten:?}"));
+        let eleven: Vec<f64> = (0..11).map(f64::from).collect();
+        assert_eq!(summarize_returns(&eleven), "mean 5, lowest 0, highest 10");
+    }
+
+    #[test]
+    fn a_directory_without_policy_files_is_not_refused_as_a_policy_directory() {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(refuse_policy_dir_as_run(dir.path()).is_ok());
+        // A run directory holds policy.json in its policy/ subdirectory.
+        std::fs::create_dir(dir.path().join(results_tree::POLICY_DIR)).unwrap();
+        std::fs::write(dir.path().join(crate::policy_files::POLICY_FILE), "{}").unwrap();
+        assert!(refuse_policy_dir_as_run(dir.path()).is_ok());
+    }
+}

@@ -43,3 +43,43 @@ pub(super) fn run(args: ReplayArgs) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused, error_text};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> ReplayArgs {
+        match accepted("replay", flags) {
+            Command::Replay(args) => args,
+            _ => unreachable!("`replay` parses as Command::Replay"),
+        }
+    }
+
+    #[test]
+    fn replay_needs_the_actions_file_and_is_quiet_by_default() {
+        assert_refused(
+            "replay",
+            &[],
+            ErrorKind::MissingRequiredArgument,
+            "--actions <ACTIONS>",
+        );
+        let args = parse(&["--actions", "log.json"]);
+        assert_eq!(args.actions, PathBuf::from("log.json"));
+        assert!(!args.verbose);
+        assert!(parse(&["--actions", "log.json", "--verbose"]).verbose);
+    }
+
+    #[test]
+    fn replay_of_a_missing_file_names_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("none.json");
+        let text = error_text(run(parse(&["--actions", path.to_str().unwrap()])));
+        assert!(
+            text.starts_with(&format!("Error: reading replay file {}", path.display())),
+            "{text}"
+        );
+    }
+}

@@ -39,3 +39,27 @@ pub(super) fn run(args: ResultsArgs) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::accepted;
+    use crate::cli::Command;
+
+    fn parse(flags: &[&str]) -> ResultsArgs {
+        match accepted("results", flags) {
+            Command::Results(args) => args,
+            _ => unreachable!("`results` parses as Command::Results"),
+        }
+    }
+
+    #[test]
+    fn results_reads_results_and_writes_to_stdout_by_default() {
+        let args = parse(&[]);
+        assert_eq!(args.results, PathBuf::from("results"));
+        assert_eq!(args.out, None);
+        let args = parse(&["--results", "reproduction", "--out", "all.csv"]);
+        assert_eq!(args.results, PathBuf::from("reproduction"));
+        assert_eq!(args.out, Some(PathBuf::from("all.csv")));
+    }
+}

@@ -95,3 +95,93 @@ pub(super) fn run(args: RobotArgs) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> RobotArgs {
+        let argv = [&["--policy", "p", "--agent", "1"], flags].concat();
+        match accepted("robot", &argv) {
+            Command::Robot(args) => args,
+            _ => unreachable!("`robot` parses as Command::Robot"),
+        }
+    }
+
+    fn refused(flags: &[&str], message: &str) {
+        let argv = [&["--policy", "p", "--agent", "0"], flags].concat();
+        assert_refused("robot", &argv, ErrorKind::ValueValidation, message);
+    }
+
+    #[test]
+    fn robot_needs_a_policy_and_an_agent() {
+        let missing = ErrorKind::MissingRequiredArgument;
+        assert_refused("robot", &["--agent", "0"], missing, "--policy <POLICY>");
+        assert_refused("robot", &["--policy", "p"], missing, "--agent <AGENT>");
+        assert_refused(
+            "robot",
+            &["--policy", "p", "--agent", "x"],
+            ErrorKind::ValueValidation,
+            "'x'",
+        );
+    }
+
+    #[test]
+    fn robot_serves_stdio_with_the_server_s_default_limits() {
+        let args = parse(&[]);
+        assert_eq!(args.policy, PathBuf::from("p"));
+        assert_eq!(args.agent, 1);
+        assert_eq!(args.listen, None);
+        assert_eq!(args.max_connections, 16);
+        assert_eq!(
+            args.max_line_bytes,
+            crate::deploy::line_reader::MAX_LINE_BYTES
+        );
+        assert_eq!(args.max_line_bytes, 64 * 1024);
+        assert_eq!(
+            args.idle_timeout_secs,
+            crate::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS
+        );
+        assert_eq!(args.idle_timeout_secs, 300);
+        assert!(!args.mock && !args.exit_on_stdin_close);
+        let args = parse(&["--mock", "--exit-on-stdin-close"]);
+        assert!(args.mock && args.exit_on_stdin_close);
+    }
+
+    #[test]
+    fn robot_listen_takes_a_socket_address() {
+        let args = parse(&["--listen", "127.0.0.1:0"]);
+        assert_eq!(args.listen, Some("127.0.0.1:0".parse().unwrap()));
+        refused(&["--listen", "localhost"], "'localhost'");
+    }
+
+    #[test]
+    fn robot_limits_are_bounded() {
+        assert_eq!(parse(&["--max-connections", "4096"]).max_connections, 4096);
+        refused(&["--max-connections", "0"], "must be at least 1");
+        refused(
+            &["--max-connections", "4097"],
+            "must be at most 4096, got 4097",
+        );
+        let most = (64 << 20).to_string();
+        assert_eq!(parse(&["--max-line-bytes", &most]).max_line_bytes, 64 << 20);
+        refused(&["--max-line-bytes", "0"], "must be at least 1");
+        refused(
+            &["--max-line-bytes", "67108865"],
+            "must be at most 67108864, got 67108865",
+        );
+        assert_eq!(parse(&["--idle-timeout-secs", "1"]).idle_timeout_secs, 1);
+        assert_eq!(
+            parse(&["--idle-timeout-secs", "86400"]).idle_timeout_secs,
+            86_400
+        );
+        refused(&["--idle-timeout-secs", "0"], "0 is not in 1..=86400");
+        refused(
+            &["--idle-timeout-secs", "86401"],
+            "86401 is not in 1..=86400",
+        );
+    }
+}

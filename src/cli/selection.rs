@@ -69,3 +69,50 @@ fn overrides(
         set,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn selection(methods: Option<&str>, seeds: Option<&str>, set: &[&str]) -> Selection {
+        Selection {
+            config: None,
+            methods: methods.map(|m| m.split(',').map(String::from).collect()),
+            seeds: seeds.map(String::from),
+            set: set.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    #[test]
+    fn no_config_selects_the_built_in_quick_start() {
+        let e = selection(None, None, &[]).load().unwrap();
+        assert_eq!(e.name, "quickstart_bp10");
+    }
+
+    #[test]
+    fn methods_and_seeds_replace_the_experiment_s() {
+        let e = selection(Some("our1,cen-ddrqn"), Some("3..6"), &[])
+            .load()
+            .unwrap();
+        assert_eq!(
+            e.methods.iter().map(|m| m.name()).collect::<Vec<_>>(),
+            ["our1", "cen-ddrqn"]
+        );
+        assert_eq!(e.seeds, [3, 4, 5]);
+        let e = selection(None, Some("0,3,7"), &[]).load().unwrap();
+        assert_eq!(e.seeds, [0, 3, 7]);
+    }
+
+    #[test]
+    fn unknown_methods_bad_seed_lists_and_unknown_keys_are_refused() {
+        let err = |s: Selection| format!("{:#}", s.load().expect_err("refused"));
+        assert!(err(selection(Some("our3"), None, &[])).contains("our3"));
+        for seeds in ["5..2", "0,0", "x"] {
+            assert!(
+                err(selection(None, Some(seeds), &[])).contains(seeds),
+                "{seeds}"
+            );
+        }
+        assert!(err(selection(None, None, &["no_such_key=1"])).contains("no_such_key"));
+    }
+}

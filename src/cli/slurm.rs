@@ -68,3 +68,42 @@ pub(super) fn run(args: SlurmArgs) -> Result<()> {
     print!("{script}");
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, error_text};
+    use crate::cli::Command;
+
+    fn parse(flags: &[&str]) -> SlurmArgs {
+        match accepted("slurm", flags) {
+            Command::Slurm(args) => args,
+            _ => unreachable!("`slurm` parses as Command::Slurm"),
+        }
+    }
+
+    #[test]
+    fn slurm_asks_12_hours_and_4g_per_task_into_results_by_default() {
+        let args = parse(&["--config", "e.toml"]);
+        assert_eq!(args.select.config, Some(PathBuf::from("e.toml")));
+        assert_eq!(args.out, PathBuf::from("results"));
+        assert_eq!(args.time, "12:00:00");
+        assert_eq!(args.mem, "4G");
+        assert!(args.sbatch.is_empty());
+    }
+
+    #[test]
+    fn slurm_sbatch_lines_may_start_with_hyphens_and_repeat() {
+        let args = parse(&["--sbatch=--partition=cpu", "--sbatch", "--qos=long"]);
+        assert_eq!(args.sbatch, ["--partition=cpu", "--qos=long"]);
+    }
+
+    #[test]
+    fn slurm_needs_a_config_file() {
+        let args = parse(&["--methods", "our1"]);
+        assert_eq!(
+            error_text(run(args)),
+            "Error: slurm needs --config FILE (the experiment the array tasks train)"
+        );
+    }
+}

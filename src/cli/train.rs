@@ -134,3 +134,91 @@ pub(super) fn run(args: TrainArgs) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::tests::{accepted, assert_refused, error_text};
+    use crate::cli::Command;
+    use clap::error::ErrorKind;
+
+    fn parse(flags: &[&str]) -> TrainArgs {
+        match accepted("train", flags) {
+            Command::Train(args) => args,
+            _ => unreachable!("`train` parses as Command::Train"),
+        }
+    }
+
+    #[test]
+    fn train_defaults_to_the_built_in_run_into_results() {
+        let args = parse(&[]);
+        assert_eq!(args.select.config, None);
+        assert_eq!(args.select.methods, None);
+        assert_eq!(args.select.seeds, None);
+        assert!(args.select.set.is_empty());
+        assert_eq!(args.jobs, None);
+        assert_eq!(args.out, PathBuf::from("results"));
+        assert!(!args.force && !args.quiet && !args.no_plot);
+        assert_eq!(args.plots, None);
+        assert_eq!(args.run_index, None);
+    }
+
+    #[test]
+    fn train_selection_flags_split_methods_and_repeat_set() {
+        let args = parse(&[
+            "--config",
+            "experiments/fig4a.toml",
+            "--methods",
+            "our1,dec-hddrqn",
+            "--seeds",
+            "0..3",
+            "--set",
+            "total_epi=300",
+            "--set",
+            "our1.l_rate=0.001",
+        ]);
+        assert_eq!(
+            args.select.config,
+            Some(PathBuf::from("experiments/fig4a.toml"))
+        );
+        assert_eq!(
+            args.select.methods,
+            Some(vec!["our1".to_string(), "dec-hddrqn".to_string()])
+        );
+        assert_eq!(args.select.seeds.as_deref(), Some("0..3"));
+        assert_eq!(args.select.set, ["total_epi=300", "our1.l_rate=0.001"]);
+    }
+
+    #[test]
+    fn train_jobs_is_at_least_one() {
+        assert_eq!(parse(&["--jobs", "4"]).jobs, Some(4));
+        let v = ErrorKind::ValueValidation;
+        assert_refused("train", &["--jobs", "0"], v, "must be at least 1");
+        assert_refused(
+            "train",
+            &["--jobs", "many"],
+            v,
+            "expected a positive integer",
+        );
+    }
+
+    #[test]
+    fn train_run_index_past_the_last_run_is_refused_before_training() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("results");
+        let args = parse(&[
+            "--out",
+            out.to_str().unwrap(),
+            "--no-plot",
+            "--run-index",
+            "2",
+        ]);
+        assert_eq!(args.run_index, Some(2));
+        // The built-in experiment trains two runs.
+        assert_eq!(
+            error_text(run(args)),
+            "Error: --run-index 2: the experiment has 2 runs (0..2)"
+        );
+        assert!(!out.exists(), "nothing is written before the refusal");
+    }
+}
