@@ -24,8 +24,8 @@ pub(super) struct AuditArgs {
 
 /// Retrain the chosen runs in parallel, one line each; fails if any differs or cannot be retrained.
 pub(super) fn run(args: AuditArgs) -> Result<()> {
-    use crate::experiment::audit::{audit_all, choose, finished_runs, AuditOutcome};
-    use crate::experiment::provenance::Provenance;
+    use crate::experiment::cluster::audit::{audit_all, choose, finished_runs, AuditOutcome};
+    use crate::experiment::run::provenance::Provenance;
     let dirs = if args.run.is_empty() {
         let all = finished_runs(&args.results)?;
         if all.is_empty() {

@@ -2,6 +2,8 @@
 //! 1..=max (so a size from a flag is bounded like one from a config) and the per-reply timeout
 //! of the commands that talk to robots.
 
+use crate::experiment::definition::limits;
+
 /// `--timeout-secs` of `deploy` and `domain`: a deadline per robot reply, 1 s to a day. 0
 /// would fail every reply at once (or, as a socket timeout, wait forever).
 pub(super) fn parse_timeout_secs(text: &str) -> Result<u64, String> {
@@ -24,10 +26,10 @@ pub(super) fn at_least_one(text: &str) -> Result<usize, String> {
 }
 
 /// An episode count flag: at least 1 and at most a config's `eval_num_epi` may be
-/// ([`MAX_EVAL_NUM_EPI`](crate::experiment::limits::MAX_EVAL_NUM_EPI)), so a flag cannot ask
-/// for more than a config could.
+/// ([`MAX_EVAL_NUM_EPI`](limits::MAX_EVAL_NUM_EPI)), so a flag cannot ask for more than a
+/// config could.
 pub(super) fn episode_count(text: &str) -> Result<usize, String> {
-    bounded_count(text, crate::experiment::limits::MAX_EVAL_NUM_EPI)
+    bounded_count(text, limits::MAX_EVAL_NUM_EPI)
 }
 
 /// A count flag in 1..=`max`: a size from a flag is bounded like one from a config.
@@ -85,7 +87,7 @@ mod tests {
 
     #[test]
     fn an_episode_count_is_bounded_like_eval_num_epi() {
-        let max = crate::experiment::limits::MAX_EVAL_NUM_EPI;
+        let max = limits::MAX_EVAL_NUM_EPI;
         assert_eq!(max, 100_000);
         assert_eq!(episode_count("100000"), Ok(max));
         assert_eq!(

@@ -21,7 +21,7 @@ pub(super) struct DeployArgs {
 
 /// Start one robot process per agent, play the episodes against them and print each one's line.
 pub(super) fn run(args: DeployArgs) -> Result<()> {
-    use crate::deploy::processes::deploy_streaming;
+    use crate::deploy::drive::processes::deploy_streaming;
     let mut run = args.episodes.load()?;
     let exe = std::env::current_exe().context("locating the macdec executable")?;
     let extra: Vec<String> = if args.mock {

@@ -30,7 +30,7 @@ pub(super) struct DomainArgs {
 pub(super) fn run(args: DomainArgs) -> Result<()> {
     let mut run = args.episodes.load()?;
     let mut printer = EpisodePrinter::new(args.episodes.trajectories);
-    crate::deploy::remote::run_with_robots_at(
+    crate::deploy::drive::remote::run_with_robots_at(
         &run.manifest,
         &args.robots,
         args.episodes.episodes,

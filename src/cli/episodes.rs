@@ -29,8 +29,8 @@ pub(super) struct EpisodeArgs {
 
 /// A loaded policy directory and the evaluation stream its episodes draw from.
 pub(super) struct EpisodeRun {
-    pub(super) manifest: crate::deploy::Manifest,
-    pub(super) verified: Vec<crate::deploy::VerifiedAgent>,
+    pub(super) manifest: crate::policy_files::Manifest,
+    pub(super) verified: Vec<crate::policy_files::VerifiedAgent>,
     /// `--seed`, or the run's seed.
     pub(super) seed: u64,
     pub(super) rng: crate::envs::EnvRng,
@@ -40,8 +40,8 @@ impl EpisodeArgs {
     /// The policy (manifest and verified weights) and the evaluation env's stream of the seed.
     /// Every episode command simulates the domain, so a custom domain's policy is refused here.
     pub(super) fn load(&self) -> Result<EpisodeRun> {
-        use crate::experiment::seeds::{stream, Role};
-        let (manifest, verified) = crate::deploy::manifest::load_all(&self.policy)
+        use crate::experiment::definition::seeds::{stream, Role};
+        let (manifest, verified) = crate::policy_files::load_all(&self.policy)
             .with_context(|| format!("loading policy {}", self.policy.display()))?;
         manifest
             .env
@@ -78,8 +78,8 @@ impl EpisodePrinter {
 
     pub(super) fn print(
         &mut self,
-        trace: crate::deploy::EpisodeTrace,
-    ) -> Result<(), crate::deploy::driver::DeployError> {
+        trace: crate::deploy::drive::driver::EpisodeTrace,
+    ) -> Result<(), crate::deploy::drive::driver::DeployError> {
         let mut out = std::io::stdout().lock();
         writeln!(out, "{}", trace.json_line(self.trajectories))?;
         out.flush()?;

@@ -21,11 +21,11 @@ pub(super) fn run(args: EvalArgs) -> Result<()> {
     let mut run = args.load()?;
     let mut printer = EpisodePrinter::new(args.trajectories);
     let choice = if sample {
-        crate::deploy::local_eval::Choice::Sampled
+        crate::deploy::drive::local_eval::Choice::Sampled
     } else {
-        crate::deploy::local_eval::Choice::Greedy
+        crate::deploy::drive::local_eval::Choice::Greedy
     };
-    crate::deploy::local_eval::eval_policy(
+    crate::deploy::drive::local_eval::eval_policy(
         &run.manifest,
         &run.verified,
         args.episodes,

@@ -1,6 +1,6 @@
 //! `macdec export`: a trained run's decentralized nets as a policy directory for robots.
 
-use crate::experiment::results_tree;
+use crate::experiment::run::results_tree;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
 
@@ -18,7 +18,7 @@ pub(super) struct ExportArgs {
 pub(super) fn run(args: ExportArgs) -> Result<()> {
     let ExportArgs { run, out } = args;
     let (run, out) = (run.as_path(), out.as_path());
-    let manifest = crate::deploy::export::export_run(run, out)
+    let manifest = crate::deploy::policy::export::export_run(run, out)
         .with_context(|| format!("exporting {} to {}", run.display(), out.display()))?;
     if !results_tree::is_finished(run) {
         eprintln!(

@@ -1,5 +1,6 @@
 //! `macdec import`: a policy directory from the references' PyTorch state_dicts.
 
+use crate::experiment::definition::limits;
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 use std::path::PathBuf;
@@ -29,11 +30,11 @@ pub(super) struct ImportArgs {
     #[arg(long)]
     params: Option<PathBuf>,
     /// ICRA Box Pushing grid size N (N x N); the paper uses 10 and 30.
-    #[arg(long, value_parser = |t: &str| bounded_count(t, crate::experiment::limits::MAX_GRID_DIM))]
+    #[arg(long, value_parser = |t: &str| bounded_count(t, limits::MAX_GRID_DIM))]
     grid: Option<usize>,
     /// Episode length in primitive steps (ICRA paper: Box Pushing 100 on 10x10, 200 on 30x30,
     /// Warehouse 150; required for icra). MacroMARL: the published horizon by default.
-    #[arg(long, value_parser = |t: &str| bounded_count(t, crate::experiment::limits::MAX_HORIZON))]
+    #[arg(long, value_parser = |t: &str| bounded_count(t, limits::MAX_HORIZON))]
     horizon: Option<usize>,
     /// ICRA Warehouse: std of the Turtlebots' movement noise (paper 0).
     #[arg(long, default_value_t = 0.0)]
@@ -52,8 +53,8 @@ pub(super) struct ImportArgs {
 
 /// Build the policy directory from the reference's state_dicts and say what was imported.
 pub(super) fn run(args: ImportArgs) -> Result<()> {
-    use crate::deploy::import::{import_policy, ImportRequest};
-    use crate::deploy::import_actors::import_actors;
+    use crate::deploy::policy::import::{import_policy, ImportRequest};
+    use crate::deploy::policy::import_actors::import_actors;
     let env = import_env(&args)?;
     let request = ImportRequest {
         discount: args

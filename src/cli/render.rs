@@ -1,7 +1,7 @@
 //! `macdec render`: animate a trained run's policy as a GIF.
 
-use crate::experiment::policy_files::NetRole;
-use crate::experiment::results_tree;
+use crate::experiment::run::results_tree;
+use crate::policy_files::NetRole;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 

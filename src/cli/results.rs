@@ -18,7 +18,7 @@ pub(super) struct ResultsArgs {
 pub(super) fn run(args: ResultsArgs) -> Result<()> {
     let ResultsArgs { results, out } = args;
     let (results, out) = (results.as_path(), out.as_deref());
-    use crate::experiment::tidy_table::{write_tidy_file, write_tidy_table};
+    use crate::experiment::run::tidy_table::{write_tidy_file, write_tidy_table};
     let context = || format!("tabulating the runs of {}", results.display());
     match out {
         Some(path) => {
@@ -29,7 +29,7 @@ pub(super) fn run(args: ResultsArgs) -> Result<()> {
             let mut stdout = std::io::BufWriter::new(std::io::stdout().lock());
             match write_tidy_table(results, &mut stdout) {
                 // A reader that stops early (`| head`) is not an error.
-                Err(crate::experiment::tidy_table::TidyError::Write { source, .. })
+                Err(crate::experiment::run::tidy_table::TidyError::Write { source, .. })
                     if source.kind() == std::io::ErrorKind::BrokenPipe => {}
                 other => {
                     other.with_context(context)?;

@@ -23,11 +23,11 @@ pub(super) struct RobotArgs {
     max_connections: usize,
     /// Longest request line in bytes, at most 64 MiB; a longer one gets an error reply and is
     /// discarded.
-    #[arg(long, default_value_t = crate::deploy::line_reader::MAX_LINE_BYTES,
+    #[arg(long, default_value_t = crate::deploy::serve::line_reader::MAX_LINE_BYTES,
           value_parser = |t: &str| bounded_count(t, 64 << 20))]
     max_line_bytes: usize,
     /// With --listen: close a connection silent between requests for this many seconds.
-    #[arg(long, default_value_t = crate::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS,
+    #[arg(long, default_value_t = crate::deploy::serve::server::DEFAULT_IDLE_TIMEOUT_SECS,
           value_parser = clap::value_parser!(u64).range(1..=86_400))]
     idle_timeout_secs: u64,
     /// Run a deterministic stand-in policy instead of the weights (tests).
@@ -40,11 +40,11 @@ pub(super) struct RobotArgs {
 
 /// Fresh policies (zero hidden state) for agent `agent`'s robot, one per connection.
 fn policy_factory(
-    manifest: &crate::deploy::Manifest,
-    verified: &crate::deploy::VerifiedAgent,
+    manifest: &crate::policy_files::Manifest,
+    verified: &crate::policy_files::VerifiedAgent,
     mock: bool,
-) -> Result<crate::deploy::server::PolicyFactory> {
-    use crate::deploy::{mock::MockPolicy, AgentPolicy};
+) -> Result<crate::deploy::serve::server::PolicyFactory> {
+    use crate::deploy::{policy::mock::MockPolicy, AgentPolicy};
     let entry = &manifest.agents[verified.index];
     if mock {
         let (obs, n, salt) = (entry.obs_size, entry.n_actions, entry.index as u64);
@@ -52,13 +52,15 @@ fn policy_factory(
             Box::new(MockPolicy::new(obs, n, salt)) as Box<dyn AgentPolicy>
         }));
     }
-    let net = crate::deploy::net_policy::load_net(manifest, verified)?;
-    Ok(crate::deploy::net_policy::net_factory(net))
+    let net = crate::deploy::policy::net_policy::load_net(manifest, verified)?;
+    Ok(crate::deploy::policy::net_policy::net_factory(net))
 }
 
 /// Serve the agent's policy on stdin/stdout, or on TCP with `--listen`.
 pub(super) fn run(args: RobotArgs) -> Result<()> {
-    use crate::deploy::{manifest::load_agent, processes, RobotSpec};
+    use crate::deploy::drive::processes;
+    use crate::deploy::serve::robot::RobotSpec;
+    use crate::policy_files::load_agent;
     let (manifest, verified) = load_agent(&args.policy, args.agent)
         .with_context(|| format!("loading agent {} of {}", args.agent, args.policy.display()))?;
     let spec = std::sync::Arc::new(RobotSpec::new(&manifest, args.agent)?);
@@ -68,7 +70,7 @@ pub(super) fn run(args: RobotArgs) -> Result<()> {
     }
     match args.listen {
         None => {
-            crate::deploy::serve_stdio(factory(), spec, args.max_line_bytes)?;
+            crate::deploy::serve::robot::serve_stdio(factory(), spec, args.max_line_bytes)?;
         }
         Some(addr) => {
             let listener = std::net::TcpListener::bind(addr)
@@ -84,13 +86,13 @@ pub(super) fn run(args: RobotArgs) -> Result<()> {
                 args.agent,
                 args.policy.display()
             );
-            let limits = crate::deploy::Limits {
+            let limits = crate::deploy::serve::server::Limits {
                 max_line_bytes: args.max_line_bytes,
                 max_connections: args.max_connections,
                 idle_timeout: Some(std::time::Duration::from_secs(args.idle_timeout_secs)),
                 ..Default::default()
             };
-            crate::deploy::serve_tcp(listener, factory, spec, limits)?;
+            crate::deploy::serve::server::serve_tcp(listener, factory, spec, limits)?;
         }
     }
     Ok(())
@@ -138,12 +140,12 @@ mod tests {
         assert_eq!(args.max_connections, 16);
         assert_eq!(
             args.max_line_bytes,
-            crate::deploy::line_reader::MAX_LINE_BYTES
+            crate::deploy::serve::line_reader::MAX_LINE_BYTES
         );
         assert_eq!(args.max_line_bytes, 64 * 1024);
         assert_eq!(
             args.idle_timeout_secs,
-            crate::deploy::server::DEFAULT_IDLE_TIMEOUT_SECS
+            crate::deploy::serve::server::DEFAULT_IDLE_TIMEOUT_SECS
         );
         assert_eq!(args.idle_timeout_secs, 300);
         assert!(!args.mock && !args.exit_on_stdin_close);

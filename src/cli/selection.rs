@@ -2,8 +2,8 @@
 //! `--seeds` and `--set`, resolved into an [`Experiment`].
 
 use crate::algos::method::Method;
-use crate::experiment::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
-use crate::experiment::seeds::parse_seeds;
+use crate::experiment::definition::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
+use crate::experiment::definition::seeds::parse_seeds;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 

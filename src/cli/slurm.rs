@@ -1,7 +1,7 @@
 //! `macdec slurm`: a Slurm job-array script that trains an experiment's runs, one task each.
 
-use crate::experiment::results_tree;
-use crate::experiment::slurm::{job_script, SlurmOptions};
+use crate::experiment::cluster::slurm::{job_script, SlurmOptions};
+use crate::experiment::run::results_tree;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 

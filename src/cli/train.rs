@@ -1,9 +1,9 @@
 //! `macdec train`: train an experiment's runs in parallel, then report their curves and draw
 //! the figures.
 
-use crate::experiment::runner::{RunStatus, RunnerOptions};
-use crate::experiment::stop::StopSignal;
-use crate::experiment::train_all::train_all;
+use crate::experiment::run::runner::{RunStatus, RunnerOptions};
+use crate::experiment::run::stop::StopSignal;
+use crate::experiment::run::train_all::train_all;
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
 
@@ -52,7 +52,7 @@ pub(super) fn run(args: TrainArgs) -> Result<()> {
         }
         runs = vec![runs.swap_remove(i)];
     }
-    let jobs = crate::experiment::limits::worker_threads(
+    let jobs = crate::experiment::definition::limits::worker_threads(
         args.jobs
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         runs.len(),
@@ -109,7 +109,7 @@ pub(super) fn run(args: TrainArgs) -> Result<()> {
         .filter(|(_, s)| !matches!(s, RunStatus::Failed(_) | RunStatus::Busy))
         .map(|(r, _)| r.clone())
         .collect();
-    crate::experiment::report::print_curves(&args.out, &shown)?;
+    crate::experiment::run::report::print_curves(&args.out, &shown)?;
     if !args.no_plot {
         let plots = args.plots.as_deref().unwrap_or(&args.out);
         match crate::plot::plot_results(&args.out, plots) {

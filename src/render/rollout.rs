@@ -5,7 +5,7 @@ use crate::algos::value::acting::ActScratch;
 use crate::algos::value::evaluate::GreedyActor;
 use crate::algos::value::evaluate::GreedyPolicy;
 use crate::envs::MacroEnv;
-use crate::experiment::seeds::{stream, Role};
+use crate::experiment::definition::seeds::{stream, Role};
 use crate::nn::QNet;
 use crate::policy_files::{read_policy_files, NetRole, PolicyError};
 use crate::render::{play_episode, write_gif_with, RenderError};

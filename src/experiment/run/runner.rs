@@ -6,10 +6,10 @@
 //! describes the run asked for (provenance aside); a different run in its directory fails that
 //! run, naming the keys that differ.
 
-use crate::experiment::config::RunSpec;
-use crate::experiment::results_tree;
-use crate::experiment::train_run::{existing_run, Existing};
-use crate::experiment::work_queue::run_in_order;
+use crate::experiment::definition::config::RunSpec;
+use crate::experiment::run::results_tree;
+use crate::experiment::run::train_run::{existing_run, Existing};
+use crate::experiment::run::work_queue::run_in_order;
 use crate::files::links::check_real_dirs;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -51,8 +51,8 @@ pub enum RunEnd {
     /// Another process holds the run's lock and is training it: left to that process, so
     /// several processes (or machines sharing the results tree) can work through one campaign.
     Busy,
-    /// Stopped early on request ([`crate::experiment::stop::StopSignal`]), its checkpoint saved:
-    /// training it again resumes it.
+    /// Stopped early on request ([`crate::experiment::run::stop::StopSignal`]), its checkpoint
+    /// saved: training it again resumes it.
     Stopped,
 }
 
@@ -271,7 +271,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::config::{Experiment, Overrides};
+    use crate::experiment::definition::config::{Experiment, Overrides};
 
     fn runs(n: usize) -> Vec<RunSpec> {
         let o = Overrides {
@@ -355,8 +355,8 @@ mod tests {
 
     /// What a finished run leaves: its config.toml and the marker.
     fn finish(spec: &RunSpec, dir: &Path) {
-        use crate::experiment::results_tree::{CONFIG, FINISHED};
-        use crate::experiment::train_run::RunManifest;
+        use crate::experiment::run::results_tree::{CONFIG, FINISHED};
+        use crate::experiment::run::train_run::RunManifest;
         std::fs::create_dir_all(dir).unwrap();
         let text = toml::to_string(&RunManifest::for_spec(spec)).unwrap();
         std::fs::write(dir.join(CONFIG), text).unwrap();
@@ -365,7 +365,7 @@ mod tests {
 
     #[test]
     fn a_finished_run_of_another_config_is_refused_naming_the_keys_but_provenance_is_ignored() {
-        use crate::experiment::results_tree::CONFIG;
+        use crate::experiment::run::results_tree::CONFIG;
         let dir = tempfile::tempdir().unwrap();
         let opts = RunnerOptions {
             out: dir.path().to_path_buf(),
