@@ -10,9 +10,9 @@
 
 use crate::experiment::definition::config::RunSpec;
 use crate::experiment::run::metrics::{self, MetricsError, EVAL_RETURN_UNDISCOUNTED};
+use crate::experiment::run::progress::Progress;
 use crate::experiment::run::provenance::Provenance;
 use crate::experiment::run::results_tree::{self, CONFIG};
-use crate::experiment::run::runner::Progress;
 use crate::experiment::run::train_run::{train_run, RunError, RunManifest};
 use crate::files::bounded_read::{read_text_in_tree, MAX_TEXT_BYTES};
 use rand::seq::SliceRandom;

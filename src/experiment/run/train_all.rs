@@ -4,7 +4,8 @@
 //! [`StopSignal`] starts no new run and stops the running ones at their next episode boundary,
 //! resumable.
 
-use super::runner::{run_all, RunEnd, RunStatus, RunnerOptions};
+use super::progress::RunEnd;
+use super::runner::{run_all, RunStatus, RunnerOptions};
 use super::stop::StopSignal;
 use super::train_run::train_run_until;
 use crate::experiment::definition::config::RunSpec;

@@ -17,9 +17,9 @@ use crate::experiment::definition::run_settings::RunSettings;
 use crate::experiment::definition::seeds::{stream, Role};
 use crate::experiment::run::checkpoint::{self, CheckpointIdentity};
 use crate::experiment::run::metrics::{self, METRICS_FILE};
+use crate::experiment::run::progress::{Progress, RunEnd};
 use crate::experiment::run::provenance::Provenance;
 use crate::experiment::run::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
-use crate::experiment::run::runner::{Progress, RunEnd};
 use crate::experiment::run::stop::StopSignal;
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::{
