@@ -11,11 +11,11 @@ use crate::algos::any_loop::AnyLoop;
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::algos::training_loop::{Advance, EvalPoint, TrainError};
-use crate::deploy::export::{export_nets, ExportError};
+use crate::deploy::policy::export::{export_nets, ExportError};
 use crate::envs::{EnvError, MacroEnv};
-use crate::experiment::config::validate;
-use crate::experiment::run_settings::RunSettings;
-use crate::experiment::train_run::run_rngs;
+use crate::experiment::definition::config::validate;
+use crate::experiment::definition::run_settings::RunSettings;
+use crate::experiment::run::train_run::run_rngs;
 use crate::nn::ActingNet;
 use crate::policy_files::policy_env::PolicyEnv;
 use crate::policy_files::{Manifest, RunInfo};
@@ -41,8 +41,8 @@ pub enum LibraryTrainError {
 }
 
 /// Train `method` with seed `seed` on the domain `make_env` builds and return every evaluation
-/// point (the rows `metrics.csv` would hold; write them with [`crate::experiment::metrics::write`]
-/// to plot them with `macdec plot`).
+/// point (the rows `metrics.csv` would hold; write them with
+/// [`crate::experiment::run::metrics::write`] to plot them with `macdec plot`).
 ///
 /// `make_env` is called once to check the config against the domain's horizon, then once per
 /// environment the method needs (evaluation, training, Our-2's second training env); each call
@@ -164,7 +164,7 @@ impl TrainedPolicy {
 mod tests {
     use super::*;
     use crate::envs::{AnyEnv, EnvSpec};
-    use crate::experiment::paper::value_paper_defaults;
+    use crate::experiment::definition::paper::value_paper_defaults;
 
     /// The library trains on BP 10x10 here.
     fn spec() -> EnvSpec {
@@ -202,7 +202,7 @@ mod tests {
 
     #[test]
     fn an_exported_library_policy_holds_the_trained_nets_for_either_kind_of_domain() {
-        use crate::deploy::net_policy::load_net;
+        use crate::deploy::policy::net_policy::load_net;
         use crate::policy_files::load_agent;
         let c = short(Method::Our1);
         let spec = spec();
@@ -256,8 +256,8 @@ mod tests {
 
     #[test]
     fn an_actor_critic_policy_keeps_its_actors_and_exports_the_decentralized_ones() {
-        use crate::deploy::net_policy::load_net;
-        use crate::experiment::paper::actor_critic_defaults;
+        use crate::deploy::policy::net_policy::load_net;
+        use crate::experiment::definition::paper::actor_critic_defaults;
         use crate::policy_files::load_agent;
         let spec = crate::envs::bp_ma_v0::spec(4, 20);
         let short = |method| -> RunConfig {

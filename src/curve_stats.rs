@@ -1,7 +1,8 @@
 //! The statistics behind a learning curve (`docs/ALGORITHMS.md` §7.2): the mean over runs at each
 //! evaluation point, its standard error, and the centred moving average the paper calls
 //! "smoothed by 20 neighbors". Pure functions on numbers; no files, no drawing. Shared by the
-//! figures (`plot`) and the terminal report after training (`experiment::report`), and below both.
+//! figures (`plot`) and the terminal report after training (`experiment::run::report`), and
+//! below both.
 
 use std::collections::BTreeMap;
 

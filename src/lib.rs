@@ -18,20 +18,21 @@
 //!                                                   metrics.csv)
 //!                                                        │
 //!            results/<experiment>/<curve>/seed-<k>/ ◄────┘
-//!              ├─► plot (figures, summaries)   ├─► experiment::tidy_table (one long CSV)
-//!              ├─► render (GIF rollouts)       ├─► experiment::audit (retrain and compare)
+//!              ├─► plot (figures, summaries)   ├─► experiment::run::tidy_table (one long CSV)
+//!              ├─► render (GIF rollouts)       ├─► experiment::cluster::audit (retrain, compare)
 //!              └─► deploy (export, eval, robot server, robot drivers) via policy_files
 //! ```
 //!
 //! Each stage, in that order:
 //!
 //! 1. [`experiment::definition`]: an experiment file becomes a validated
-//!    [`experiment::config::Experiment`] (methods, seeds, sweeps) and per-run
-//!    [`RunConfig`]s ([`experiment::paper`] holds the papers' settings, [`experiment::limits`]
-//!    every bound).
-//! 2. [`experiment::run`]: [`experiment::runner`] trains the runs in parallel, each through
-//!    [`experiment::train_run`] (resume from [`experiment::checkpoint`], write
-//!    [`experiment::metrics`] and [`policy_files`], named by [`experiment::results_tree`]).
+//!    [`experiment::definition::config::Experiment`] (methods, seeds, sweeps) and per-run
+//!    [`RunConfig`]s ([`experiment::definition::paper`] holds the papers' settings,
+//!    [`experiment::definition::limits`] every bound).
+//! 2. [`experiment::run`]: [`experiment::run::runner`] trains the runs in parallel, each through
+//!    [`experiment::run::train_run`] (resume from [`experiment::run::checkpoint`], write
+//!    [`experiment::run::metrics`] and [`policy_files`], named by
+//!    [`experiment::run::results_tree`]).
 //! 3. [`algos`]: one [`algos::training_loop::TrainingLoop`] drives a learner per method family:
 //!    [`algos::value`] (the ICRA methods) and [`algos::actor_critic`] (MacroMARL's); a method's
 //!    choices are [`Method`].
@@ -39,10 +40,10 @@
 //!    finds a domain by name, and [`envs::replay`] of action logs.
 //! 5. [`nn`] on [`autograd`]: layers, the recurrent Q-net and actors, Adam, safetensors I/O.
 //! 6. After training: [`plot`] (learning curves and tables, statistics in [`curve_stats`]),
-//!    [`experiment::tidy_table`], [`render`] (pictures drawn with [`draw`]), [`deploy`]
+//!    [`experiment::run::tidy_table`], [`render`] (pictures drawn with [`draw`]), [`deploy`]
 //!    (export and import of [`policy_files`], the robot protocol and server, drivers),
-//!    [`experiment::audit`], and [`mod@bench`] for timings. [`files`] is the ground floor every layer
-//!    writes through (atomic writes, bounded reads).
+//!    [`experiment::cluster::audit`], and [`mod@bench`] for timings. [`files`] is the ground
+//!    floor every layer writes through (atomic writes, bounded reads).
 //!
 //! Lower layers never name higher ones: `autograd` knows no layers, `envs` no nets and no
 //! learner (a family's published settings for a domain live in the family's folder), `algos` no
@@ -80,6 +81,8 @@ pub use algos::hyper::RunConfig;
 pub use algos::method::Method;
 pub use algos::training_loop::EvalPoint;
 pub use api::{train, train_policy, LibraryTrainError, TrainedPolicy};
-pub use deploy::PolicyEnv;
 pub use envs::{EnvError, EnvRng, EnvSpec, FirstRecordObs, MacroEnv, StepOutcome};
-pub use experiment::paper::{actor_critic_defaults, paper_defaults, value_paper_defaults};
+pub use experiment::definition::paper::{
+    actor_critic_defaults, paper_defaults, value_paper_defaults,
+};
+pub use policy_files::PolicyEnv;

@@ -146,7 +146,7 @@ fn a_killed_actor_critic_run_resumes_to_the_same_numbers() {
 fn sampling_a_q_net_policy_is_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let spec = macdec::envs::box_pushing::spec(10, 100);
-    macdec::deploy::mock::write_mock_policy(dir.path(), spec).unwrap();
+    macdec::deploy::policy::mock::write_mock_policy(dir.path(), spec).unwrap();
     let out = run(&["eval", "--policy", dir.path().to_str().unwrap(), "--sample"]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);

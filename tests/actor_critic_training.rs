@@ -8,8 +8,8 @@ use macdec::algos::method::{Family, Method};
 use macdec::algos::training_loop::{Advance, EvalPoint};
 use macdec::envs::EnvSpec;
 use macdec::envs::MacroEnv;
-use macdec::experiment::paper::actor_critic_defaults;
-use macdec::experiment::train_run::run_rngs;
+use macdec::experiment::definition::paper::actor_critic_defaults;
+use macdec::experiment::run::train_run::run_rngs;
 use macdec::RunConfig;
 
 fn ac_methods() -> impl Iterator<Item = Method> {

@@ -6,10 +6,11 @@ mod common;
 
 use common::{robot_process, run};
 use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
-use macdec::deploy::link::JsonLink;
-use macdec::deploy::manifest::Manifest;
-use macdec::deploy::protocol::Reply;
-use macdec::deploy::{greedy_action, PolicyEnv};
+use macdec::deploy::drive::link::JsonLink;
+use macdec::deploy::greedy_action;
+use macdec::deploy::serve::protocol::Reply;
+use macdec::policy_files::Manifest;
+use macdec::policy_files::PolicyEnv;
 use macdec::{value_paper_defaults, EnvError, EnvRng, MacroEnv, Method, StepOutcome};
 use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;

@@ -7,10 +7,10 @@
 mod common;
 
 use common::run;
-use macdec::deploy::link::{JsonLink, LinkError};
-use macdec::deploy::mock::{mock_manifest, write_mock_policy};
-use macdec::deploy::protocol::Reply;
-use macdec::deploy::Manifest;
+use macdec::deploy::drive::link::{JsonLink, LinkError};
+use macdec::deploy::policy::mock::{mock_manifest, write_mock_policy};
+use macdec::deploy::serve::protocol::Reply;
+use macdec::policy_files::Manifest;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::time::{Duration, Instant};

@@ -2,13 +2,14 @@
 //! stdin/stdout and TCP robots, refusal of a corrupt export, and a multi-process deployment equal
 //! to in-process greedy execution.
 
-use macdec::deploy::link::LocalLink;
-use macdec::deploy::manifest::MANIFEST_FILE;
-use macdec::deploy::mock::{mock_policies, write_mock_policy, MockPolicy};
-use macdec::deploy::protocol::{Ack, Reply, Request};
-use macdec::deploy::{greedy_action, run_episodes, AgentPolicy, EpisodeTrace};
+use macdec::deploy::drive::driver::{run_episodes, EpisodeTrace};
+use macdec::deploy::drive::link::LocalLink;
+use macdec::deploy::policy::mock::{mock_policies, write_mock_policy, MockPolicy};
+use macdec::deploy::serve::protocol::{Ack, Reply, Request};
+use macdec::deploy::{greedy_action, AgentPolicy};
 use macdec::envs::EnvSpec;
-use macdec::experiment::seeds::{stream, Role};
+use macdec::experiment::definition::seeds::{stream, Role};
+use macdec::policy_files::POLICY_FILE;
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 
@@ -129,7 +130,7 @@ fn robot_refuses_a_corrupt_export_with_the_file_named() {
         "{}",
         String::from_utf8_lossy(&ok.stderr)
     );
-    std::fs::remove_file(dir.path().join(MANIFEST_FILE)).unwrap();
+    std::fs::remove_file(dir.path().join(POLICY_FILE)).unwrap();
     let out = Command::new(BIN)
         .args(["robot", "--mock", "--agent", "0", "--policy"])
         .arg(dir.path())
@@ -162,7 +163,7 @@ fn tcp_robot_announces_its_port_and_serves_connections() {
     BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut first)
         .unwrap();
-    let addr = macdec::deploy::processes::parse_announcement(&first).expect(&first);
+    let addr = macdec::deploy::drive::processes::parse_announcement(&first).expect(&first);
     let stream = std::net::TcpStream::connect(addr).unwrap();
     let mut reader = BufReader::new(stream.try_clone().unwrap());
     (&stream)
@@ -241,8 +242,8 @@ checkpoint_freq = 40
 fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluation() {
     use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
     use macdec::envs::MacroEnv;
-    use macdec::experiment::results_tree::CHECKPOINT;
-    use macdec::experiment::train_run::load_checkpoint;
+    use macdec::experiment::run::results_tree::CHECKPOINT;
+    use macdec::experiment::run::train_run::load_checkpoint;
 
     let dir = tempfile::tempdir().unwrap();
     let results = common::train_config(dir.path(), TINY);
@@ -269,7 +270,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         .output()
         .unwrap();
     ok(&out);
-    let (manifest, _) = macdec::deploy::manifest::load_all(&policy).unwrap();
+    let (manifest, _) = macdec::policy_files::load_all(&policy).unwrap();
     assert_eq!(
         (manifest.run.method.as_str(), manifest.run.seed),
         ("our1", 3)

@@ -4,18 +4,18 @@
 //! at addresses (`macdec deploy --robots`) likewise, refused by name when misordered.
 
 use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
-use macdec::deploy::architecture::Architecture;
-use macdec::deploy::driver::{run_episodes, EpisodeTrace};
-use macdec::deploy::link::{JsonLink, LocalLink};
-use macdec::deploy::local_eval::eval_policy;
-use macdec::deploy::manifest::{load_all, Manifest, VerifiedAgent};
-use macdec::deploy::mock::{mock_manifest, mock_policies, MockPolicy};
-use macdec::deploy::net_policy::{load_net, net_factory};
-use macdec::deploy::remote::run_with_robots_at;
-use macdec::deploy::robot::RobotSpec;
-use macdec::deploy::server::{spawn_server, Limits, RobotServer};
+use macdec::deploy::drive::driver::{run_episodes, EpisodeTrace};
+use macdec::deploy::drive::link::{JsonLink, LocalLink};
+use macdec::deploy::drive::local_eval::eval_policy;
+use macdec::deploy::drive::remote::run_with_robots_at;
+use macdec::deploy::policy::mock::{mock_manifest, mock_policies, MockPolicy};
+use macdec::deploy::policy::net_policy::{load_net, net_factory};
+use macdec::deploy::serve::robot::RobotSpec;
+use macdec::deploy::serve::server::{spawn_server, Limits, RobotServer};
 use macdec::deploy::{greedy_action, AgentPolicy};
 use macdec::envs::{EnvRng, EnvSpec, MacroEnv};
+use macdec::policy_files::architecture::Architecture;
+use macdec::policy_files::{load_all, Manifest, VerifiedAgent};
 
 mod common;
 
@@ -61,7 +61,7 @@ fn reference_episode(env_spec: EnvSpec, seed_rng: &mut EnvRng) -> (f64, Vec<Vec<
 }
 
 /// One robot server thread per agent, each with its own mock policy, and a link to each.
-fn tcp_robots(env_spec: EnvSpec) -> (Vec<RobotServer>, Vec<macdec::deploy::link::TcpLink>) {
+fn tcp_robots(env_spec: EnvSpec) -> (Vec<RobotServer>, Vec<macdec::deploy::drive::link::TcpLink>) {
     let manifest = mock_manifest(env_spec.clone());
     let servers: Vec<RobotServer> = (0..manifest.agents.len())
         .map(|i| mock_robot_server(&manifest, i, i as u64))
@@ -272,7 +272,7 @@ fn eval_equals_in_process_greedy_evaluation_and_streams_every_episode() {
         &manifest,
         &verified,
         3,
-        macdec::deploy::local_eval::Choice::Greedy,
+        macdec::deploy::drive::local_eval::Choice::Greedy,
         &mut EnvRng::seed_from_u64(9),
         |t| {
             seen.push(t);

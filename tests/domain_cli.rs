@@ -10,7 +10,7 @@ use common::{robot_process, run};
 fn domain_against_listening_robots_prints_the_eval_and_deploy_episodes() {
     let dir = tempfile::tempdir().unwrap();
     let spec = macdec::envs::warehouse::spec(150, 0.3);
-    macdec::deploy::mock::write_mock_policy(dir.path(), spec).unwrap();
+    macdec::deploy::policy::mock::write_mock_policy(dir.path(), spec).unwrap();
     let p = dir.path().to_str().unwrap();
     let robots: Vec<_> = (0..3).map(|i| robot_process(dir.path(), i, true)).collect();
     let addrs: Vec<&str> = robots.iter().map(|r| r.addr.as_str()).collect();

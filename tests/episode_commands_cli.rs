@@ -5,7 +5,7 @@
 mod common;
 
 use common::{robot_process, run, traces, write_synthetic_policy};
-use macdec::deploy::EpisodeTrace;
+use macdec::deploy::drive::driver::EpisodeTrace;
 use macdec::envs::EnvSpec;
 use std::process::Output;
 

@@ -5,8 +5,8 @@ use macdec::algos::any_loop::AnyLoop;
 use macdec::algos::method::Method;
 use macdec::algos::training_loop::{Advance, EvalPoint};
 use macdec::envs::EnvSpec;
-use macdec::experiment::paper::{actor_critic_defaults, value_paper_defaults};
-use macdec::experiment::train_run::run_rngs;
+use macdec::experiment::definition::paper::{actor_critic_defaults, value_paper_defaults};
+use macdec::experiment::run::train_run::run_rngs;
 use macdec::RunConfig;
 
 fn train(spec: &EnvSpec, config: &RunConfig, method: Method) -> Vec<EvalPoint> {

@@ -1,7 +1,7 @@
 //! Every shipped experiment config parses, and the paper figures carry the paper's settings.
 
 use macdec::algos::method::Method;
-use macdec::experiment::config::{Experiment, Overrides};
+use macdec::experiment::definition::config::{Experiment, Overrides};
 use std::path::Path;
 
 fn load(name: &str) -> Experiment {
@@ -148,7 +148,7 @@ fn sweeps_expand_into_variants() {
 fn figure_6_shares_figure_5s_our2_runs_with_identical_configs() {
     let fig5 = load("fig5_wtd.toml").runs().unwrap();
     let fig6 = load("fig6_wtd_ablation.toml").runs().unwrap();
-    let our2 = |runs: &[macdec::experiment::config::RunSpec]| -> Vec<_> {
+    let our2 = |runs: &[macdec::experiment::definition::config::RunSpec]| -> Vec<_> {
         runs.iter()
             .filter(|r| r.method == Method::Our2)
             .cloned()

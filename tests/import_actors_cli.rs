@@ -8,10 +8,10 @@
 mod common;
 
 use common::{run, stdout_lines, weight};
-use macdec::deploy::architecture::{synthetic_weights, Architecture};
-use macdec::deploy::manifest::load_all;
-use macdec::deploy::EpisodeTrace;
+use macdec::deploy::drive::driver::EpisodeTrace;
 use macdec::envs::{EnvSpec, MacroEnv};
+use macdec::policy_files::architecture::{synthetic_weights, Architecture};
+use macdec::policy_files::load_all;
 use macdec::policy_files::NetKind;
 use std::path::{Path, PathBuf};
 

@@ -6,11 +6,11 @@
 mod common;
 
 use common::{agents_arg, run, stdout_lines, weight, write_agents};
-use macdec::deploy::architecture::Architecture;
-use macdec::deploy::import::{reference_state_dict, Naming};
-use macdec::deploy::manifest::{load_all, MANIFEST_FILE};
-use macdec::deploy::EpisodeTrace;
+use macdec::deploy::drive::driver::EpisodeTrace;
+use macdec::deploy::policy::import::{reference_state_dict, Naming};
 use macdec::envs::EnvSpec;
+use macdec::policy_files::architecture::Architecture;
+use macdec::policy_files::{load_all, POLICY_FILE};
 
 #[test]
 fn imported_policies_evaluate_exactly_as_deployed_on_robot_processes() {
@@ -198,7 +198,7 @@ fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
         let err = String::from_utf8_lossy(&res.stderr);
         assert!(!res.status.success());
         assert!(err.contains(&needle), "expected `{needle}` in: {err}");
-        assert!(!out.join(MANIFEST_FILE).exists());
+        assert!(!out.join(POLICY_FILE).exists());
     }
     let res = run(&[
         "import",
@@ -214,7 +214,7 @@ fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
     assert!(String::from_utf8_lossy(&res.stderr).contains("needs --grid"));
     let res = run(&["eval", "--policy", dir.path().to_str().unwrap()]);
     assert!(!res.status.success());
-    assert!(String::from_utf8_lossy(&res.stderr).contains(MANIFEST_FILE));
+    assert!(String::from_utf8_lossy(&res.stderr).contains(POLICY_FILE));
 }
 
 /// The discount `macdec import` writes by default ([`EnvSpec::paper_discount`]) is the one the

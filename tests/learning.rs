@@ -4,10 +4,10 @@
 //! 80.71 in at least 4 of 5 seeds. Runs are resumable and kept in `target/learning-check/`.
 
 use macdec::algos::method::Method;
-use macdec::experiment::config::{Experiment, Overrides};
-use macdec::experiment::metrics::{read, METRICS_FILE};
-use macdec::experiment::runner::{run_all, RunStatus, RunnerOptions};
-use macdec::experiment::train_run::train_run;
+use macdec::experiment::definition::config::{Experiment, Overrides};
+use macdec::experiment::run::metrics::{read, METRICS_FILE};
+use macdec::experiment::run::runner::{run_all, RunStatus, RunnerOptions};
+use macdec::experiment::run::train_run::train_run;
 use std::path::Path;
 
 const OPTIMAL_BP10: f64 = 80.71093744250365;

@@ -5,8 +5,8 @@
 //! Q-nets with M = H = 2); `expected_q.json` holds each net's Q-values for three fixed
 //! observations from a zero state, computed by that build.
 
-use macdec::deploy::export::export_run;
-use macdec::deploy::net_policy::load_net;
+use macdec::deploy::policy::export::export_run;
+use macdec::deploy::policy::net_policy::load_net;
 use macdec::nn::QNet;
 use macdec::policy_files::{
     load_all, read_policy_files, read_qnets, Manifest, NetKind, NetRole, PolicyEnv, FORMAT_VERSION,

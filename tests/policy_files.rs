@@ -3,9 +3,9 @@
 //! keep working on run directories whose `policy.json` or `config.toml` lacks keys a later
 //! version adds or carries keys this version does not know.
 
-use macdec::experiment::policy_files::{read_policy_files, NetRole, POLICY_DIR, POLICY_FILE};
-use macdec::experiment::results_tree::CHECKPOINT;
-use macdec::experiment::train_run::load_checkpoint;
+use macdec::experiment::run::results_tree::CHECKPOINT;
+use macdec::experiment::run::train_run::load_checkpoint;
+use macdec::policy_files::{read_policy_files, NetRole, POLICY_DIR, POLICY_FILE};
 use std::path::Path;
 use std::process::Command;
 

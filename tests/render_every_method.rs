@@ -1,7 +1,7 @@
 //! `macdec render` animates a trained run of every method (issue 40 item 3): the six
 //! actor-critic methods' actors (Mac-CAC's centralized actor as one team policy) beside the
-//! value methods' Q-nets (`tests/policy_files.rs`), and refuses a net the run does not have by
-//! naming it.
+//! value methods' Q-nets (`tests/policy_files.rs`), greedy or sampled from the run seed's own
+//! streams, and refuses a net the run does not have by naming it.
 
 mod common;
 
@@ -73,6 +73,11 @@ fn every_actor_critic_run_renders_and_a_missing_net_is_named() {
         );
         // Greedy acting from the run's seed: the same episodes again.
         assert_eq!(reported(&run(&args)), first, "{method}");
+        // Sampled as MacroMARL evaluates: reproducible from the run's seed too.
+        let mut sampled = args.to_vec();
+        sampled.push("--sample");
+        let drawn = reported(&run(&sampled));
+        assert_eq!(reported(&run(&sampled)), drawn, "{method} --sample");
         // The nets the method does not have are refused by name.
         let other = if method == "mac-cac" { "dec" } else { "cen" };
         let refused = run(&[
@@ -96,4 +101,18 @@ fn every_actor_critic_run_renders_and_a_missing_net_is_named() {
             "{method}: {err}"
         );
     }
+}
+
+#[test]
+fn a_q_net_run_refuses_to_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_dir = common::train_tiny_run(dir.path());
+    let gif = dir.path().join("q.gif");
+    let out = run(&["render", "--run", s(&run_dir), "--out", s(&gif), "--sample"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("sampling (--sample) needs an actor policy"),
+        "{err}"
+    );
 }

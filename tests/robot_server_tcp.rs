@@ -3,12 +3,12 @@
 //! clients.
 
 use macdec::deploy::greedy_action;
-use macdec::deploy::line_reader::MAX_LINE_BYTES;
-use macdec::deploy::mock::{mock_manifest, MockPolicy};
-use macdec::deploy::protocol::Reply;
-use macdec::deploy::protocol::{Ack, Request};
-use macdec::deploy::robot::RobotSpec;
-use macdec::deploy::server::{
+use macdec::deploy::policy::mock::{mock_manifest, MockPolicy};
+use macdec::deploy::serve::line_reader::MAX_LINE_BYTES;
+use macdec::deploy::serve::protocol::Reply;
+use macdec::deploy::serve::protocol::{Ack, Request};
+use macdec::deploy::serve::robot::RobotSpec;
+use macdec::deploy::serve::server::{
     spawn_server, Limits, PolicyFactory, RobotServer, DEFAULT_IDLE_TIMEOUT_SECS,
 };
 use macdec::deploy::AgentPolicy;

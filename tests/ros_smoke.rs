@@ -12,8 +12,8 @@
 mod common;
 
 use common::{agents_arg, write_agents, BIN};
-use macdec::deploy::architecture::Architecture;
-use macdec::deploy::import::Naming;
+use macdec::deploy::policy::import::Naming;
+use macdec::policy_files::architecture::Architecture;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

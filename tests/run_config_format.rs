@@ -5,7 +5,7 @@
 //! `[provenance]` table still loads.
 
 use macdec::envs::EnvSpec;
-use macdec::experiment::train_run::RunManifest;
+use macdec::experiment::run::train_run::RunManifest;
 use std::path::{Path, PathBuf};
 
 fn root() -> &'static Path {

@@ -3,7 +3,7 @@
 //! `macdec eval` steps it: the hidden state advances only when that agent's macro-action is
 //! done, and the greedy macro-action is the highest score (ties to the lowest index).
 
-use macdec::deploy::net_policy::{load_net, NetPolicy};
+use macdec::deploy::policy::net_policy::{load_net, NetPolicy};
 use macdec::deploy::{greedy_action, AgentPolicy};
 use macdec::policy_files::{load_all, Manifest, PolicyEnv, POLICY_DIR, POLICY_FILE};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};

@@ -1,8 +1,8 @@
 //! Every run of a results tree as columns for `macdec.load_results`: read by the same reader
-//! as `macdec results` ([`macdec::experiment::tidy_table`]), so the two give the same rows.
+//! as `macdec results` ([`macdec::experiment::run::tidy_table`]), so the two give the same rows.
 
-use macdec::experiment::metrics::{EVAL_RETURN_UNDISCOUNTED, LEADING_COLUMNS, WALL_SECONDS};
-use macdec::experiment::tidy_table::{read_run, tidy_runs, TidyError};
+use macdec::experiment::run::metrics::{EVAL_RETURN_UNDISCOUNTED, LEADING_COLUMNS, WALL_SECONDS};
+use macdec::experiment::run::tidy_table::{read_run, tidy_runs, TidyError};
 use numpy::IntoPyArray;
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
 use pyo3::prelude::*;

@@ -1,14 +1,14 @@
 //! `macdec.train`: the runs of an experiment trained by the CLI's runner
-//! ([`macdec::experiment::train_all::train_all`]) in a thread of its own while the calling thread,
-//! without the GIL, waits and polls for Ctrl-C; an interrupt raises the stop signal, the runs
+//! ([`macdec::experiment::run::train_all::train_all`]) in a thread of its own while the calling
+//! thread, without the GIL, waits and polls for Ctrl-C; an interrupt raises the stop signal, the runs
 //! save their checkpoints and stop, and `KeyboardInterrupt` is raised once they have.
 
 use macdec::algos::method::Method;
-use macdec::experiment::config::{Experiment, Overrides};
-use macdec::experiment::runner::{RunStatus, RunnerOptions};
-use macdec::experiment::seeds::parse_seeds;
-use macdec::experiment::stop::StopSignal;
-use macdec::experiment::train_all::train_all;
+use macdec::experiment::definition::config::{Experiment, Overrides};
+use macdec::experiment::definition::seeds::parse_seeds;
+use macdec::experiment::run::runner::{RunStatus, RunnerOptions};
+use macdec::experiment::run::stop::StopSignal;
+use macdec::experiment::run::train_all::train_all;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
@@ -78,7 +78,7 @@ pub fn train(
     let runs = experiment
         .runs()
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let jobs = macdec::experiment::limits::worker_threads(
+    let jobs = macdec::experiment::definition::limits::worker_threads(
         jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         runs.len(),
     );

@@ -3,9 +3,9 @@
 //! A run's [`RunConfig`] is its family's own set of keys: the ICRA code's flags for the value
 //! methods ([`ValueConfig`], `docs/ALGORITHMS.md` §10) and MacroMARL's for the actor-critic methods
 //! ([`AcConfig`], `docs/MACROMARL.md` §1.4). A learner reads only its own struct;
-//! `experiment::config` builds them from files, sweeps and `--set` overrides. They name no domain:
-//! the loop is handed a way to build the environment, and a run on disk records its domain beside
-//! these keys (`experiment::run_settings`).
+//! `experiment::definition::config` builds them from files, sweeps and `--set` overrides. They
+//! name no domain: the loop is handed a way to build the environment, and a run on disk records its domain beside
+//! these keys (`experiment::definition::run_settings`).
 
 use serde::{Deserialize, Serialize};
 

@@ -402,8 +402,8 @@ mod tests {
     use super::*;
     use crate::algos::learner::{EvalReturns, LanePlan};
     use crate::envs::StepOutcome;
-    use crate::experiment::paper::value_paper_defaults;
-    use crate::experiment::train_run::run_rngs;
+    use crate::experiment::definition::paper::value_paper_defaults;
+    use crate::experiment::run::train_run::run_rngs;
 
     /// A learner that acts with macro-action 0 and logs when the loop calls it, so the loop's
     /// schedule can be checked apart from any method. Its second lane does not count episodes.

@@ -8,8 +8,8 @@ use crate::algos::any_loop::AnyLoop;
 use crate::algos::method::{Family, Method};
 use crate::algos::training_loop::{Advance, TrainError};
 use crate::envs::EnvSpec;
-use crate::experiment::paper::paper_defaults;
-use crate::experiment::train_run::run_rngs;
+use crate::experiment::definition::paper::paper_defaults;
+use crate::experiment::run::train_run::run_rngs;
 use std::time::Instant;
 
 /// What one benchmarked run did and how fast.

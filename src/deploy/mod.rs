@@ -1,40 +1,33 @@
-//! Running trained decentralized policies on robots (issue 7): the exported policy directory
-//! ([`manifest`], [`architecture`]), the JSON-lines robot protocol ([`protocol`]), the robot stub
-//! that serves one agent's policy over stdin/stdout or TCP ([`robot`], [`server`]), and
-//! decentralized deployment: one process runs the domain and talks to one robot per agent, each
-//! seeing only its own macro-observations ([`driver`], [`link`], [`processes`]).
+//! Running trained decentralized policies on robots (issue 7), in three folders by job:
+//! [`policy`] (the policy directory, of the one format in [`crate::policy_files`]: writing it
+//! from a run ([`policy::export`]) or from the reference code's PyTorch state_dicts
+//! ([`policy::import`], [`policy::import_actors`]), the net acting from it), [`serve`] (the robot
+//! side: the JSON-lines protocol ([`serve::protocol`]) and the robot stub that serves one agent's
+//! policy over stdin/stdout or TCP ([`serve::robot`], [`serve::server`])) and [`drive`] (the
+//! domain side: one process runs the domain and talks to one robot per agent, each seeing only
+//! its own macro-observations ([`drive::driver`], [`drive::link`], [`drive::processes`])).
 //!
 //! The robot side knows no learner: a policy is anything implementing [`AgentPolicy`] (the real
-//! net, [`net_policy::NetPolicy`] over a Q-net or an actor, or [`mock::MockPolicy`] in tests and behind the
-//! CLI's hidden `--mock` flag). [`remote`] drives robots that already run elsewhere (`macdec
-//! domain`, the ROS bridge of issue 14). Only [`export`] reads a run directory, and only its
-//! policy files ([`crate::policy_files`]), never its checkpoint; deploy imports nothing
-//! of the learner (`src/algos`). [`import`] builds the same policy directory from the reference code's PyTorch state_dicts, and [`local_eval`] runs
-//! any policy directory's greedy episodes in-process, exactly as deployment does. A policy may be
-//! of a domain defined outside this binary ([`policy_env`]): robots serve it, the commands that
-//! simulate a domain refuse it by name.
+//! net, [`policy::net_policy::NetPolicy`] over a Q-net or an actor, or
+//! [`policy::mock::MockPolicy`] in tests and behind the CLI's hidden `--mock` flag).
+//! [`drive::remote`] drives robots that already run elsewhere (`macdec domain`, the ROS bridge of
+//! issue 14). Only [`policy::export`] reads a run directory, and only its policy files
+//! ([`crate::policy_files`]), never its checkpoint; deploy imports nothing of the learner
+//! (`src/algos`). [`drive::local_eval`] runs any policy directory's greedy episodes in-process,
+//! exactly as deployment does. A policy may be of a domain defined outside this binary
+//! ([`crate::policy_files::PolicyEnv`]): robots serve it, the commands that simulate a domain
+//! refuse it by name.
 //!
-//! Three folders by job: [`policy`] (the policy directory: format, export, import, the Q-net
-//! acting from it), [`serve`] (the robot side: protocol, stdio and TCP servers) and [`drive`]
-//! (the domain side: episodes against robot links, processes, remote robots, local evaluation).
-//! Their modules are re-exported here, so `macdec::deploy::<module>` paths stay.
+//! Each module has one path, through its folder. Two items keep a short path too, because the
+//! README and the custom-domain error message name them so: a program with its own domain
+//! drives robots with [`JsonLink::connect`] and [`run_episodes`].
 
 pub mod drive;
 pub mod policy;
 pub mod serve;
 
-pub use drive::{driver, link, local_eval, processes, remote};
-pub use policy::{
-    architecture, export, import, import_actors, manifest, mock, net_policy, policy_env,
-};
-pub use serve::{deadline, line_reader, protocol, robot, server};
-
-pub use driver::{run_episode, run_episodes, run_episodes_with, EpisodeTrace, StepRecord};
-pub use link::{JsonLink, LinkError, LocalLink, RobotLink};
-pub use manifest::{Manifest, VerifiedAgent};
-pub use policy_env::{CustomEnv, NotInBinary, PolicyEnv};
-pub use robot::{serve_stdio, serve_stream, RobotSpec, Session};
-pub use server::{serve_tcp, spawn_server, Limits, RobotServer};
+pub use drive::driver::run_episodes;
+pub use drive::link::JsonLink;
 
 /// One agent's decentralized policy with its recurrent state, as a robot runs it: the agent's own
 /// macro-observation in, one Q-value per macro-action out (`docs/ALGORITHMS.md` §4.2, greedy).

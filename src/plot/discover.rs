@@ -1,6 +1,6 @@
 //! Finding the runs of a results tree: `<results>/<experiment>/<curve>/seed-<k>/` with a
-//! `metrics.csv`, a `config.toml` and, once complete, a `finished` marker (`experiment::config`,
-//! `experiment::runner`).
+//! `metrics.csv`, a `config.toml` and, once complete, a `finished` marker
+//! (`experiment::definition::config`, `experiment::run::runner`).
 //!
 //! Results trees collect junk (a run killed before its first evaluation, a stray file, a copy
 //! being synced), so anything that is not a run is skipped with a note. A malformed metrics file
@@ -9,16 +9,16 @@
 use super::error::PlotError;
 use super::setting::EnvSetting;
 use crate::algos::method::Method;
-use crate::experiment::metrics::{self, MetricsError};
-use crate::experiment::provenance::Provenance;
-use crate::experiment::results_tree;
+use crate::experiment::run::metrics::{self, MetricsError};
+use crate::experiment::run::provenance::Provenance;
+use crate::experiment::run::results_tree;
 use crate::files::bounded_read::{read_text_in_tree, MAX_TEXT_BYTES};
 use std::path::{Path, PathBuf};
 
-pub use crate::experiment::config::SHARED_CURVES_FILE;
-pub use crate::experiment::metrics::METRICS_FILE;
+pub use crate::experiment::definition::config::SHARED_CURVES_FILE;
+pub use crate::experiment::run::metrics::METRICS_FILE;
 /// The file each run writes its resolved config to.
-pub use crate::experiment::results_tree::CONFIG as CONFIG_FILE;
+pub use crate::experiment::run::results_tree::CONFIG as CONFIG_FILE;
 
 /// One run's learning curve and what a figure needs to know about it.
 #[derive(Debug, Clone, PartialEq)]
@@ -330,8 +330,8 @@ fn subdirs_or_note(dir: &Path, notes: &mut Vec<String>) -> Vec<PathBuf> {
 pub(crate) mod tests {
     use super::*;
     use crate::envs::EnvSpec;
-    use crate::experiment::metrics::MetricsRow;
-    use crate::experiment::run_settings::RunSettings;
+    use crate::experiment::definition::run_settings::RunSettings;
+    use crate::experiment::run::metrics::MetricsRow;
 
     /// Write a synthetic run: returns at the given episodes, a config, and optionally the marker.
     pub(crate) fn write_run(

@@ -26,7 +26,7 @@ impl EnvSetting {
     pub fn from_config_toml(text: &str) -> Result<Self, String> {
         let mut table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
         // A run directory's config.toml holds the run's identity and its resolved config under
-        // `[config]` (experiment::train_run::RunManifest); a bare config is accepted too.
+        // `[config]` (experiment::run::train_run::RunManifest); a bare config is accepted too.
         if let Some(toml::Value::Table(inner)) = table.remove("config") {
             table = inner;
         }
@@ -84,7 +84,7 @@ impl EnvSetting {
 mod tests {
     use super::*;
     use crate::algos::method::Method;
-    use crate::experiment::run_settings::RunSettings;
+    use crate::experiment::definition::run_settings::RunSettings;
 
     fn setting_of(env: EnvSpec) -> EnvSetting {
         let text = toml::to_string(&RunSettings::paper(env, Method::Our1)).unwrap();
@@ -93,7 +93,7 @@ mod tests {
 
     #[test]
     fn a_run_manifest_is_read_through_its_config_table() {
-        let manifest = crate::experiment::train_run::RunManifest {
+        let manifest = crate::experiment::run::train_run::RunManifest {
             experiment: "e".into(),
             method: Method::Our1,
             variant: String::new(),

@@ -4,14 +4,15 @@
 // Every test binary compiles this module and uses only part of it.
 #![allow(dead_code)]
 
-use macdec::deploy::architecture::{synthetic_weights, Architecture};
-use macdec::deploy::import::{reference_state_dict, Naming};
-use macdec::deploy::manifest::{Manifest, RunInfo};
-use macdec::deploy::mock::MockPolicy;
-use macdec::deploy::robot::RobotSpec;
-use macdec::deploy::server::{spawn_server, Limits, PolicyFactory, RobotServer};
-use macdec::deploy::{AgentPolicy, EpisodeTrace};
+use macdec::deploy::drive::driver::EpisodeTrace;
+use macdec::deploy::policy::import::{reference_state_dict, Naming};
+use macdec::deploy::policy::mock::MockPolicy;
+use macdec::deploy::serve::robot::RobotSpec;
+use macdec::deploy::serve::server::{spawn_server, Limits, PolicyFactory, RobotServer};
+use macdec::deploy::AgentPolicy;
 use macdec::envs::{EnvSpec, MacroEnv};
+use macdec::policy_files::architecture::{synthetic_weights, Architecture};
+use macdec::policy_files::{Manifest, RunInfo};
 use std::io::{BufRead, BufReader};
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
@@ -190,7 +191,7 @@ pub fn robot_process(policy: &Path, agent: usize, mock: bool) -> RobotProcess {
     BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
-    let addr = macdec::deploy::processes::parse_announcement(&line)
+    let addr = macdec::deploy::drive::processes::parse_announcement(&line)
         .unwrap_or_else(|| panic!("robot announcement: {line}"))
         .to_string();
     RobotProcess { child, addr }

@@ -4,7 +4,7 @@
 //! messages, so over any transport it must give the same returns and trajectories as in-process
 //! greedy evaluation of the same policy with the same seeds.
 
-use crate::deploy::link::{LinkError, RobotLink};
+use crate::deploy::drive::link::{LinkError, RobotLink};
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use serde::{Deserialize, Serialize};
 
@@ -188,8 +188,8 @@ impl EpisodeTrace {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::link::{JsonLink, LocalLink};
-    use crate::deploy::mock::{mock_manifest, MockPolicy};
+    use crate::deploy::drive::link::{JsonLink, LocalLink};
+    use crate::deploy::policy::mock::{mock_manifest, MockPolicy};
 
     use rand::SeedableRng;
 
@@ -218,10 +218,10 @@ mod tests {
     /// A link to a scripted robot: the info reply, then `replies`, then a closed stream.
     fn scripted(
         agent: usize,
-        manifest: &crate::deploy::Manifest,
+        manifest: &crate::policy_files::Manifest,
         replies: &str,
     ) -> JsonLink<std::io::Cursor<Vec<u8>>, Vec<u8>> {
-        let info = crate::deploy::protocol::Reply::Info {
+        let info = crate::deploy::serve::protocol::Reply::Info {
             agent,
             manifest: Box::new(manifest.clone()),
         }
@@ -287,7 +287,7 @@ mod tests {
     fn a_robot_for_another_agent_or_policy_fails_the_handshake() {
         let spec = crate::envs::box_pushing::spec(10, 100);
         let manifest = mock_manifest(spec.clone());
-        let info = crate::deploy::protocol::Reply::Info {
+        let info = crate::deploy::serve::protocol::Reply::Info {
             agent: 1,
             manifest: Box::new(manifest.clone()),
         }

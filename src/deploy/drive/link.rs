@@ -3,9 +3,9 @@
 //! stream (a TCP connection to a robot process or thread), and [`LocalLink`] calls a policy
 //! directly (in-process greedy execution, the reference the protocol path must equal).
 
-use crate::deploy::deadline::{DeadlineStream, ReplyClock};
-use crate::deploy::line_reader::{LineEvent, LineReader};
-use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
+use crate::deploy::serve::deadline::{DeadlineStream, ReplyClock};
+use crate::deploy::serve::line_reader::{LineEvent, LineReader};
+use crate::deploy::serve::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
 use crate::policy_files::Manifest;
 use std::io::{BufRead, BufReader, Write};

@@ -5,9 +5,9 @@
 //! Actor policies can also be evaluated as MacroMARL does, sampling each macro-action from the
 //! actor's distribution ([`Choice::Sampled`]; each agent draws from its own stream of the seed).
 
-use crate::deploy::driver::{run_episodes_with, DeployError, EpisodeTrace};
-use crate::deploy::link::LocalLink;
-use crate::deploy::net_policy::{load_net, NetPolicy};
+use crate::deploy::drive::driver::{run_episodes_with, DeployError, EpisodeTrace};
+use crate::deploy::drive::link::LocalLink;
+use crate::deploy::policy::net_policy::{load_net, NetPolicy};
 use crate::envs::EnvRng;
 use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};
 use std::sync::Arc;
@@ -101,7 +101,7 @@ mod tests {
     fn a_callback_error_stops_the_run() {
         let spec = crate::envs::box_pushing::spec(10, 100);
         let dir = tempfile::tempdir().unwrap();
-        crate::deploy::mock::write_mock_policy(dir.path(), spec).unwrap();
+        crate::deploy::policy::mock::write_mock_policy(dir.path(), spec).unwrap();
         let (manifest, verified) = load_all(dir.path()).unwrap();
         let mut calls = 0;
         let err = eval_policy(

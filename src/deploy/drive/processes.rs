@@ -6,8 +6,8 @@
 //! Started with `--exit-on-stdin-close`, it exits when its stdin closes, so robots never outlive
 //! a deployment that was killed.
 
-use crate::deploy::driver::{run_episode, DeployError, EpisodeTrace};
-use crate::deploy::link::JsonLink;
+use crate::deploy::drive::driver::{run_episode, DeployError, EpisodeTrace};
+use crate::deploy::drive::link::JsonLink;
 use crate::envs::EnvRng;
 use crate::policy_files::Manifest;
 use serde::{Deserialize, Serialize};

@@ -1,12 +1,13 @@
 //! `macdec domain` (issue 14): the domain runs here and its robots are already running elsewhere,
-//! each reachable at its own address and speaking the robot protocol ([`crate::deploy::protocol`]):
-//! `macdec robot --listen` on a real robot, or a bridge that forwards every message to a robot's
-//! ROS node (`ros/macdec_domain_node.py`). The same handshake ([`JsonLink::connect`] checks each
-//! robot's agent and manifest) and the same driver loop as `macdec deploy`, so for the same policy
-//! and seed it prints exactly `deploy`'s and `eval`'s episode lines.
+//! each reachable at its own address and speaking the robot protocol
+//! ([`crate::deploy::serve::protocol`]): `macdec robot --listen` on a real robot, or a bridge that
+//! forwards every message to a robot's ROS node (`ros/macdec_domain_node.py`). The same handshake
+//! ([`JsonLink::connect`] checks each robot's agent and manifest) and the same driver loop as
+//! `macdec deploy`, so for the same policy and seed it prints exactly `deploy`'s and `eval`'s
+//! episode lines.
 
-use crate::deploy::driver::{run_episodes_with, DeployError, EpisodeTrace};
-use crate::deploy::link::JsonLink;
+use crate::deploy::drive::driver::{run_episodes_with, DeployError, EpisodeTrace};
+use crate::deploy::drive::link::JsonLink;
 use crate::envs::EnvRng;
 use crate::policy_files::Manifest;
 use std::net::SocketAddr;

@@ -1,14 +1,10 @@
 //! Policies for robots: writing a policy directory (the one format of [`crate::policy_files`])
 //! from a run ([`export`]) or from the references' PyTorch files ([`import`] for the ICRA
 //! Q-nets, [`import_actors`] for MacroMARL's actors), the net that acts
-//! from it ([`net_policy`]) and a mock policy for tests ([`mock`]). [`manifest`],
-//! [`architecture`] and [`policy_env`] re-export the format's parts under their older paths.
+//! from it ([`net_policy`]) and a mock policy for tests ([`mock`]).
 
 pub mod export;
 pub mod import;
 pub mod import_actors;
-pub mod manifest;
 pub mod mock;
 pub mod net_policy;
-
-pub use crate::policy_files::{architecture, policy_env};

@@ -3,7 +3,7 @@
 //! evaluation uses. The scores it answers with are the net's (Q-values or log-probabilities);
 //! either way the highest is the greedy macro-action.
 
-use crate::deploy::server::PolicyFactory;
+use crate::deploy::serve::server::PolicyFactory;
 use crate::deploy::AgentPolicy;
 use crate::nn::{ActingNet, ActingState};
 use crate::policy_files::{Manifest, PolicyError, VerifiedAgent};

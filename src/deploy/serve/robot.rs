@@ -2,8 +2,8 @@
 //! between them (issue 7). [`Session`] is one client's conversation; [`serve_stream`] runs it over
 //! any byte stream (stdin/stdout, one TCP connection) with the bounded line reader.
 
-use crate::deploy::line_reader::{LineEvent, LineReader};
-use crate::deploy::protocol::{Ack, ProtocolError, Reply, Request};
+use crate::deploy::serve::line_reader::{LineEvent, LineReader};
+use crate::deploy::serve::protocol::{Ack, ProtocolError, Reply, Request};
 use crate::deploy::{greedy_action, AgentPolicy};
 use crate::policy_files::Manifest;
 use std::io::{self, BufRead, Write};
@@ -230,8 +230,8 @@ pub fn serve_stdio(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::line_reader::MAX_LINE_BYTES;
-    use crate::deploy::mock::{mock_manifest, MockPolicy};
+    use crate::deploy::policy::mock::{mock_manifest, MockPolicy};
+    use crate::deploy::serve::line_reader::MAX_LINE_BYTES;
 
     fn bp_spec(agent: usize) -> (Manifest, Arc<RobotSpec>) {
         let manifest = mock_manifest(crate::envs::box_pushing::spec(10, 100));

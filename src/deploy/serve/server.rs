@@ -2,10 +2,10 @@
 //! hidden state) per connection, a bounded number of connections, bounded lines. A client that
 //! misbehaves or vanishes affects only its own connection.
 
-use crate::deploy::deadline::DeadlineStream;
-use crate::deploy::line_reader::MAX_LINE_BYTES;
-use crate::deploy::protocol::Reply;
-use crate::deploy::robot::{serve_stream, RobotError, RobotSpec, Session};
+use crate::deploy::serve::deadline::DeadlineStream;
+use crate::deploy::serve::line_reader::MAX_LINE_BYTES;
+use crate::deploy::serve::protocol::Reply;
+use crate::deploy::serve::robot::{serve_stream, RobotError, RobotSpec, Session};
 use crate::deploy::AgentPolicy;
 use std::io::{BufReader, Write};
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};

@@ -8,12 +8,12 @@
 //! before that column existed. Every committed run must pass at HEAD; a change that alters numerics must
 //! recompute the results it affects.
 
-use crate::experiment::config::RunSpec;
-use crate::experiment::metrics::{self, MetricsError, EVAL_RETURN_UNDISCOUNTED};
-use crate::experiment::provenance::Provenance;
-use crate::experiment::results_tree::{self, CONFIG};
-use crate::experiment::runner::Progress;
-use crate::experiment::train_run::{train_run, RunError, RunManifest};
+use crate::experiment::definition::config::RunSpec;
+use crate::experiment::run::metrics::{self, MetricsError, EVAL_RETURN_UNDISCOUNTED};
+use crate::experiment::run::progress::Progress;
+use crate::experiment::run::provenance::Provenance;
+use crate::experiment::run::results_tree::{self, CONFIG};
+use crate::experiment::run::train_run::{train_run, RunError, RunManifest};
 use crate::files::bounded_read::{read_text_in_tree, MAX_TEXT_BYTES};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -265,7 +265,7 @@ pub fn audit_all(
         result
     };
     let order: Vec<usize> = (0..dirs.len()).collect();
-    crate::experiment::work_queue::run_in_order(&order, jobs, one)
+    crate::experiment::run::work_queue::run_in_order(&order, jobs, one)
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! shared results directory (no figures: tasks would race to draw them). Runs checkpoint and resume, so a preempted and requeued task
 //! continues where it stopped; `macdec plot` then reads the union of the run directories.
 
-use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
+use crate::experiment::definition::names::{check_curve_name, check_experiment_name, NameError};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -138,7 +138,7 @@ pub fn job_script(
         no_control("run label", label)?;
         let (curve, seed) = label.split_once('/').unwrap_or((label, ""));
         check_curve_name(curve)?;
-        if crate::experiment::results_tree::parse_seed_dir(seed).is_none() {
+        if crate::experiment::run::results_tree::parse_seed_dir(seed).is_none() {
             return Err(SlurmError::BadValue {
                 what: "run label",
                 value: label.clone(),

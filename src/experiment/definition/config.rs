@@ -9,11 +9,11 @@
 use crate::algos::hyper::{AcConfig, RunConfig, ValueConfig};
 use crate::algos::method::{Family, Method};
 use crate::envs::EnvSpec;
-use crate::experiment::limits;
-use crate::experiment::names::{check_curve_name, check_experiment_name, NameError};
-use crate::experiment::results_tree;
-use crate::experiment::run_settings::RunSettings;
-use crate::experiment::seeds::{check_seed_list, parse_seeds, SeedsError};
+use crate::experiment::definition::limits;
+use crate::experiment::definition::names::{check_curve_name, check_experiment_name, NameError};
+use crate::experiment::definition::run_settings::RunSettings;
+use crate::experiment::definition::seeds::{check_seed_list, parse_seeds, SeedsError};
+use crate::experiment::run::results_tree;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -202,7 +202,7 @@ pub struct Experiment {
 
 /// The file in `<results>/<experiment>/` naming the curves that live in another experiment's
 /// directory (`our2 = "fig5_wtd"`), written by `macdec train` and read by `macdec plot`.
-pub use crate::experiment::results_tree::SHARED_CURVES as SHARED_CURVES_FILE;
+pub use crate::experiment::run::results_tree::SHARED_CURVES as SHARED_CURVES_FILE;
 
 /// The command-line overrides of `macdec train`.
 #[derive(Debug, Clone, Default)]

@@ -175,7 +175,7 @@ mod tests {
     use super::*;
     use crate::algos::method::Method;
 
-    use crate::experiment::paper::value_paper_defaults as paper_defaults;
+    use crate::experiment::definition::paper::value_paper_defaults as paper_defaults;
 
     #[test]
     fn the_papers_settings_are_within_every_bound() {

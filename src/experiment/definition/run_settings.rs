@@ -8,7 +8,7 @@
 use crate::algos::hyper::RunConfig;
 use crate::algos::method::Method;
 use crate::envs::EnvSpec;
-use crate::experiment::paper::paper_defaults;
+use crate::experiment::definition::paper::paper_defaults;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// The domain a run trains on and its hyperparameters: `config.toml`'s `[config]` table.

@@ -1,6 +1,6 @@
 //! Run seeds: the `--seeds` syntax, and one random stream per role derived from a run's seed.
 
-use crate::experiment::limits::{MAX_SEED, MAX_SEEDS};
+use crate::experiment::definition::limits::{MAX_SEED, MAX_SEEDS};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -43,7 +43,7 @@ pub enum SeedsError {
     #[error("seeds `{0}`: seed {1} appears twice")]
     Duplicate(String, u64),
     /// More seeds than `MAX_SEEDS`: the text and the count.
-    #[error("seeds `{0}`: {1} seeds, at most {max} allowed", max = crate::experiment::limits::MAX_SEEDS)]
+    #[error("seeds `{0}`: {1} seeds, at most {max} allowed", max = MAX_SEEDS)]
     TooMany(String, u128),
     /// A seed beyond [`MAX_SEED`]: the text and the seed.
     #[error("seeds `{0}`: seed {1} is beyond the largest supported seed, {max} (runs record their seed as a TOML integer)", max = MAX_SEED)]

@@ -13,7 +13,7 @@
 
 use crate::algos::any_loop::AnyLoop;
 use crate::algos::method::Method;
-use crate::experiment::run_settings::RunSettings;
+use crate::experiment::definition::run_settings::RunSettings;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -213,7 +213,7 @@ pub fn decode(
 mod tests {
     use super::*;
 
-    use crate::experiment::train_run::run_rngs;
+    use crate::experiment::run::train_run::run_rngs;
 
     fn tiny() -> (CheckpointIdentity, AnyLoop) {
         let mut c = RunSettings::paper(crate::envs::box_pushing::paper_spec(8), Method::Our1);

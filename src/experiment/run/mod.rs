@@ -1,12 +1,13 @@
-//! Running it and what a run writes: the parallel runner ([`runner`], [`work_queue`]), every run
-//! of an experiment ([`train_all`], stopped early by a [`stop`] signal), one run on disk with
-//! resume ([`train_run`]), its files ([`results_tree`] names them; [`checkpoint`],
-//! [`metrics`], [`policy_files`], [`provenance`]), the terminal summary ([`report`]) and every
-//! run of a tree as one table ([`tidy_table`]).
+//! Running it and what a run writes: the parallel runner ([`runner`], [`work_queue`], with the
+//! [`progress`] a run reports to it), every run of an experiment ([`train_all`], stopped early by
+//! a [`stop`] signal), one run on disk with resume ([`train_run`]), its files ([`results_tree`]
+//! names them; [`checkpoint`], [`metrics`], [`provenance`]; its `policy/` directory is of the one
+//! format in [`crate::policy_files`]), the terminal summary ([`report`]) and every run of a tree
+//! as one table ([`tidy_table`]).
 
 pub mod checkpoint;
 pub mod metrics;
-pub mod policy_files;
+pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod results_tree;

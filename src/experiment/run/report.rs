@@ -3,8 +3,8 @@
 //! points, with a bar per point.
 
 use crate::curve_stats::aggregate;
-use crate::experiment::config::RunSpec;
-use crate::experiment::metrics;
+use crate::experiment::definition::config::RunSpec;
+use crate::experiment::run::metrics;
 use std::collections::BTreeMap;
 use std::path::Path;
 

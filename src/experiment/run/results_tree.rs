@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 /// A run's resolved config (its identity, domain, hyperparameters and provenance).
 pub const CONFIG: &str = "config.toml";
-/// A run's learning curve, see [`crate::experiment::metrics`].
-pub use crate::experiment::metrics::{METRICS_FILE, METRICS_FILE_GZ};
+/// A run's learning curve, see [`crate::experiment::run::metrics`].
+pub use crate::experiment::run::metrics::{METRICS_FILE, METRICS_FILE_GZ};
 /// The whole training loop, for resuming only (never committed).
 pub const CHECKPOINT: &str = "checkpoint.bin";
 /// The run's nets as policy files, see [`crate::policy_files`].

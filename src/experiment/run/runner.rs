@@ -6,10 +6,11 @@
 //! describes the run asked for (provenance aside); a different run in its directory fails that
 //! run, naming the keys that differ.
 
-use crate::experiment::config::RunSpec;
-use crate::experiment::results_tree;
-use crate::experiment::train_run::{existing_run, Existing};
-use crate::experiment::work_queue::run_in_order;
+use crate::experiment::definition::config::RunSpec;
+use crate::experiment::run::progress::{Heartbeat, Progress, RunEnd};
+use crate::experiment::run::results_tree;
+use crate::experiment::run::train_run::{existing_run, Existing};
+use crate::experiment::run::work_queue::run_in_order;
 use crate::files::links::check_real_dirs;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -25,35 +26,9 @@ pub struct RunnerOptions {
     /// Recompute finished runs instead of skipping them.
     pub force: bool,
     /// No progress bars (logs, CI); one line per finished run instead. Without a terminal
-    /// on stderr that is the default anyway, with a line every [`HEARTBEAT`] per run besides.
+    /// on stderr that is the default anyway, with a line every
+    /// [`HEARTBEAT`](crate::experiment::run::progress::HEARTBEAT) per run besides.
     pub quiet: bool,
-}
-
-/// How often a run reports how far it got when there are no progress bars and no `--quiet`
-/// (stderr is not a terminal: a log file, a pipe, a batch job).
-pub const HEARTBEAT: std::time::Duration = std::time::Duration::from_secs(60);
-
-/// The heartbeat of one run drawn without bars: its name, its episode count and when it last
-/// reported.
-struct Heartbeat {
-    name: String,
-    total_epi: u64,
-    last: std::sync::Mutex<std::time::Instant>,
-}
-
-/// How a run that did not fail ended, as the function training it reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RunEnd {
-    /// Trained to its end (or the rest of the way from its checkpoint).
-    Trained,
-    /// Already finished when its turn came (another process finished it meanwhile).
-    AlreadyFinished,
-    /// Another process holds the run's lock and is training it: left to that process, so
-    /// several processes (or machines sharing the results tree) can work through one campaign.
-    Busy,
-    /// Stopped early on request ([`crate::experiment::stop::StopSignal`]), its checkpoint saved:
-    /// training it again resumes it.
-    Stopped,
 }
 
 /// What became of one run.
@@ -72,47 +47,6 @@ pub enum RunStatus {
     Stopped,
     /// Stopped by an error; holds its message.
     Failed(String),
-}
-
-/// A progress handle a run updates as episodes complete.
-#[derive(Clone)]
-pub struct Progress {
-    bar: ProgressBar,
-    total: ProgressBar,
-    last: Arc<std::sync::atomic::AtomicU64>,
-    heartbeat: Option<Arc<Heartbeat>>,
-}
-
-impl Progress {
-    /// A handle that draws nothing (for tests and library callers).
-    pub fn hidden() -> Self {
-        Progress {
-            bar: ProgressBar::hidden(),
-            total: ProgressBar::hidden(),
-            last: Arc::default(),
-            heartbeat: None,
-        }
-    }
-
-    /// Report that `episodes` training episodes are complete, with a short status message.
-    pub fn update(&self, episodes: u64, message: impl Into<std::borrow::Cow<'static, str>>) {
-        use std::sync::atomic::Ordering;
-        let before = self.last.swap(episodes, Ordering::Relaxed);
-        self.total.inc(episodes.saturating_sub(before));
-        self.bar.set_position(episodes);
-        let message = message.into();
-        if let Some(h) = &self.heartbeat {
-            let mut last = h.last.lock().unwrap_or_else(|e| e.into_inner());
-            if last.elapsed() >= HEARTBEAT {
-                *last = std::time::Instant::now();
-                eprintln!(
-                    "{}: episode {episodes} of {} {message}",
-                    h.name, h.total_epi
-                );
-            }
-        }
-        self.bar.set_message(message);
-    }
 }
 
 /// `experiment/curve/seed-k`, as progress lines name a run.
@@ -271,7 +205,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::config::{Experiment, Overrides};
+    use crate::experiment::definition::config::{Experiment, Overrides};
 
     fn runs(n: usize) -> Vec<RunSpec> {
         let o = Overrides {
@@ -355,8 +289,8 @@ mod tests {
 
     /// What a finished run leaves: its config.toml and the marker.
     fn finish(spec: &RunSpec, dir: &Path) {
-        use crate::experiment::results_tree::{CONFIG, FINISHED};
-        use crate::experiment::train_run::RunManifest;
+        use crate::experiment::run::results_tree::{CONFIG, FINISHED};
+        use crate::experiment::run::train_run::RunManifest;
         std::fs::create_dir_all(dir).unwrap();
         let text = toml::to_string(&RunManifest::for_spec(spec)).unwrap();
         std::fs::write(dir.join(CONFIG), text).unwrap();
@@ -365,7 +299,7 @@ mod tests {
 
     #[test]
     fn a_finished_run_of_another_config_is_refused_naming_the_keys_but_provenance_is_ignored() {
-        use crate::experiment::results_tree::CONFIG;
+        use crate::experiment::run::results_tree::CONFIG;
         let dir = tempfile::tempdir().unwrap();
         let opts = RunnerOptions {
             out: dir.path().to_path_buf(),

@@ -207,7 +207,7 @@ enum Cell<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::metrics::MetricsRow;
+    use crate::experiment::run::metrics::MetricsRow;
 
     fn row(episode: u64, ret: f64, family: Vec<Option<f64>>) -> MetricsRow {
         MetricsRow {

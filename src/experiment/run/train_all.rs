@@ -4,10 +4,11 @@
 //! [`StopSignal`] starts no new run and stops the running ones at their next episode boundary,
 //! resumable.
 
-use super::runner::{run_all, RunEnd, RunStatus, RunnerOptions};
+use super::progress::RunEnd;
+use super::runner::{run_all, RunStatus, RunnerOptions};
 use super::stop::StopSignal;
 use super::train_run::train_run_until;
-use crate::experiment::config::RunSpec;
+use crate::experiment::definition::config::RunSpec;
 
 /// Train `runs` as `opts` says (`force` recomputes finished runs), stopping early when `stop` is
 /// raised. Returns each run's status in input order: a run not started before the stop is
@@ -29,8 +30,8 @@ pub fn train_all(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::config::{Experiment, Overrides};
-    use crate::experiment::metrics;
+    use crate::experiment::definition::config::{Experiment, Overrides};
+    use crate::experiment::run::metrics;
     use std::path::Path;
 
     const TINY: &str = r#"

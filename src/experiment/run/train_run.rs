@@ -1,7 +1,7 @@
 //! One training run on disk: its directory, config, checkpoints, metrics and resume.
 //!
 //! Layout of `<results>/<experiment>/<curve>/seed-<k>/`: `config.toml` (the resolved config plus
-//! method and seed), `metrics.csv` (see [`crate::experiment::metrics`]), `checkpoint.bin` (the
+//! method and seed), `metrics.csv` (see [`crate::experiment::run::metrics`]), `checkpoint.bin` (the
 //! whole trainer: nets, Adam moments, replay, RNG states, counters; for resuming only),
 //! `policy/` (the nets as safetensors plus `policy.json`, written with every checkpoint; see
 //! [`crate::policy_files`]), `finished` once done, and `.lock`, which the training
@@ -12,15 +12,15 @@
 use crate::algos::any_loop::AnyLoop;
 use crate::algos::method::Method;
 use crate::algos::training_loop::{Advance, RunRngs, TrainError};
-use crate::experiment::checkpoint::{self, CheckpointIdentity};
-use crate::experiment::config::RunSpec;
-use crate::experiment::metrics::{self, METRICS_FILE};
-use crate::experiment::provenance::Provenance;
-use crate::experiment::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
-use crate::experiment::run_settings::RunSettings;
-use crate::experiment::runner::{Progress, RunEnd};
-use crate::experiment::seeds::{stream, Role};
-use crate::experiment::stop::StopSignal;
+use crate::experiment::definition::config::RunSpec;
+use crate::experiment::definition::run_settings::RunSettings;
+use crate::experiment::definition::seeds::{stream, Role};
+use crate::experiment::run::checkpoint::{self, CheckpointIdentity};
+use crate::experiment::run::metrics::{self, METRICS_FILE};
+use crate::experiment::run::progress::{Progress, RunEnd};
+use crate::experiment::run::provenance::Provenance;
+use crate::experiment::run::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
+use crate::experiment::run::stop::StopSignal;
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::{
     read_in_tree, read_text_in_tree, MAX_CHECKPOINT_BYTES, MAX_TEXT_BYTES,
@@ -90,20 +90,20 @@ impl TryFrom<RecordedManifest> for RunManifest {
 
 impl RunManifest {
     /// The checks `train` makes before it runs a config: every key in range for the method
-    /// ([`crate::experiment::config::validate`]) and the seed at most
-    /// [`MAX_SEED`](crate::experiment::limits::MAX_SEED). Returns the key and why.
+    /// ([`crate::experiment::definition::config::validate`]) and the seed at most
+    /// [`MAX_SEED`](crate::experiment::definition::limits::MAX_SEED). Returns the key and why.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
-        if self.seed > crate::experiment::limits::MAX_SEED {
+        if self.seed > crate::experiment::definition::limits::MAX_SEED {
             return Err((
                 "seed",
                 format!(
                     "must be at most {}, got {}",
-                    crate::experiment::limits::MAX_SEED,
+                    crate::experiment::definition::limits::MAX_SEED,
                     self.seed
                 ),
             ));
         }
-        crate::experiment::config::validate(
+        crate::experiment::definition::config::validate(
             &self.config.config,
             self.method,
             self.config.env.horizon(),
@@ -579,7 +579,7 @@ pub fn train_run_until(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::config::{Experiment, Overrides};
+    use crate::experiment::definition::config::{Experiment, Overrides};
 
     fn spec() -> RunSpec {
         let e = Experiment::parse("", Path::new("e.toml"), "e", &Overrides::default()).unwrap();
