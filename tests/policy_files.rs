@@ -11,7 +11,7 @@ use std::process::Command;
 
 mod common;
 
-use common::{ok, BIN};
+use common::{ok, render_returns as returns, BIN};
 
 /// A tiny Box Pushing experiment with one decentralized and one centralized method.
 const TINY: &str = r#"
@@ -44,16 +44,6 @@ fn export(run: &Path, out: &Path) -> std::process::Output {
     let mut cmd = Command::new(BIN);
     cmd.args(["export", "--run"]).arg(run).arg("--out").arg(out);
     cmd.output().unwrap()
-}
-
-/// The team returns `macdec render` reports.
-fn returns(out: &std::process::Output) -> String {
-    ok(out);
-    let err = String::from_utf8_lossy(&out.stderr);
-    let at = err
-        .find("team returns")
-        .expect("render reports its returns");
-    err[at..].trim().to_string()
 }
 
 fn render(run: &Path, out: &Path) -> std::process::Output {

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{ok, run, train_config};
+use common::{render_returns, run, train_config};
 use std::path::Path;
 
 const AC_METHODS: [&str; 6] = [
@@ -39,16 +39,6 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// The team returns `render` reported on stderr.
-fn reported(out: &std::process::Output) -> String {
-    ok(out);
-    let err = String::from_utf8_lossy(&out.stderr);
-    let at = err
-        .find("team returns")
-        .expect("render reports its returns");
-    err[at..].trim().to_string()
-}
-
 #[test]
 fn every_actor_critic_run_renders_and_a_missing_net_is_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -65,19 +55,19 @@ fn every_actor_critic_run_renders_and_a_missing_net_is_named() {
             "--episodes",
             "2",
         ];
-        let first = reported(&run(&args));
+        let first = render_returns(&run(&args));
         let bytes = std::fs::read(&gif).unwrap();
         assert!(
             bytes.starts_with(b"GIF89a") && bytes.len() > 1000,
             "{method}"
         );
         // Greedy acting from the run's seed: the same episodes again.
-        assert_eq!(reported(&run(&args)), first, "{method}");
+        assert_eq!(render_returns(&run(&args)), first, "{method}");
         // Sampled as MacroMARL evaluates: reproducible from the run's seed too.
         let mut sampled = args.to_vec();
         sampled.push("--sample");
-        let drawn = reported(&run(&sampled));
-        assert_eq!(reported(&run(&sampled)), drawn, "{method} --sample");
+        let drawn = render_returns(&run(&sampled));
+        assert_eq!(render_returns(&run(&sampled)), drawn, "{method} --sample");
         // The nets the method does not have are refused by name.
         let other = if method == "mac-cac" { "dec" } else { "cen" };
         let refused = run(&[

@@ -77,6 +77,16 @@ pub fn ok(out: &Output) -> String {
     String::from_utf8(out.stdout.clone()).unwrap()
 }
 
+/// The team returns a successful `macdec render` reported on stderr.
+pub fn render_returns(out: &Output) -> String {
+    ok(out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let at = err
+        .find("team returns")
+        .expect("render reports its returns");
+    err[at..].trim().to_string()
+}
+
 /// The lines of a successful command's stdout.
 pub fn stdout_lines(out: &Output) -> Vec<String> {
     ok(out).lines().map(str::to_string).collect()
