@@ -2,7 +2,7 @@
 //! `--seeds` and `--set`, resolved into an [`Experiment`].
 
 use crate::algos::method::Method;
-use crate::experiment::definition::config::{Experiment, Overrides, DEFAULT_EXPERIMENT};
+use crate::experiment::definition::config::{quick_start, Experiment, Overrides};
 use crate::experiment::definition::seeds::parse_seeds;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 /// Which runs of an experiment, as `train` and `slurm` both select them.
 #[derive(clap::Args)]
 pub(super) struct Selection {
-    /// Experiment TOML (see experiments/); without it, a short built-in Box Pushing 10x10 run.
+    /// Experiment TOML (see experiments/); without it, a short built-in run of the methods'
+    /// family: Box Pushing 10x10 (ICRA methods) or MacroMARL's Box Pushing 6x6 (actor-critic).
     #[arg(long)]
     pub(super) config: Option<PathBuf>,
     /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2 (ICRA 2020), mac-iac,
@@ -37,12 +38,10 @@ impl Selection {
             Some(path) => {
                 Experiment::load(path, &o).with_context(|| format!("loading {}", path.display()))?
             }
-            None => Experiment::parse(
-                DEFAULT_EXPERIMENT,
-                Path::new("<built-in default>"),
-                "quickstart_bp10",
-                &o,
-            )?,
+            None => {
+                let (text, name) = quick_start(o.methods.as_deref()).map_err(anyhow::Error::msg)?;
+                Experiment::parse(text, Path::new("<built-in default>"), name, &o)?
+            }
         })
     }
 }
@@ -84,9 +83,31 @@ mod tests {
     }
 
     #[test]
-    fn no_config_selects_the_built_in_quick_start() {
+    fn no_config_selects_the_methods_family_s_quick_start() {
         let e = selection(None, None, &[]).load().unwrap();
         assert_eq!(e.name, "quickstart_bp10");
+        let e = selection(Some("dec-hddrqn"), None, &[]).load().unwrap();
+        assert_eq!(e.name, "quickstart_bp10");
+        // An actor-critic method trains MacroMARL's Box Pushing 6x6, with its own keys.
+        let e = selection(Some("mac-iac,mac-cac"), None, &[])
+            .load()
+            .unwrap();
+        assert_eq!(e.name, "quickstart_bp6");
+        assert_eq!(e.methods, [Method::MacIac, Method::MacCac]);
+        let e = selection(Some("mac-iac"), None, &["n_env=4"])
+            .load()
+            .unwrap();
+        assert_eq!(e.name, "quickstart_bp6");
+        let err = format!(
+            "{:#}",
+            selection(Some("our1,mac-iac"), None, &[])
+                .load()
+                .expect_err("two families")
+        );
+        assert!(
+            err.contains("one family's quick start") && err.contains("experiments/macromarl"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -229,6 +229,55 @@ total_epi = 1500
 eps_l_d_steps = 1000
 "#;
 
+/// The embedded quick start of the actor-critic family, which `macdec train --methods
+/// <actor-critic methods>` without `--config` trains: MacroMARL's published Box Pushing 6x6
+/// block (40 000 episodes, seconds per run) with Mac-IAISC, the method that most often reaches
+/// the optimum there, two seeds.
+pub const AC_QUICK_START: &str = r#"
+name = "quickstart_bp6"
+methods = ["mac-iaisc"]
+seeds = "0..2"
+
+[params]
+env_name = "BP-MA-v0"
+grid_dim = [6, 6]
+env_terminate_step = 100
+"#;
+
+/// The built-in experiment (text, name) `train` runs without `--config` for these `--methods`:
+/// the value family's [`DEFAULT_EXPERIMENT`] (also without `--methods`), the actor-critic
+/// family's [`AC_QUICK_START`]; methods of both families have no common quick start, and the
+/// error says which methods belong to which and where the experiment files are.
+pub fn quick_start(methods: Option<&[Method]>) -> Result<(&'static str, &'static str), String> {
+    let families: std::collections::BTreeSet<bool> = methods
+        .unwrap_or(&[])
+        .iter()
+        .map(|m| m.family() == Family::ActorCritic)
+        .collect();
+    match (families.contains(&false), families.contains(&true)) {
+        (_, false) => Ok((DEFAULT_EXPERIMENT, "quickstart_bp10")),
+        (false, true) => Ok((AC_QUICK_START, "quickstart_bp6")),
+        (true, true) => {
+            let of = |ac: bool| {
+                Method::ALL
+                    .iter()
+                    .filter(|m| (m.family() == Family::ActorCritic) == ac)
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            Err(format!(
+                "without --config, train runs one family's quick start: the ICRA methods' \
+                 (Box Pushing 10x10: {}) or the actor-critic methods' (MacroMARL's Box Pushing \
+                 6x6: {}); name methods of one family, or pass --config (e.g. \
+                 experiments/macromarl/bp6.toml, whose domain both families train on)",
+                of(false),
+                of(true)
+            ))
+        }
+    }
+}
+
 impl Experiment {
     /// Load an experiment file and apply command-line overrides.
     pub fn load(path: &Path, overrides: &Overrides) -> Result<Self, ConfigError> {
