@@ -7,9 +7,9 @@
 //! per-seed random streams, so a run through [`train`] on Box Pushing or Warehouse gives exactly
 //! the numbers of `macdec train` with that config, method and seed.
 
-use crate::algos::any_loop::AnyLoop;
-use crate::algos::hyper::RunConfig;
-use crate::algos::method::Method;
+use crate::algos::families::AnyLoop;
+use crate::algos::families::Method;
+use crate::algos::families::RunConfig;
 use crate::algos::training_loop::{Advance, EvalPoint, TrainError};
 use crate::deploy::policy::export::{export_nets, ExportError};
 use crate::envs::{EnvError, MacroEnv};
@@ -163,16 +163,18 @@ impl TrainedPolicy {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::actor_critic::method::AcMethod;
+    use crate::algos::family::FamilyMethod;
+    use crate::algos::value::method::ValueMethod;
     use crate::envs::{AnyEnv, EnvSpec};
-    use crate::experiment::definition::paper::value_paper_defaults;
 
     /// The library trains on BP 10x10 here.
     fn spec() -> EnvSpec {
         crate::envs::box_pushing::spec(10, 100)
     }
 
-    fn short(method: Method) -> RunConfig {
-        let mut c = value_paper_defaults(&spec(), method);
+    fn short(method: ValueMethod) -> RunConfig {
+        let mut c = method.defaults(&spec());
         c.total_epi = 12;
         c.eval_freq = 4;
         c.into()
@@ -180,8 +182,9 @@ mod tests {
 
     #[test]
     fn library_training_gives_the_numbers_of_the_command_lines_trainer() {
-        for method in [Method::Our1, Method::DecHddrqn] {
-            let c = short(method);
+        for value_method in [ValueMethod::Our1, ValueMethod::DecHddrqn] {
+            let c = short(value_method);
+            let method = Method::from(value_method);
             let evals = train(|| spec().build(), &c, method, 5, |_| {}).unwrap();
             let mut t: AnyLoop<AnyEnv> =
                 AnyLoop::new(&c, method, 5, run_rngs(5), || spec().build()).unwrap();
@@ -204,10 +207,24 @@ mod tests {
     fn an_exported_library_policy_holds_the_trained_nets_for_either_kind_of_domain() {
         use crate::deploy::policy::net_policy::load_net;
         use crate::policy_files::load_agent;
-        let c = short(Method::Our1);
+        let c = short(ValueMethod::Our1);
         let spec = spec();
-        let trained = train_policy(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
-        let evals = train(|| spec.build(), &c, Method::Our1, 3, |_| {}).unwrap();
+        let trained = train_policy(
+            || spec.build(),
+            &c,
+            Method::Value(ValueMethod::Our1),
+            3,
+            |_| {},
+        )
+        .unwrap();
+        let evals = train(
+            || spec.build(),
+            &c,
+            Method::Value(ValueMethod::Our1),
+            3,
+            |_| {},
+        )
+        .unwrap();
         let no_wall = |e: &[EvalPoint]| -> Vec<EvalPoint> {
             e.iter()
                 .map(|p| EvalPoint {
@@ -242,8 +259,8 @@ mod tests {
         }
         let cen = train_policy(
             || spec.build(),
-            &short(Method::CenDdrqn),
-            Method::CenDdrqn,
+            &short(ValueMethod::CenDdrqn),
+            Method::Value(ValueMethod::CenDdrqn),
             3,
             |_| {},
         )
@@ -257,11 +274,10 @@ mod tests {
     #[test]
     fn an_actor_critic_policy_keeps_its_actors_and_exports_the_decentralized_ones() {
         use crate::deploy::policy::net_policy::load_net;
-        use crate::experiment::definition::paper::actor_critic_defaults;
         use crate::policy_files::load_agent;
         let spec = crate::envs::bp_ma_v0::spec(4, 20);
-        let short = |method| -> RunConfig {
-            let mut c = actor_critic_defaults(&spec, method);
+        let short = |method: AcMethod| -> RunConfig {
+            let mut c = method.defaults(&spec);
             c.total_epi = 8;
             c.n_env = 4;
             c.train_freq = 4;
@@ -271,8 +287,8 @@ mod tests {
         };
         let iac = train_policy(
             || spec.build(),
-            &short(Method::MacIac),
-            Method::MacIac,
+            &short(AcMethod::MacIac),
+            Method::ActorCritic(AcMethod::MacIac),
             1,
             |_| {},
         )
@@ -289,8 +305,8 @@ mod tests {
         }
         let cac = train_policy(
             || spec.build(),
-            &short(Method::MacCac),
-            Method::MacCac,
+            &short(AcMethod::MacCac),
+            Method::ActorCritic(AcMethod::MacCac),
             1,
             |_| {},
         )
@@ -307,18 +323,25 @@ mod tests {
 
     #[test]
     fn a_bad_config_key_is_named_before_training() {
-        let mut c = short(Method::Our1);
-        c.value_mut().unwrap().batch_size = 0;
+        let mut c = short(ValueMethod::Our1);
+        c.of_mut::<ValueMethod>().unwrap().batch_size = 0;
         let spec = spec();
-        let err = train(|| spec.build(), &c, Method::Our1, 0, |_| {}).unwrap_err();
+        let err = train(
+            || spec.build(),
+            &c,
+            Method::Value(ValueMethod::Our1),
+            0,
+            |_| {},
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("batch_size"), "{err}");
     }
 
     #[test]
     fn a_failing_env_factory_is_reported() {
-        let c = short(Method::Our1);
+        let c = short(ValueMethod::Our1);
         let bad = || crate::envs::box_pushing::BoxPushing::new(3, 100);
-        let err = train(bad, &c, Method::Our1, 0, |_| {}).unwrap_err();
+        let err = train(bad, &c, Method::Value(ValueMethod::Our1), 0, |_| {}).unwrap_err();
         assert!(err.to_string().contains("grid"), "{err}");
     }
 }

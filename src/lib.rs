@@ -27,8 +27,8 @@
 //!
 //! 1. [`experiment::definition`]: an experiment file becomes a validated
 //!    [`experiment::definition::config::Experiment`] (methods, seeds, sweeps) and per-run
-//!    [`RunConfig`]s ([`experiment::definition::paper`] holds the papers' settings,
-//!    [`experiment::definition::limits`] every bound).
+//!    [`RunConfig`]s (each method's family holds the papers' settings, [`Method::defaults`];
+//!    [`experiment::definition::limits`] lists every bound).
 //! 2. [`experiment::run`]: [`experiment::run::runner`] trains the runs in parallel, each through
 //!    [`experiment::run::train_run`] (resume from [`experiment::run::checkpoint`], write
 //!    [`experiment::run::metrics`] and [`policy_files`], named by
@@ -76,13 +76,8 @@ pub mod plot;
 pub mod policy_files;
 pub mod render;
 
-pub use algos::any_loop::AnyLoop;
-pub use algos::hyper::RunConfig;
-pub use algos::method::Method;
+pub use algos::families::{AnyLoop, Method, RunConfig};
 pub use algos::training_loop::EvalPoint;
 pub use api::{train, train_policy, LibraryTrainError, TrainedPolicy};
 pub use envs::{EnvError, EnvRng, EnvSpec, FirstRecordObs, MacroEnv, StepOutcome};
-pub use experiment::definition::paper::{
-    actor_critic_defaults, paper_defaults, value_paper_defaults,
-};
 pub use policy_files::PolicyEnv;

@@ -3,24 +3,30 @@
 //! uninterrupted one, every method trains on every MacroMARL domain it can and refuses the ones
 //! it cannot with a clear error, and the state-critic methods learn Box Pushing 6x6.
 
-use macdec::algos::any_loop::AnyLoop;
-use macdec::algos::method::{Family, Method};
+use macdec::algos::actor_critic::method::AcMethod;
+use macdec::algos::families::AnyLoop;
+use macdec::algos::families::{Family, InList, Method};
+use macdec::algos::family::FamilyMethod;
 use macdec::algos::training_loop::{Advance, EvalPoint};
 use macdec::envs::EnvSpec;
 use macdec::envs::MacroEnv;
-use macdec::experiment::definition::paper::actor_critic_defaults;
 use macdec::experiment::run::train_run::run_rngs;
 use macdec::RunConfig;
 
 fn ac_methods() -> impl Iterator<Item = Method> {
-    Method::ALL
-        .into_iter()
-        .filter(|m| m.family() == Family::ActorCritic)
+    Family::ActorCritic.methods().into_iter()
+}
+
+/// The published settings of actor-critic `method` on `spec`.
+fn published(spec: &EnvSpec, method: Method) -> macdec::algos::actor_critic::config::AcConfig {
+    AcMethod::of(method)
+        .expect("an actor-critic method")
+        .defaults(spec)
 }
 
 /// A short run's config: 4 lanes, 4 episodes per update, an evaluation every 8.
 fn short(spec: &EnvSpec, method: Method, episodes: usize) -> RunConfig {
-    let mut c = actor_critic_defaults(spec, method);
+    let mut c = published(spec, method);
     c.total_epi = episodes;
     c.n_env = 4;
     c.train_freq = 4;
@@ -103,7 +109,11 @@ fn every_method_trains_on_every_macromarl_domain_that_gives_what_it_needs() {
         let has_state = spec.build().unwrap().state_size() > 0;
         for method in ac_methods() {
             let config = short(&spec, method, 8);
-            let needs_state = matches!(method, Method::NaiveMacIasc | Method::MacIaisc);
+            let needs_state = matches!(
+                method,
+                Method::ActorCritic(AcMethod::NaiveMacIasc)
+                    | Method::ActorCritic(AcMethod::MacIaisc)
+            );
             let built = AnyLoop::new(&config, method, 0, run_rngs(0), || spec.build());
             match built {
                 Ok(mut l) if !needs_state || has_state => {
@@ -126,8 +136,11 @@ fn the_state_critic_methods_learn_box_pushing_6x6() {
     // The published settings, 12 000 episodes, seed 0: the state-critic methods push the big box
     // (optimum 270.61 at gamma 0.98; the two small boxes alone give at most 37.26).
     let spec = macdec::envs::bp_ma_v0::spec(6, 100);
-    for method in [Method::NaiveMacIasc, Method::MacIaisc] {
-        let mut c = actor_critic_defaults(&spec, method);
+    for method in [
+        Method::ActorCritic(AcMethod::NaiveMacIasc),
+        Method::ActorCritic(AcMethod::MacIaisc),
+    ] {
+        let mut c = published(&spec, method);
         c.total_epi = 12_000;
         let evals = train(&spec, &c.into(), method, 0);
         let best = evals.iter().map(|e| e.eval_return).fold(f64::MIN, f64::max);

@@ -5,13 +5,15 @@
 mod common;
 
 use common::{robot_process, run};
+use macdec::algos::family::FamilyMethod;
 use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
+use macdec::algos::value::method::ValueMethod;
 use macdec::deploy::drive::link::JsonLink;
 use macdec::deploy::greedy_action;
 use macdec::deploy::serve::protocol::Reply;
 use macdec::policy_files::Manifest;
 use macdec::policy_files::PolicyEnv;
-use macdec::{value_paper_defaults, EnvError, EnvRng, MacroEnv, Method, StepOutcome};
+use macdec::{EnvError, EnvRng, MacroEnv, Method, StepOutcome};
 use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;
 use std::path::Path;
@@ -129,7 +131,7 @@ impl MacroEnv for Beacon {
 
 /// A few episodes of Our-1 on [`Beacon`] through the library, exported to `dir`.
 fn train_and_export(dir: &Path) -> (macdec::TrainedPolicy, Manifest) {
-    let mut config = value_paper_defaults(&macdec::envs::warehouse::paper_spec(), Method::Our1);
+    let mut config = ValueMethod::Our1.defaults(&macdec::envs::warehouse::paper_spec());
     config.total_epi = 12;
     config.eps_l_d_steps = 6;
     config.h_stable_at = 6;
@@ -143,7 +145,14 @@ fn train_and_export(dir: &Path) -> (macdec::TrainedPolicy, Manifest) {
     config.cen_mlp_layer_size = 8;
     config.cen_rnn_h_size = 8;
     let config = config.into();
-    let trained = macdec::train_policy(Beacon::new, &config, Method::Our1, 4, |_| {}).unwrap();
+    let trained = macdec::train_policy(
+        Beacon::new,
+        &config,
+        Method::Value(ValueMethod::Our1),
+        4,
+        |_| {},
+    )
+    .unwrap();
     assert_eq!(trained.episodes_trained, 12);
     assert!(trained.evals.iter().any(|e| e.updates > 0), "it trained");
     let env = Beacon::new().unwrap();

@@ -1,11 +1,13 @@
 //! Every evaluation records the undiscounted return beside the discounted one: with a discount
 //! of 1 the two are the same number, below 1 they differ, for both families.
 
-use macdec::algos::any_loop::AnyLoop;
-use macdec::algos::method::Method;
+use macdec::algos::actor_critic::method::AcMethod;
+use macdec::algos::families::AnyLoop;
+use macdec::algos::families::Method;
+use macdec::algos::family::FamilyMethod;
 use macdec::algos::training_loop::{Advance, EvalPoint};
+use macdec::algos::value::method::ValueMethod;
 use macdec::envs::EnvSpec;
-use macdec::experiment::definition::paper::{actor_critic_defaults, value_paper_defaults};
 use macdec::experiment::run::train_run::run_rngs;
 use macdec::RunConfig;
 
@@ -29,11 +31,11 @@ fn same(evals: &[EvalPoint]) -> bool {
 fn value_methods_record_the_undiscounted_return() {
     let spec = macdec::envs::box_pushing::spec(10, 100);
     for (discount, equal) in [(1.0, true), (0.9, false)] {
-        let mut c = value_paper_defaults(&spec, Method::DecHddrqn);
+        let mut c = ValueMethod::DecHddrqn.defaults(&spec);
         c.total_epi = 20;
         c.eval_freq = 5;
         c.discount = discount;
-        let evals = train(&spec, &c.into(), Method::DecHddrqn);
+        let evals = train(&spec, &c.into(), Method::Value(ValueMethod::DecHddrqn));
         assert_eq!(same(&evals), equal, "discount {discount}: {evals:?}");
     }
 }
@@ -42,14 +44,14 @@ fn value_methods_record_the_undiscounted_return() {
 fn actor_critic_methods_record_the_undiscounted_return() {
     let spec = macdec::envs::bp_ma_v0::spec(4, 20);
     for (gamma, equal) in [(1.0, true), (0.9, false)] {
-        let mut c = actor_critic_defaults(&spec, Method::MacIac);
+        let mut c = AcMethod::MacIac.defaults(&spec);
         c.total_epi = 24;
         c.n_env = 4;
         c.train_freq = 4;
         c.eval_freq = 8;
         c.eval_num_epi = 4;
         c.gamma = gamma;
-        let evals = train(&spec, &c.into(), Method::MacIac);
+        let evals = train(&spec, &c.into(), Method::ActorCritic(AcMethod::MacIac));
         assert_eq!(same(&evals), equal, "gamma {gamma}: {evals:?}");
     }
 }

@@ -1,6 +1,8 @@
 //! Every shipped experiment config parses, and the paper figures carry the paper's settings.
 
-use macdec::algos::method::Method;
+use macdec::algos::actor_critic::method::AcMethod;
+use macdec::algos::families::Method;
+use macdec::algos::value::method::ValueMethod;
 use macdec::experiment::definition::config::{Experiment, Overrides};
 use std::path::Path;
 
@@ -41,18 +43,29 @@ fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() 
         assert_eq!(e.seeds, (0..20).collect::<Vec<u64>>(), "{}", e.name);
         // Box Pushing's published Naive Mac-IACC and Mac-IAICC runs use the state critics.
         let critics = if e.name.starts_with("bp") {
-            [Method::NaiveMacIasc, Method::MacIaisc]
+            [
+                Method::ActorCritic(AcMethod::NaiveMacIasc),
+                Method::ActorCritic(AcMethod::MacIaisc),
+            ]
         } else {
-            [Method::NaiveMacIacc, Method::MacIaicc]
+            [
+                Method::ActorCritic(AcMethod::NaiveMacIacc),
+                Method::ActorCritic(AcMethod::MacIaicc),
+            ]
         };
         assert_eq!(
             e.methods,
-            [Method::MacIac, Method::MacCac, critics[0], critics[1]],
+            [
+                Method::ActorCritic(AcMethod::MacIac),
+                Method::ActorCritic(AcMethod::MacCac),
+                critics[0],
+                critics[1]
+            ],
             "{}",
             e.name
         );
         for run in e.runs().unwrap().iter().filter(|r| r.seed == 0) {
-            let c = run.config.actor_critic().expect("an actor-critic config");
+            let c = run.config.of::<AcMethod>().expect("an actor-critic config");
             // Every published block differs from the argparse defaults in its learning rates.
             assert_ne!((c.a_lr, c.c_lr), (1e-4, 1e-3), "{} {}", e.name, run.method);
             assert!(c.train_freq >= c.n_env, "{} {}", e.name, run.method);
@@ -81,7 +94,7 @@ fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() 
     );
     // Spot checks against `docs/MACROMARL.md` §1.4.
     let bp12 = load("macromarl/bp12.toml").runs().unwrap();
-    let iac = bp12[0].config.actor_critic().unwrap();
+    let iac = bp12[0].config.of::<AcMethod>().unwrap();
     assert_eq!(
         (iac.n_env, iac.train_freq, iac.c_target_update_freq),
         (8, 16, 128)
@@ -89,14 +102,14 @@ fn macromarls_blocks_have_twenty_seeds_and_the_published_methods_and_settings() 
     let wh_b = load("macromarl/wh_b.toml").runs().unwrap();
     let cac = wh_b
         .iter()
-        .find(|r| r.method == Method::MacCac)
+        .find(|r| r.method == Method::ActorCritic(AcMethod::MacCac))
         .unwrap()
         .config
-        .actor_critic()
+        .of::<AcMethod>()
         .unwrap();
     assert_eq!((cac.a_rnn_layer_size, cac.c_target_update_freq), (64, 16));
     let ablation = load("macromarl/wh_ablation.toml").runs().unwrap();
-    let iac = ablation[0].config.actor_critic().unwrap();
+    let iac = ablation[0].config.of::<AcMethod>().unwrap();
     assert_eq!((iac.n_env, iac.c_lr), (16, 5e-4));
 }
 
@@ -105,19 +118,35 @@ fn paper_figures_have_forty_seeds_and_their_methods() {
     for (file, methods) in [
         (
             "fig4a_bp10.toml",
-            [Method::DecHddrqn, Method::CenDdrqn, Method::Our1],
+            [
+                Method::Value(ValueMethod::DecHddrqn),
+                Method::Value(ValueMethod::CenDdrqn),
+                Method::Value(ValueMethod::Our1),
+            ],
         ),
         (
             "fig4b_bp30.toml",
-            [Method::DecHddrqn, Method::CenDdrqn, Method::Our1],
+            [
+                Method::Value(ValueMethod::DecHddrqn),
+                Method::Value(ValueMethod::CenDdrqn),
+                Method::Value(ValueMethod::Our1),
+            ],
         ),
         (
             "fig5_wtd.toml",
-            [Method::DecHddrqn, Method::CenDdrqn, Method::Our2],
+            [
+                Method::Value(ValueMethod::DecHddrqn),
+                Method::Value(ValueMethod::CenDdrqn),
+                Method::Value(ValueMethod::Our2),
+            ],
         ),
         (
             "fig6_wtd_ablation.toml",
-            [Method::Our1, Method::Our1R, Method::Our2],
+            [
+                Method::Value(ValueMethod::Our1),
+                Method::Value(ValueMethod::Our1R),
+                Method::Value(ValueMethod::Our2),
+            ],
         ),
     ] {
         let e = load(file);
@@ -129,7 +158,7 @@ fn paper_figures_have_forty_seeds_and_their_methods() {
 #[test]
 fn bp30_uses_longer_windows_and_horizon() {
     let runs = load("fig4b_bp30.toml").runs().unwrap();
-    let c = runs[0].config.value().expect("a value method");
+    let c = runs[0].config.of::<ValueMethod>().expect("a value method");
     assert_eq!(runs[0].env, macdec::envs::box_pushing::spec(30, 200));
     assert_eq!((c.trace_len, c.train_freq), (45, 45));
 }
@@ -150,7 +179,7 @@ fn figure_6_shares_figure_5s_our2_runs_with_identical_configs() {
     let fig6 = load("fig6_wtd_ablation.toml").runs().unwrap();
     let our2 = |runs: &[macdec::experiment::definition::config::RunSpec]| -> Vec<_> {
         runs.iter()
-            .filter(|r| r.method == Method::Our2)
+            .filter(|r| r.method == Method::Value(ValueMethod::Our2))
             .cloned()
             .collect()
     };
@@ -166,7 +195,7 @@ fn figure_6_shares_figure_5s_our2_runs_with_identical_configs() {
     // Figure 6's own curves stay its own.
     assert!(fig6
         .iter()
-        .filter(|r| r.method != Method::Our2)
+        .filter(|r| r.method != Method::Value(ValueMethod::Our2))
         .all(|r| r.experiment == "fig6_wtd_ablation"));
 }
 

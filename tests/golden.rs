@@ -13,11 +13,12 @@
 //! conditional joint argmax exactly, gradients and every updated parameter to 1e-5 relative plus
 //! 1e-7 absolute. No torch is needed.
 
+use macdec::algos::value::method::ValueMethod;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use macdec::algos::method::Method;
+use macdec::algos::families::InList;
 use macdec::algos::value::record::{Episode, Layout, RecordRef};
 use macdec::algos::value::replay::{Batch, Sequence};
 use macdec::algos::value::squeeze::squeeze_agent;
@@ -344,7 +345,7 @@ fn compare_trace(
 fn run_case(case: &str) -> String {
     let dir = golden_dir(case);
     let g = read_golden(&dir);
-    let method: Method = g.method.parse().unwrap();
+    let method = ValueMethod::of(g.method.parse().unwrap()).expect("a value method");
     let layout = Layout::new(&g.layout.obs_sizes, &g.layout.n_actions).unwrap();
     let nets_of = |name: &str| {
         let mut nets = Nets::new(
@@ -401,7 +402,7 @@ fn run_case(case: &str) -> String {
         if let Some(c) = cen.as_mut() {
             c.policy = ref_weights["cen"].clone();
         }
-        let (dec_ref, cen_ref) = if method == Method::Our2 {
+        let (dec_ref, cen_ref) = if method == ValueMethod::Our2 {
             (
                 iteration.dec_batch.as_ref().expect("Our-2 has a dec batch"),
                 iteration.cen_batch.as_ref().expect("Our-2 has a cen batch"),

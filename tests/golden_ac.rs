@@ -21,9 +21,10 @@ use std::path::{Path, PathBuf};
 
 use macdec::algos::actor_critic::config::AcConfig;
 use macdec::algos::actor_critic::episode::Episode;
+use macdec::algos::actor_critic::method::{AcActor, AcCritic, AcDesign, AcMethod};
 use macdec::algos::actor_critic::nets::{AcNets, CriticNet, NetSizes};
 use macdec::algos::actor_critic::update::{update, UpdateParams, UpdateTrace};
-use macdec::algos::method::{AcActor, AcCritic, AcDesign, Method};
+use macdec::algos::family::FamilyMethod;
 use macdec::autograd::Tape;
 use macdec::nn::{Params, GRU_ACTOR_TENSOR_NAMES, STATE_CRITIC_TENSOR_NAMES};
 use rand::SeedableRng;
@@ -430,11 +431,11 @@ fn run_case(case: &str) -> String {
     let golden: Value =
         serde_json::from_slice(&std::fs::read(dir.join("golden.json")).unwrap()).unwrap();
     let alg = golden["alg"].as_str().unwrap();
-    let method = Method::ALL
-        .into_iter()
-        .find(|m| m.actor_critic().is_some_and(|d| d.reference_alg == alg))
+    let method = *AcMethod::ALL
+        .iter()
+        .find(|m| m.design().reference_alg == alg)
         .unwrap_or_else(|| panic!("no method is the reference's {alg}"));
-    let design = method.actor_critic().unwrap();
+    let design = method.design();
     let h = &golden["hyper"];
     let sizes = NetSizes {
         obs_sizes: list(&h["obs_sizes"]).iter().map(usize_of).collect(),

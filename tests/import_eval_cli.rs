@@ -6,6 +6,7 @@
 mod common;
 
 use common::{agents_arg, run, stdout_lines, weight, write_agents};
+use macdec::algos::value::method::ValueMethod;
 use macdec::deploy::drive::driver::EpisodeTrace;
 use macdec::deploy::policy::import::{reference_state_dict, Naming};
 use macdec::envs::EnvSpec;
@@ -221,17 +222,20 @@ fn bad_state_dicts_and_arguments_are_refused_and_nothing_is_written() {
 /// learner's paper defaults train with: the paper's, Box Pushing 0.98 and Warehouse 1.0 (`docs/ALGORITHMS.md` §10).
 #[test]
 fn deploys_paper_discounts_are_the_learners() {
-    use macdec::algos::method::Method;
-    use macdec::paper_defaults;
+    use macdec::algos::families::Method;
     for (spec, paper) in [
         (macdec::envs::box_pushing::paper_spec(10), 0.98),
         (macdec::envs::box_pushing::paper_spec(30), 0.98),
         (macdec::envs::warehouse::paper_spec(), 1.0),
     ] {
         assert_eq!(spec.paper_discount(), Some(paper), "{spec:?}");
-        for method in [Method::Our1, Method::CenDdrqn, Method::DecHddrqn] {
+        for method in [
+            Method::Value(ValueMethod::Our1),
+            Method::Value(ValueMethod::CenDdrqn),
+            Method::Value(ValueMethod::DecHddrqn),
+        ] {
             assert_eq!(
-                paper_defaults(&spec, method).discount(),
+                method.defaults(&spec).discount(),
                 paper,
                 "{spec:?} {method:?}"
             );

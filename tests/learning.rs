@@ -3,7 +3,8 @@
 //! Our-1, Cen-DDRQN and Dec-HDDRQN each reach a final greedy return within 5% of the optimal
 //! 80.71 in at least 4 of 5 seeds. Runs are resumable and kept in `target/learning-check/`.
 
-use macdec::algos::method::Method;
+use macdec::algos::families::Method;
+use macdec::algos::value::method::ValueMethod;
 use macdec::experiment::definition::config::{Experiment, Overrides};
 use macdec::experiment::run::metrics::{read, METRICS_FILE};
 use macdec::experiment::run::runner::{run_all, RunStatus, RunnerOptions};
@@ -17,7 +18,11 @@ const OPTIMAL_BP10: f64 = 80.71093744250365;
 fn bp10_methods_reach_the_optimum_in_four_of_five_seeds() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let overrides = Overrides {
-        methods: Some(vec![Method::Our1, Method::CenDdrqn, Method::DecHddrqn]),
+        methods: Some(vec![
+            Method::Value(ValueMethod::Our1),
+            Method::Value(ValueMethod::CenDdrqn),
+            Method::Value(ValueMethod::DecHddrqn),
+        ]),
         seeds: Some((0..5).collect()),
         set: Vec::new(),
     };
@@ -37,7 +42,11 @@ fn bp10_methods_reach_the_optimum_in_four_of_five_seeds() {
         statuses.iter().all(|s| !matches!(s, RunStatus::Failed(_))),
         "{statuses:?}"
     );
-    for method in [Method::Our1, Method::CenDdrqn, Method::DecHddrqn] {
+    for method in [
+        Method::Value(ValueMethod::Our1),
+        Method::Value(ValueMethod::CenDdrqn),
+        Method::Value(ValueMethod::DecHddrqn),
+    ] {
         let finals: Vec<f64> = runs
             .iter()
             .filter(|r| r.method == method)

@@ -3,7 +3,7 @@
 //! thread, without the GIL, waits and polls for Ctrl-C; an interrupt raises the stop signal, the runs
 //! save their checkpoints and stop, and `KeyboardInterrupt` is raised once they have.
 
-use macdec::algos::method::Method;
+use macdec::algos::families::Method;
 use macdec::experiment::definition::config::{Experiment, Overrides};
 use macdec::experiment::definition::seeds::parse_seeds;
 use macdec::experiment::run::runner::{RunStatus, RunnerOptions};

@@ -7,12 +7,12 @@
 //! training lanes act and what they record, what one training iteration and a target sync do,
 //! how its evaluated policy acts, which metrics columns it adds and which nets it saves.
 //!
-//! Adding a family is a folder under `src/algos/` with one type implementing this trait, a
-//! [`crate::algos::method::Family`] variant, and one arm in each `match` on the family (the run
-//! on disk and the checkpoint pick the loop's learner type there).
+//! Adding a family is a folder under `src/algos/` with one type implementing this trait and
+//! its methods' enum implementing [`crate::algos::family::FamilyMethod`], and one line in the
+//! list of families ([`crate::algos::families`]).
 
-use crate::algos::hyper::RunConfig;
-use crate::algos::method::Method;
+use crate::algos::families::Method;
+use crate::algos::family::FamilyConfig;
 use crate::algos::train_error::TrainError;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::QNet;
@@ -104,23 +104,27 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
     /// What the learner keeps per training lane besides the environment: hidden states, the
     /// episode being recorded, the lane's replay.
     type Lane: Clone + std::fmt::Debug + Serialize + DeserializeOwned;
+    /// The family's methods.
+    type Method: Copy + std::fmt::Debug + Into<Method>;
+    /// The family's resolved keys.
+    type Config: FamilyConfig;
 
     /// Build the nets and buffers of `method` for the domain `env` is an instance of (its sizes,
     /// horizon and first-record rule; `env` is in its reset state). Errors name the bad setting.
     fn new<E: MacroEnv>(
-        config: &RunConfig,
-        method: Method,
+        config: &Self::Config,
+        method: Self::Method,
         seed: u64,
         env: &E,
         rngs: LearnerRngs,
     ) -> Result<Self, TrainError>;
 
     /// The method being trained.
-    fn method(&self) -> Method;
+    fn method(&self) -> Self::Method;
     /// The run's seed.
     fn seed(&self) -> u64;
     /// The run's configuration.
-    fn config(&self) -> &RunConfig;
+    fn config(&self) -> &Self::Config;
 
     /// When the loop calls [`Self::train_iteration`] and [`Self::sync_targets`].
     fn schedule(&self) -> Schedule;

@@ -1,8 +1,6 @@
 //! Why a training loop stopped early: what the loop, the environments and a learner can fail with.
 
-use crate::algos::method::Method;
-use crate::algos::value::update::UpdateError;
-use crate::algos::value::ReplayError;
+use crate::algos::families::Method;
 use crate::envs::EnvError;
 
 impl TrainError {
@@ -23,12 +21,10 @@ pub enum TrainError {
     /// An environment refused a step or reset.
     #[error(transparent)]
     Env(#[from] EnvError),
-    /// The replay buffer refused a record or a sample.
+    /// A family's own machinery failed (a replay buffer refused a record, an update failed);
+    /// the family's error says what.
     #[error(transparent)]
-    Replay(#[from] ReplayError),
-    /// A value-based update failed.
-    #[error(transparent)]
-    Update(#[from] UpdateError),
+    Family(Box<dyn std::error::Error + Send + Sync>),
     /// A loss or parameter became NaN or infinite.
     #[error("{method} seed {seed}: non-finite {what} at episode {episode}")]
     NonFinite {
@@ -44,7 +40,7 @@ pub enum TrainError {
     /// The method's nets cannot be built for the domain; the text says why.
     #[error("{0}")]
     Nets(String),
-    /// The config is for the other family (value-based vs actor-critic).
+    /// The config is another family's.
     #[error("{method}: the config holds another method family's keys")]
     WrongFamily {
         /// The method asked for.

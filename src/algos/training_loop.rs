@@ -5,9 +5,8 @@
 //! The whole loop is one serializable value, so a checkpoint is the loop itself and a resumed run
 //! continues with exactly the numbers of an uninterrupted one.
 
-use crate::algos::hyper::RunConfig;
+use crate::algos::family::FamilyConfig;
 use crate::algos::learner::{Learner, LearnerRngs, SavedNets, Schedule};
-use crate::algos::method::Method;
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -109,8 +108,8 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
     /// What the learner needs to know about the domain comes from its [`MacroEnv`]
     /// implementation; the config's `env` is not read here.
     pub fn new(
-        config: &RunConfig,
-        method: Method,
+        config: &L::Config,
+        method: L::Method,
         seed: u64,
         rngs: RunRngs,
         make_env: impl Fn() -> Result<E, EnvError>,
@@ -125,7 +124,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         let plans = learner.lanes();
         if plans.len() > MAX_LANES {
             return Err(TrainError::TooManyLanes {
-                method,
+                method: method.into(),
                 asked: plans.len(),
                 available: MAX_LANES,
             });
@@ -175,12 +174,12 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
     }
 
     /// The run's configuration.
-    pub fn config(&self) -> &RunConfig {
+    pub fn config(&self) -> &L::Config {
         self.learner.config()
     }
 
     /// The method being trained.
-    pub fn method(&self) -> Method {
+    pub fn method(&self) -> L::Method {
         self.learner.method()
     }
 
@@ -400,16 +399,18 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::family::FamilyMethod;
     use crate::algos::learner::{EvalReturns, LanePlan};
+    use crate::algos::value::config::ValueConfig;
+    use crate::algos::value::method::ValueMethod;
     use crate::envs::StepOutcome;
-    use crate::experiment::definition::paper::value_paper_defaults;
     use crate::experiment::run::train_run::run_rngs;
 
     /// A learner that acts with macro-action 0 and logs when the loop calls it, so the loop's
     /// schedule can be checked apart from any method. Its second lane does not count episodes.
     #[derive(Debug, Clone, Serialize, Deserialize)]
     struct Probe {
-        config: RunConfig,
+        config: ValueConfig,
         trains: Vec<(usize, u64)>,
         syncs: u64,
         evals: u64,
@@ -418,9 +419,11 @@ mod tests {
 
     impl Learner for Probe {
         type Lane = usize;
+        type Method = ValueMethod;
+        type Config = ValueConfig;
         fn new<E: MacroEnv>(
-            config: &RunConfig,
-            _: Method,
+            config: &ValueConfig,
+            _: ValueMethod,
             _: u64,
             _: &E,
             _: LearnerRngs,
@@ -433,13 +436,13 @@ mod tests {
                 lane_steps: [0; 2],
             })
         }
-        fn method(&self) -> Method {
-            Method::Our2
+        fn method(&self) -> ValueMethod {
+            ValueMethod::Our2
         }
         fn seed(&self) -> u64 {
             0
         }
-        fn config(&self) -> &RunConfig {
+        fn config(&self) -> &ValueConfig {
             &self.config
         }
         fn schedule(&self) -> Schedule {
@@ -522,13 +525,12 @@ mod tests {
         // Box Pushing 8x8 with horizon 10 and every agent always on action 0: each episode runs
         // to the horizon, so episode k ends at main-loop step 10k - 1.
         let spec = crate::envs::box_pushing::spec(8, 10);
-        let mut config = value_paper_defaults(&spec, Method::Our2);
+        let mut config = ValueMethod::Our2.defaults(&spec);
         config.total_epi = 4;
         config.eval_freq = 2;
         config.checkpoint_freq = 3;
-        let config: RunConfig = config.into();
         let mut l: TrainingLoop<Probe, _> =
-            TrainingLoop::new(&config, Method::Our2, 0, run_rngs(0), || spec.build()).unwrap();
+            TrainingLoop::new(&config, ValueMethod::Our2, 0, run_rngs(0), || spec.build()).unwrap();
         let mut stops = Vec::new();
         while let Advance::Episode { checkpoint_due } = l.advance().unwrap() {
             stops.push((l.episodes(), checkpoint_due));

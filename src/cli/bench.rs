@@ -61,7 +61,6 @@ pub(super) fn run(args: BenchArgs) -> Result<()> {
 }
 
 fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
-    use crate::algos::method::Method;
     use crate::bench::train;
     let mut rows = Vec::new();
     for (env, method) in train::suite() {
@@ -75,26 +74,11 @@ fn bench_train(only: Option<&str>, episodes: usize) -> Result<()> {
     print!("{}", train::format_table(&rows));
     if only.is_none() {
         // Two runs on two threads should take no longer than one alone (no shared state).
-        let one = train::bench_train(
-            crate::envs::box_pushing::paper_spec(10),
-            Method::Our1,
-            episodes,
-        )?;
+        let our1: crate::algos::families::Method = "our1".parse().expect("a method");
+        let one = train::bench_train(crate::envs::box_pushing::paper_spec(10), our1, episodes)?;
         let (a, b) = rayon::join(
-            || {
-                train::bench_train(
-                    crate::envs::box_pushing::paper_spec(10),
-                    Method::Our1,
-                    episodes,
-                )
-            },
-            || {
-                train::bench_train(
-                    crate::envs::box_pushing::paper_spec(10),
-                    Method::Our1,
-                    episodes,
-                )
-            },
+            || train::bench_train(crate::envs::box_pushing::paper_spec(10), our1, episodes),
+            || train::bench_train(crate::envs::box_pushing::paper_spec(10), our1, episodes),
         );
         let (a, b) = (a?, b?);
         println!(

@@ -1,7 +1,7 @@
 //! Which runs of an experiment `train` and `slurm` select: the config file, `--methods`,
 //! `--seeds` and `--set`, resolved into an [`Experiment`].
 
-use crate::algos::method::Method;
+use crate::algos::families::Method;
 use crate::experiment::definition::config::{quick_start, Experiment, Overrides};
 use crate::experiment::definition::seeds::parse_seeds;
 use anyhow::{Context, Result};
@@ -72,6 +72,7 @@ fn overrides(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::actor_critic::method::AcMethod;
 
     fn selection(methods: Option<&str>, seeds: Option<&str>, set: &[&str]) -> Selection {
         Selection {
@@ -93,7 +94,13 @@ mod tests {
             .load()
             .unwrap();
         assert_eq!(e.name, "quickstart_bp6");
-        assert_eq!(e.methods, [Method::MacIac, Method::MacCac]);
+        assert_eq!(
+            e.methods,
+            [
+                Method::ActorCritic(AcMethod::MacIac),
+                Method::ActorCritic(AcMethod::MacCac)
+            ]
+        );
         let e = selection(Some("mac-iac"), None, &["n_env=4"])
             .load()
             .unwrap();

@@ -8,7 +8,7 @@
 
 use super::error::PlotError;
 use super::setting::EnvSetting;
-use crate::algos::method::Method;
+use crate::algos::families::Method;
 use crate::experiment::run::metrics::{self, MetricsError};
 use crate::experiment::run::provenance::Provenance;
 use crate::experiment::run::results_tree;
@@ -220,8 +220,8 @@ fn curve_dirs(results: &Path, exp_dir: &Path, notes: &mut Vec<String>) -> Vec<Pa
 fn curve_order(c: &CurveData) -> (usize, String, String) {
     let rank = c
         .method
-        .and_then(|m| Method::ALL.iter().position(|&x| x == m))
-        .unwrap_or(Method::ALL.len());
+        .and_then(|m| Method::all().iter().position(|&x| x == m))
+        .unwrap_or(Method::all().len());
     (rank, c.variant.clone(), c.name.clone())
 }
 
@@ -329,6 +329,7 @@ fn subdirs_or_note(dir: &Path, notes: &mut Vec<String>) -> Vec<PathBuf> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::algos::value::method::ValueMethod;
     use crate::envs::EnvSpec;
     use crate::experiment::definition::run_settings::RunSettings;
     use crate::experiment::run::metrics::MetricsRow;
@@ -362,7 +363,7 @@ pub(crate) mod tests {
             .collect();
         let columns = crate::algos::value::learner::METRIC_COLUMNS;
         metrics::write(&dir.join(METRICS_FILE), &columns, &rows).unwrap();
-        let config = RunSettings::paper(env, Method::Our1);
+        let config = RunSettings::paper(env, Method::Value(ValueMethod::Our1));
         std::fs::write(dir.join(CONFIG_FILE), toml::to_string(&config).unwrap()).unwrap();
         if finished {
             std::fs::write(dir.join(results_tree::FINISHED), "").unwrap();
@@ -421,11 +422,14 @@ pub(crate) mod tests {
             variant: variant.into(),
             runs: vec![],
         };
-        assert_eq!(c("our1-r", Some(Method::Our1R), "").legend(), "Our-1-R");
+        assert_eq!(
+            c("our1-r", Some(Method::Value(ValueMethod::Our1R)), "").legend(),
+            "Our-1-R"
+        );
         assert_eq!(
             c(
                 "our2@l_rate=0.001,trace_len=10",
-                Some(Method::Our2),
+                Some(Method::Value(ValueMethod::Our2)),
                 "l_rate=0.001,trace_len=10"
             )
             .legend(),

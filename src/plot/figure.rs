@@ -8,7 +8,7 @@ use super::stats::{
     run_mean_over_training, smooth, CurvePoint, Smoothing,
 };
 use super::summary::CurveSummary;
-use crate::algos::method::{Family, Method};
+use crate::algos::families::{Family, Method};
 
 /// An RGB colour.
 pub type Rgb = (u8, u8, u8);
@@ -118,20 +118,19 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
         None => exp.name.clone(),
     };
     let quantity = if metric == EVAL_RETURN {
-        // The value methods evaluate greedily; MacroMARL's actor-critic methods sample (P8).
-        let families: Vec<Family> = exp
+        // Each family says what its evaluation measures (the ICRA methods act greedily,
+        // MacroMARL's actor-critic methods sample, P8); curves of no known method are the
+        // first family's.
+        let measured: std::collections::BTreeSet<&str> = exp
             .curves
             .iter()
-            .filter_map(|c| c.method.map(Method::family))
+            .map(|c| c.method.map_or(Family::ALL[0], Method::family))
+            .map(|f| f.facts().evaluated_return)
             .collect();
-        let sampled = families.contains(&Family::ActorCritic);
-        let greedy = families.contains(&Family::Value) || families.is_empty();
-        match (greedy, sampled) {
-            (true, false) => "the greedy discounted return",
-            (false, true) => "the discounted return of sampled actions",
-            _ => "the discounted evaluation return (greedy or sampled by method)",
+        match measured.len() {
+            1 => measured.into_iter().next().unwrap_or_default().to_string(),
+            _ => "the discounted evaluation return (greedy or sampled by method)".to_string(),
         }
-        .to_string()
     } else {
         format!("`{metric}`")
     };
@@ -230,7 +229,7 @@ fn provenance_mix(exp: &ExperimentData) -> Option<String> {
 }
 
 fn method_rank(m: Method) -> usize {
-    Method::ALL.iter().position(|&x| x == m).unwrap_or(0)
+    Method::all().iter().position(|&x| x == m).unwrap_or(0)
 }
 
 /// A method's colour in every figure: its place among all methods, round the palette (the five
@@ -346,12 +345,8 @@ fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>
 mod tests {
     #[test]
     fn every_method_has_a_colour_and_each_papers_methods_differ() {
-        for family in [Family::Value, Family::ActorCritic] {
-            let colours: Vec<Rgb> = Method::ALL
-                .into_iter()
-                .filter(|m| m.family() == family)
-                .map(method_colour)
-                .collect();
+        for &family in Family::ALL {
+            let colours: Vec<Rgb> = family.methods().into_iter().map(method_colour).collect();
             for (i, c) in colours.iter().enumerate() {
                 assert!(!colours[..i].contains(c), "{family:?}: {colours:?}");
             }

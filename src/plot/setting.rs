@@ -83,11 +83,14 @@ impl EnvSetting {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::method::Method;
+    use crate::algos::actor_critic::method::AcMethod;
+    use crate::algos::families::Method;
+    use crate::algos::value::method::ValueMethod;
     use crate::experiment::definition::run_settings::RunSettings;
 
     fn setting_of(env: EnvSpec) -> EnvSetting {
-        let text = toml::to_string(&RunSettings::paper(env, Method::Our1)).unwrap();
+        let text =
+            toml::to_string(&RunSettings::paper(env, Method::Value(ValueMethod::Our1))).unwrap();
         EnvSetting::from_config_toml(&text).unwrap()
     }
 
@@ -95,10 +98,13 @@ mod tests {
     fn a_run_manifest_is_read_through_its_config_table() {
         let manifest = crate::experiment::run::train_run::RunManifest {
             experiment: "e".into(),
-            method: Method::Our1,
+            method: Method::Value(ValueMethod::Our1),
             variant: String::new(),
             seed: 3,
-            config: RunSettings::paper(crate::envs::box_pushing::paper_spec(30), Method::Our1),
+            config: RunSettings::paper(
+                crate::envs::box_pushing::paper_spec(30),
+                Method::Value(ValueMethod::Our1),
+            ),
             provenance: None,
         };
         let s = EnvSetting::from_config_toml(&toml::to_string(&manifest).unwrap()).unwrap();
@@ -125,7 +131,11 @@ mod tests {
     #[test]
     fn an_actor_critic_run_reads_its_gamma() {
         let spec = crate::envs::bp_ma_v0::spec(6, 100);
-        let text = toml::to_string(&RunSettings::paper(spec, Method::MacIaisc)).unwrap();
+        let text = toml::to_string(&RunSettings::paper(
+            spec,
+            Method::ActorCritic(AcMethod::MacIaisc),
+        ))
+        .unwrap();
         let s = EnvSetting::from_config_toml(&text).unwrap();
         assert_eq!(s.discount, 0.98);
         let optimum = s

@@ -3,6 +3,13 @@
 //! where no published experiment sets a key. The published values per domain and method are
 //! [`super::published`].
 
+use crate::algos::actor_critic::method::AcMethod;
+use crate::algos::config_checks::{
+    check_at_most, check_discount, check_positive, check_rates, check_unit, MAX_BATCH_ELEMENTS,
+    MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
+};
+use crate::algos::family::FamilyConfig;
+use crate::envs::EnvSpec;
 use serde::{Deserialize, Serialize};
 
 /// The resolved hyperparameters of one actor-critic run. Unknown keys are refused.
@@ -111,6 +118,123 @@ impl AcConfig {
 /// Environments one run may step in lockstep (published: at most 48).
 pub const MAX_N_ENV: usize = 4096;
 
+impl FamilyConfig for AcConfig {
+    fn total_epi(&self) -> usize {
+        self.total_epi
+    }
+    fn set_total_epi(&mut self, episodes: usize) {
+        self.total_epi = episodes;
+    }
+    fn checkpoint_freq(&self) -> usize {
+        self.checkpoint_freq
+    }
+    fn discount(&self) -> f64 {
+        self.gamma
+    }
+}
+
+/// MacroMARL's published settings for actor-critic `method` on `env` (`docs/MACROMARL.md` §1.4): the
+/// reference's argparse defaults, then the domain's published row for the method
+/// ([`super::published`]). A domain MacroMARL did not publish on keeps the defaults, with the
+/// discount of its paper setting when it has one.
+pub fn published_defaults(env: &EnvSpec, method: AcMethod) -> AcConfig {
+    let alg = method.design().reference_alg;
+    let mut table = toml::Table::try_from(AcConfig::reference_defaults()).expect("a table");
+    let published = crate::algos::actor_critic::published::settings(env, alg);
+    if published.is_empty() {
+        if let Some(d) = env.paper_discount() {
+            table.insert("gamma".into(), d.into());
+        }
+    }
+    for (key, value) in published {
+        assert!(
+            table.contains_key(&key),
+            "{}'s actor-critic settings name `{key}`, which is not a hyperparameter",
+            env.env_name()
+        );
+        table.insert(key, value);
+    }
+    AcConfig::deserialize(toml::Value::Table(table)).unwrap_or_else(|e| {
+        panic!(
+            "{}'s actor-critic settings do not type-check: {e}",
+            env.env_name()
+        )
+    })
+}
+
+/// The actor-critic family's range checks (see
+/// [`crate::algos::family::FamilyMethod::check`]).
+pub fn check(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+    check_positive(&[
+        ("env_terminate_step", horizon),
+        ("total_epi", c.total_epi),
+        ("n_env", c.n_env),
+        ("train_freq", c.train_freq),
+        ("c_target_update_freq", c.c_target_update_freq),
+        ("a_rnn_layer_size", c.a_rnn_layer_size),
+        ("c_rnn_layer_size", c.c_rnn_layer_size),
+        ("c_mid_layer_size", c.c_mid_layer_size),
+        ("eval_freq", c.eval_freq),
+        ("eval_num_epi", c.eval_num_epi),
+        ("checkpoint_freq", c.checkpoint_freq),
+    ])?;
+    check_sizes(c, horizon)?;
+    check_unit(&[
+        ("gamma", c.gamma),
+        ("eps_start", c.eps_start),
+        ("eps_end", c.eps_end),
+    ])?;
+    check_discount("gamma", c.gamma)?;
+    check_rates(&[("a_lr", c.a_lr), ("c_lr", c.c_lr)])
+}
+
+/// Check an actor-critic config's sizes against the bounds above and [`MAX_N_ENV`], for a
+/// domain whose episodes last at most `horizon` primitive steps. Returns the key and why.
+fn check_sizes(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+    check_at_most(&[
+        ("env_terminate_step", horizon, MAX_HORIZON),
+        ("total_epi", c.total_epi, MAX_TOTAL_EPI),
+        ("eval_num_epi", c.eval_num_epi, MAX_EVAL_NUM_EPI),
+        ("n_env", c.n_env, MAX_N_ENV),
+        ("train_freq", c.train_freq, MAX_N_ENV * 16),
+        ("n_step_TD", c.n_step_td, MAX_HORIZON),
+        ("a_rnn_layer_size", c.a_rnn_layer_size, MAX_NET_WIDTH),
+        ("c_rnn_layer_size", c.c_rnn_layer_size, MAX_NET_WIDTH),
+        ("c_mid_layer_size", c.c_mid_layer_size, MAX_NET_WIDTH),
+    ])?;
+    for (key, sizes) in [
+        ("a_mlp_layer_size", &c.a_mlp_layer_size),
+        ("c_mlp_layer_size", &c.c_mlp_layer_size),
+    ] {
+        if sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH) {
+            return Err((
+                key,
+                format!(
+                    "must be two widths [before, after] the recurrent layer, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
+                ),
+            ));
+        }
+    }
+    // One update's batch activations: train_freq episodes x horizon x the widest layer (x3,
+    // the GRU's gates).
+    let widest = [c.a_rnn_layer_size, c.c_rnn_layer_size, c.c_mid_layer_size]
+        .into_iter()
+        .chain(c.a_mlp_layer_size.iter().copied())
+        .chain(c.c_mlp_layer_size.iter().copied())
+        .max()
+        .unwrap_or(1) as u128;
+    let elements = c.train_freq as u128 * horizon as u128 * widest * 3;
+    if elements > MAX_BATCH_ELEMENTS {
+        return Err((
+            "train_freq",
+            format!(
+                "train_freq x env_terminate_step x the widest layer is {elements} activations, beyond {MAX_BATCH_ELEMENTS}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +252,58 @@ mod tests {
         assert!((c.eps_at(2000) - 0.505).abs() < 1e-12);
         assert_eq!(c.eps_at(4000), 0.01);
         assert_eq!(c.eps_at(9000), 0.01);
+    }
+
+    #[test]
+    fn every_actor_critic_method_has_published_settings_on_macromarls_domains() {
+        use crate::algos::family::FamilyMethod;
+        for &method in AcMethod::ALL {
+            for grid in [6, 8, 10, 12, 14] {
+                let c = published_defaults(&crate::envs::bp_ma_v0::spec(grid, 100), method);
+                assert_eq!(
+                    (c.gamma, c.total_epi),
+                    (0.98, 40_000),
+                    "{method:?} bp{grid}"
+                );
+            }
+            let bp6 = published_defaults(&crate::envs::bp_ma_v0::spec(6, 100), method);
+            // Published rows differ from the argparse defaults (a_lr 1e-4) everywhere.
+            assert_ne!(bp6.a_lr, 1e-4, "{method:?}");
+            for id in [
+                "OSD-D-v7",
+                "OSD-T-v0",
+                "OSD-T-v1",
+                "OSD-F-v0",
+                "Overcooked-MA-v1",
+            ] {
+                let spec = crate::envs::EnvSpec::new(id, &toml::Table::new()).unwrap();
+                let c = published_defaults(&spec, method);
+                assert!(c.gamma == 1.0 || c.gamma == 0.99, "{method:?} {id}");
+                assert_eq!(c.n_env, c.train_freq, "{method:?} {id}");
+            }
+        }
+        // BP 12x12 Mac-IAC: 8 environments, 16 episodes per update.
+        let c = published_defaults(&crate::envs::bp_ma_v0::spec(12, 100), AcMethod::MacIac);
+        assert_eq!((c.n_env, c.train_freq, c.n_step_td), (8, 16, 3));
+        // An ICRA domain keeps the defaults with its discount.
+        let c = published_defaults(&crate::envs::box_pushing::paper_spec(10), AcMethod::MacIac);
+        assert_eq!((c.gamma, c.a_lr), (0.98, 1e-4));
+    }
+
+    #[test]
+    fn actor_critic_bad_values_name_their_key() {
+        let mut c = AcConfig::reference_defaults();
+        assert!(check(&c, 100).is_ok());
+        c.a_mlp_layer_size = vec![32];
+        assert_eq!(check(&c, 100).unwrap_err().0, "a_mlp_layer_size");
+        c = AcConfig::reference_defaults();
+        c.gamma = 1.5;
+        assert_eq!(check(&c, 100).unwrap_err().0, "gamma");
+        c = AcConfig::reference_defaults();
+        c.n_env = 0;
+        assert_eq!(check(&c, 100).unwrap_err().0, "n_env");
+        c = AcConfig::reference_defaults();
+        c.c_lr = f64::NAN;
+        assert_eq!(check(&c, 100).unwrap_err().0, "c_lr");
     }
 }

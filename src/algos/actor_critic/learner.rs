@@ -1,7 +1,7 @@
 //! The actor-critic family as the training loop drives it (`docs/MACROMARL.md` §2): n_env lanes
 //! stepped in lockstep, an on-policy batch of the last `train_freq` completed episodes, one
 //! update per batch, sampled evaluation on n_env environments. Where the six methods differ,
-//! [`Method::actor_critic`]'s design decides.
+//! [`AcMethod::design`] decides.
 
 use std::collections::VecDeque;
 
@@ -11,11 +11,10 @@ use serde::{Deserialize, Serialize};
 use super::acting::{act_centralized, act_decentralized};
 use super::config::AcConfig;
 use super::episode::{Episode, EpisodeRecorder};
+use super::method::{AcActor, AcCritic, AcDesign, AcMethod};
 use super::nets::{AcNets, NetSizes};
 use super::update::{update, UpdateParams, UpdateTrace};
-use crate::algos::hyper::RunConfig;
 use crate::algos::learner::{EvalReturns, LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
-use crate::algos::method::{AcActor, AcCritic, AcDesign, Method};
 use crate::algos::training_loop::TrainError;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -36,8 +35,8 @@ pub struct AcLane {
 /// The nets, the on-policy batch and the learner-side random stream of an actor-critic run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct AcLearner {
-    config: RunConfig,
-    method: Method,
+    config: AcConfig,
+    method: AcMethod,
     seed: u64,
     sizes: NetSizes,
     nets: AcNets,
@@ -66,18 +65,14 @@ impl Clone for TapeCell {
 }
 
 impl AcLearner {
-    /// The family's keys (an actor-critic learner is only built from them).
+    /// The run's keys.
     fn c(&self) -> &AcConfig {
-        self.config
-            .actor_critic()
-            .expect("an actor-critic learner is built from an actor-critic config")
+        &self.config
     }
 
     /// The method's actor and critic.
     fn design(&self) -> AcDesign {
-        self.method
-            .actor_critic()
-            .expect("an actor-critic learner trains an actor-critic method")
+        self.method.design()
     }
 
     fn update_params(&self) -> UpdateParams {
@@ -158,26 +153,23 @@ impl AcLearner {
     }
 
     fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
-        TrainError::non_finite(self.method, self.seed, what, episodes)
+        TrainError::non_finite(self.method.into(), self.seed, what, episodes)
     }
 }
 
 impl Learner for AcLearner {
     type Lane = AcLane;
+    type Method = AcMethod;
+    type Config = AcConfig;
 
     fn new<E: MacroEnv>(
-        run_config: &RunConfig,
-        method: Method,
+        config: &AcConfig,
+        method: AcMethod,
         seed: u64,
         env: &E,
         mut rngs: LearnerRngs,
     ) -> Result<Self, TrainError> {
-        let config = run_config
-            .actor_critic()
-            .ok_or(TrainError::WrongFamily { method })?;
-        let design = method
-            .actor_critic()
-            .ok_or(TrainError::WrongFamily { method })?;
+        let design = method.design();
         let needs_state = matches!(design.critic, AcCritic::JointState | AcCritic::AgentState);
         let sizes = NetSizes {
             obs_sizes: env.obs_sizes().to_vec(),
@@ -187,7 +179,7 @@ impl Learner for AcLearner {
         let nets = AcNets::new(design, config, &sizes, &mut rngs.init)
             .map_err(|e| TrainError::Nets(e.to_string()))?;
         Ok(AcLearner {
-            config: run_config.clone(),
+            config: config.clone(),
             method,
             seed,
             sizes,
@@ -204,7 +196,7 @@ impl Learner for AcLearner {
         })
     }
 
-    fn method(&self) -> Method {
+    fn method(&self) -> AcMethod {
         self.method
     }
 
@@ -212,7 +204,7 @@ impl Learner for AcLearner {
         self.seed
     }
 
-    fn config(&self) -> &RunConfig {
+    fn config(&self) -> &AcConfig {
         &self.config
     }
 

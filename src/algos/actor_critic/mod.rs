@@ -11,6 +11,7 @@ pub mod acting;
 pub mod config;
 pub mod episode;
 pub mod learner;
+pub mod method;
 pub mod nets;
 pub mod published;
 pub mod returns;

@@ -5,7 +5,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::config::AcConfig;
-use crate::algos::method::{AcActor, AcCritic, AcDesign};
+use crate::algos::actor_critic::method::{AcActor, AcCritic, AcDesign};
 use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig, Params, StateCritic};
 
 /// A critic's net: on observation histories (the actor's layers, one output) or on the state.

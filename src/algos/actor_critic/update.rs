@@ -10,7 +10,7 @@ use super::episode::Episode;
 use super::nets::{AcNets, CriticNet};
 use super::returns::{discount_at, macro_returns, MacroSequence};
 use super::squeeze::Squeezed;
-use crate::algos::method::{AcActor, AcCritic, AcDesign};
+use crate::algos::actor_critic::method::{AcActor, AcCritic, AcDesign};
 use crate::autograd::{SeqPacking, Tape, Var};
 use crate::nn::{GruActor, StateCritic};
 

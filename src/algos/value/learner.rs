@@ -1,13 +1,13 @@
 //! The value-based family as the training loop drives it: the five ICRA methods' nets,
 //! exploration, replay, training iteration and evaluated policy (`docs/ALGORITHMS.md` §4-7).
-//! Where the methods differ, [`Method`]'s exhaustive `match`es decide.
+//! Where the methods differ, [`ValueMethod`]'s exhaustive `match`es decide.
 
-use crate::algos::hyper::{RunConfig, ValueConfig};
 use crate::algos::learner::{EvalReturns, LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
-use crate::algos::method::{EvaluatedPolicy, Exploration, HysteresisRule, Method};
 use crate::algos::training_loop::TrainError;
 use crate::algos::value::acting::{select_cen, select_dec, ActScratch, Explore};
+use crate::algos::value::config::ValueConfig;
 use crate::algos::value::evaluate::{evaluate, GreedyPolicy};
+use crate::algos::value::method::{EvaluatedPolicy, Exploration, HysteresisRule, ValueMethod};
 use crate::algos::value::record::Layout;
 use crate::algos::value::recorder::Recorder;
 use crate::algos::value::replay::ReplayBuffer;
@@ -43,8 +43,8 @@ pub struct ValueLane {
 /// The nets, schedules and learner-side random streams of a value-based run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ValueLearner {
-    config: RunConfig,
-    method: Method,
+    config: ValueConfig,
+    method: ValueMethod,
     seed: u64,
     layout: Layout,
     /// The horizon, for sizing each lane's recorder.
@@ -62,11 +62,9 @@ pub struct ValueLearner {
 }
 
 impl ValueLearner {
-    /// The value family's keys (a value learner is only built from a value config).
+    /// The run's keys.
     fn c(&self) -> &ValueConfig {
-        self.config
-            .value()
-            .expect("a value learner is built from a value config")
+        &self.config
     }
 
     /// The current exploration rate.
@@ -94,23 +92,22 @@ impl ValueLearner {
     }
 
     fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
-        TrainError::non_finite(self.method, self.seed, what, episodes)
+        TrainError::non_finite(self.method.into(), self.seed, what, episodes)
     }
 }
 
 impl Learner for ValueLearner {
     type Lane = ValueLane;
+    type Method = ValueMethod;
+    type Config = ValueConfig;
 
     fn new<E: MacroEnv>(
-        run_config: &RunConfig,
-        method: Method,
+        config: &ValueConfig,
+        method: ValueMethod,
         seed: u64,
         env: &E,
         mut rngs: LearnerRngs,
     ) -> Result<Self, TrainError> {
-        let config = run_config
-            .value()
-            .ok_or(TrainError::WrongFamily { method })?;
         let layout = Layout::of_env(env)?;
         let dec: Vec<Nets> = if method.has_dec_nets() {
             (0..layout.n_agents())
@@ -138,7 +135,7 @@ impl Learner for ValueLearner {
         });
         Ok(ValueLearner {
             h: hysteresis_rule(config).initial(),
-            config: run_config.clone(),
+            config: config.clone(),
             method,
             seed,
             layout,
@@ -154,7 +151,7 @@ impl Learner for ValueLearner {
         })
     }
 
-    fn method(&self) -> Method {
+    fn method(&self) -> ValueMethod {
         self.method
     }
 
@@ -162,7 +159,7 @@ impl Learner for ValueLearner {
         self.seed
     }
 
-    fn config(&self) -> &RunConfig {
+    fn config(&self) -> &ValueConfig {
         &self.config
     }
 

@@ -13,9 +13,11 @@
 pub mod acting;
 pub mod batch;
 pub mod cond_argmax;
+pub mod config;
 pub mod episode_buffer;
 pub mod evaluate;
 pub mod learner;
+pub mod method;
 pub mod published;
 pub mod record;
 pub mod recorder;
@@ -87,4 +89,17 @@ pub enum ReplayError {
     /// A restored buffer state that disagrees with itself; the text says what.
     #[error("inconsistent replay state: {0}")]
     Corrupt(String),
+}
+
+/// The value family's errors reach the training loop as [`crate::algos::train_error::TrainError::Family`].
+impl From<ReplayError> for crate::algos::train_error::TrainError {
+    fn from(e: ReplayError) -> Self {
+        crate::algos::train_error::TrainError::Family(Box::new(e))
+    }
+}
+
+impl From<update::UpdateError> for crate::algos::train_error::TrainError {
+    fn from(e: update::UpdateError) -> Self {
+        crate::algos::train_error::TrainError::Family(Box::new(e))
+    }
 }

@@ -5,8 +5,8 @@
 //! with the just-updated centralized net (Our-1, Our-2; quirk Q2); C, one TD step per agent, whose
 //! target action comes from B or from the agent's own double-Q selection.
 
-use crate::algos::method::{DecTargetAction, Method};
 use crate::algos::value::cond_argmax::{cond_argmax_rows, unravel_component, CondArgmaxError};
+use crate::algos::value::method::{DecTargetAction, ValueMethod};
 use crate::algos::value::record::Layout;
 use crate::algos::value::replay::Batch;
 use crate::algos::value::squeeze::{
@@ -82,7 +82,7 @@ impl Nets {
 #[derive(Debug, Clone, Copy)]
 pub struct IterationParams {
     /// The method, which decides targets and losses.
-    pub method: Method,
+    pub method: ValueMethod,
     /// Discount per macro-transition in the targets (quirk Q5).
     pub discount: f32,
     /// Current hysteresis h (`docs/ALGORITHMS.md` §5.6), applied where the method says.
@@ -384,6 +384,7 @@ pub enum UpdateError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::family::FamilyMethod;
     use crate::algos::value::record::{Episode, RecordRef};
     use crate::algos::value::replay::Sequence;
     use crate::algos::value::squeeze::squeeze_agent;
@@ -509,15 +510,15 @@ mod tests {
             vec![-1.0 + 0.9 * 4.0, -1.0]
         );
         assert_eq!(
-            Method::DecHddrqn.dec_target_action(),
+            ValueMethod::DecHddrqn.dec_target_action(),
             Some(DecTargetAction::OwnDoubleQ)
         );
         assert_eq!(
-            Method::Our1R.dec_target_action(),
+            ValueMethod::Our1R.dec_target_action(),
             Some(DecTargetAction::OwnDoubleQ)
         );
         assert_eq!(
-            Method::Our2.dec_target_action(),
+            ValueMethod::Our2.dec_target_action(),
             Some(DecTargetAction::CenCondArgmax)
         );
     }
@@ -540,7 +541,7 @@ mod tests {
         };
         let dec: Vec<Nets> = (0..2).map(|_| net(1, 2, &mut rng)).collect();
         let cen = net(2, 4, &mut rng);
-        for method in Method::ALL {
+        for &method in ValueMethod::ALL {
             let p = IterationParams {
                 method,
                 discount: 0.9,
@@ -556,16 +557,16 @@ mod tests {
             let (traced, trace) =
                 train_iteration_traced(p, &layout, &mut d2, use_cen.then_some(&mut c2), &b, &b)
                     .unwrap();
-            assert_eq!(plain, traced, "{method}");
-            assert_eq!(trace.cen.is_some(), use_cen, "{method}");
+            assert_eq!(plain, traced, "{method:?}");
+            assert_eq!(trace.cen.is_some(), use_cen, "{method:?}");
             for (x, y) in d1.iter().chain([&c1]).zip(d2.iter().chain([&c2])) {
                 for name in TENSOR_NAMES {
                     let (a, b) = (x.policy.params.get(name), y.policy.params.get(name));
-                    assert_eq!(a, b, "{method} {name}");
+                    assert_eq!(a, b, "{method:?} {name}");
                 }
             }
             let stepped = trace.dec.iter().flatten().count() + usize::from(trace.cen.is_some());
-            assert_eq!(stepped, plain.steps, "{method}");
+            assert_eq!(stepped, plain.steps, "{method:?}");
         }
     }
 

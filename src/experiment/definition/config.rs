@@ -6,8 +6,7 @@
 //! chosen domain and method (`docs/ALGORITHMS.md` §10): `env_name = "BP_MA"` alone is Figure 4a's
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
-use crate::algos::hyper::{AcConfig, RunConfig, ValueConfig};
-use crate::algos::method::{Family, Method};
+use crate::algos::families::{Family, Method, RunConfig};
 use crate::envs::EnvSpec;
 use crate::experiment::definition::limits;
 use crate::experiment::definition::names::{check_curve_name, check_experiment_name, NameError};
@@ -37,13 +36,18 @@ pub enum ConfigError {
         /// The TOML parser's reason.
         message: String,
     },
-    /// A key no config knows (a typo, or a flag the reference does not have).
-    #[error("{path}: unknown key `{key}` (keys are the reference's flag names, e.g. total_epi, trace_len, l_rate)")]
+    /// A key the method's family and the domain do not have (a typo, a flag the reference does
+    /// not have, or another family's key).
+    #[error("{path}: unknown key `{key}` for {method} ({hint})")]
     UnknownKey {
         /// The experiment file.
         path: PathBuf,
         /// The key, as written.
         key: String,
+        /// The method whose config was being resolved.
+        method: Method,
+        /// The nearest keys of the method's own family and domain, or which family has the key.
+        hint: String,
     },
     /// A known key with a value of the wrong type or out of range.
     #[error("{path}: `{key}`: {message}")]
@@ -215,64 +219,45 @@ pub struct Overrides {
     pub set: Vec<String>,
 }
 
-/// The embedded default experiment: a short Box Pushing 10x10 Our-1 run for the README's first
-/// command (a few minutes on two cores).
-pub const DEFAULT_EXPERIMENT: &str = r#"
-name = "quickstart_bp10"
-methods = ["our1"]
-seeds = "0..2"
+/// The embedded default experiment, the README's first command: the first family's quick
+/// start (a short Box Pushing 10x10 Our-1 run, a few minutes on two cores).
+pub fn default_experiment() -> (&'static str, &'static str) {
+    let facts = Family::ALL[0].facts();
+    (facts.quick_start, facts.quick_start_name)
+}
 
-[params]
-env_name = "BP_MA"
-grid_dim = 10
-total_epi = 1500
-eps_l_d_steps = 1000
-"#;
-
-/// The embedded quick start of the actor-critic family, which `macdec train --methods
-/// <actor-critic methods>` without `--config` trains: MacroMARL's published Box Pushing 6x6
-/// block (40 000 episodes, seconds per run) with Mac-IAISC, the method that most often reaches
-/// the optimum there, two seeds.
-pub const AC_QUICK_START: &str = r#"
-name = "quickstart_bp6"
-methods = ["mac-iaisc"]
-seeds = "0..2"
-
-[params]
-env_name = "BP-MA-v0"
-grid_dim = [6, 6]
-env_terminate_step = 100
-"#;
+/// The method an experiment file without `methods` trains (the ICRA paper's Our-1).
+pub const DEFAULT_METHOD: &str = "our1";
 
 /// The built-in experiment (text, name) `train` runs without `--config` for these `--methods`:
-/// the value family's [`DEFAULT_EXPERIMENT`] (also without `--methods`), the actor-critic
-/// family's [`AC_QUICK_START`]; methods of both families have no common quick start, and the
-/// error says which methods belong to which and where the experiment files are.
+/// their family's quick start ([`crate::algos::family::FamilyFacts::quick_start`]; the default
+/// experiment without `--methods`). Methods of several families have no common quick start: the
+/// error lists each family's methods and says where the experiment files are.
 pub fn quick_start(methods: Option<&[Method]>) -> Result<(&'static str, &'static str), String> {
-    let families: std::collections::BTreeSet<bool> = methods
-        .unwrap_or(&[])
-        .iter()
-        .map(|m| m.family() == Family::ActorCritic)
-        .collect();
-    match (families.contains(&false), families.contains(&true)) {
-        (_, false) => Ok((DEFAULT_EXPERIMENT, "quickstart_bp10")),
-        (false, true) => Ok((AC_QUICK_START, "quickstart_bp6")),
-        (true, true) => {
-            let of = |ac: bool| {
-                Method::ALL
-                    .iter()
-                    .filter(|m| (m.family() == Family::ActorCritic) == ac)
-                    .map(|m| m.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
+    let families: std::collections::BTreeSet<Family> =
+        methods.unwrap_or(&[]).iter().map(|m| m.family()).collect();
+    let mut families = families.into_iter();
+    match (families.next(), families.next()) {
+        (None, _) => Ok(default_experiment()),
+        (Some(f), None) => Ok((f.facts().quick_start, f.facts().quick_start_name)),
+        (Some(_), Some(_)) => {
+            let lists: Vec<String> = Family::ALL
+                .iter()
+                .map(|f| {
+                    let names: Vec<&str> = f.methods().iter().map(|m| m.name()).collect();
+                    format!(
+                        "{} ({}: {})",
+                        f.facts().description,
+                        f.facts().quick_start_name,
+                        names.join(", ")
+                    )
+                })
+                .collect();
             Err(format!(
-                "without --config, train runs one family's quick start: the ICRA methods' \
-                 (Box Pushing 10x10: {}) or the actor-critic methods' (MacroMARL's Box Pushing \
-                 6x6: {}); name methods of one family, or pass --config (e.g. \
-                 experiments/macromarl/bp6.toml, whose domain both families train on)",
-                of(false),
-                of(true)
+                "without --config, train runs one family's quick start; name methods of one \
+                 family: {}; or pass --config (e.g. experiments/macromarl/bp6.toml, whose domain \
+                 both families train on)",
+                lists.join("; ")
             ))
         }
     }
@@ -329,7 +314,7 @@ impl Experiment {
         let methods = match (&overrides.methods, &listed) {
             (Some(m), _) => m.clone(),
             (None, Some(l)) => l.clone(),
-            (None, None) => vec![Method::Our1],
+            (None, None) => vec![DEFAULT_METHOD.parse().expect("the default method exists")],
         };
         if methods.is_empty() {
             return Err(ConfigError::NoMethods { path: p() });
@@ -575,12 +560,12 @@ fn list_valued_keys(table: &toml::Table) -> std::collections::HashMap<String, us
         Some(toml::Value::Array(items)) => items.iter().filter_map(|v| v.as_str()).collect(),
         _ => vec!["BP_MA"],
     };
-    // The actor-critic MLP widths are a list by nature for every domain.
-    let mut depths: std::collections::HashMap<String, usize> =
-        crate::algos::actor_critic::config::LIST_KEYS
-            .iter()
-            .map(|k| (k.to_string(), 1))
-            .collect();
+    // A family's list keys (the actor-critic MLP widths) are lists by nature for every domain.
+    let mut depths: std::collections::HashMap<String, usize> = Family::ALL
+        .iter()
+        .flat_map(|f| f.facts().list_keys)
+        .map(|k| (k.to_string(), 1))
+        .collect();
     for name in names {
         let Ok(domain) = crate::envs::registry::lookup(name) else {
             continue; // resolve names the bad env_name
@@ -711,6 +696,8 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
             return Err(ConfigError::UnknownKey {
                 path: p(),
                 key: key.clone(),
+                method,
+                hint: unknown_key_hint(key, method, &defaults.env, &table),
             });
         }
         // Accept integers where floats are expected (`l_rate = 1` means 1.0).
@@ -733,9 +720,7 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
         }
         table.insert(key.clone(), value);
     }
-    let config: RunSettings = toml::Value::Table(table.clone())
-        .try_into()
-        .map_err(|e: toml::de::Error| bad("config", e.message().to_string()))?;
+    let config = RunSettings::from_table(method, table.clone()).map_err(|e| bad("config", e))?;
     // Bad values first, so `l_rate = nan` is named as a bad value, not as an unused key.
     validate(&config.config, method, config.env.horizon())
         .map_err(|(key, message)| bad(key, message))?;
@@ -757,6 +742,76 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
     Ok(config)
 }
 
+/// What to say of `key`, which neither `method`'s family nor the domain has: the closest of
+/// `known` (the run's keys: the family's and the domain's), and the family whose key it is when
+/// it belongs to another one (`l_rate` for an actor-critic method).
+fn unknown_key_hint(key: &str, method: Method, env: &EnvSpec, known: &toml::Table) -> String {
+    let family = method.family().facts();
+    let mut hint = String::new();
+    if let Some(near) = closest_key(key, known.keys().map(String::as_str)) {
+        hint.push_str(&format!("did you mean `{near}`? "));
+    }
+    let owner = Family::ALL
+        .iter()
+        .filter(|&&f| f != method.family())
+        .find(|f| f.methods()[0].defaults(env).to_table().contains_key(key));
+    if let Some(other) = owner {
+        hint.push_str(&format!(
+            "`{key}` is a key of {} ({}), not of {}; ",
+            other.facts().description,
+            other
+                .methods()
+                .iter()
+                .map(|m| m.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+            family.description
+        ));
+    }
+    let examples: Vec<String> = method
+        .defaults(env)
+        .to_table()
+        .keys()
+        .take(6)
+        .cloned()
+        .collect();
+    hint.push_str(&format!(
+        "{method} takes the keys of {}, e.g. {}",
+        family.description,
+        examples.join(", ")
+    ));
+    hint
+}
+
+/// The key of `known` nearest to `key` by edit distance, if it is within a third of the key's
+/// length (a typo), or one contains the other (`lr` for `a_lr`).
+fn closest_key<'a>(key: &str, known: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let limit = key.chars().count().div_ceil(3);
+    known
+        .map(|k| (edit_distance(key, k), k))
+        .filter(|&(d, k)| d <= limit || (key.len() >= 2 && (k.contains(key) || key.contains(k))))
+        .min()
+        .map(|(_, k)| k)
+}
+
+/// Levenshtein distance over characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (prev + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            prev = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
 /// Whether a recorded value is the one given: equal, or both the same NaN (which `==` never
 /// calls equal, so a NaN would read as a key the domain drops).
 fn same_value(recorded: &toml::Value, given: &toml::Value) -> bool {
@@ -767,143 +822,21 @@ fn same_value(recorded: &toml::Value, given: &toml::Value) -> bool {
 }
 
 /// Range checks that types cannot express, for a domain whose episodes last at most `horizon`
-/// primitive steps. Returns the offending key and why. The library entry point [`crate::train`]
-/// runs them too, so a config built in code is held to the same rules.
+/// primitive steps: the method's family's ([`Method::check`]). Returns the offending key and
+/// why. The library entry point [`crate::train`] runs them too, so a config built in code is held
+/// to the same rules.
 pub fn validate(
     c: &RunConfig,
     method: Method,
     horizon: usize,
 ) -> Result<(), (&'static str, String)> {
-    match (c, method.family()) {
-        (RunConfig::Value(v), Family::Value) => validate_value(v, method, horizon),
-        (RunConfig::ActorCritic(a), Family::ActorCritic) => validate_actor_critic(a, horizon),
-        _ => Err((
-            "config",
-            format!("{method} needs its own family's keys; this config holds the other family's"),
-        )),
-    }
-}
-
-/// [`validate`] for a value method's keys.
-fn validate_value(
-    c: &ValueConfig,
-    method: Method,
-    horizon: usize,
-) -> Result<(), (&'static str, String)> {
-    check_positive(&[
-        ("env_terminate_step", horizon),
-        ("total_epi", c.total_epi),
-        ("replay_buffer_size", c.replay_buffer_size),
-        ("h_stable_at", c.h_stable_at),
-        ("eps_l_d_steps", c.eps_l_d_steps),
-        ("train_freq", c.train_freq),
-        ("target_update_freq", c.target_update_freq),
-        ("trace_len", c.trace_len),
-        ("sub_trace_len", c.sub_trace_len),
-        ("batch_size", c.batch_size),
-        ("dec_mlp_layer_size", c.dec_mlp_layer_size),
-        ("dec_rnn_h_size", c.dec_rnn_h_size),
-        ("cen_mlp_layer_size", c.cen_mlp_layer_size),
-        ("cen_rnn_h_size", c.cen_rnn_h_size),
-        ("eval_freq", c.eval_freq),
-        ("eval_num_epi", c.eval_num_epi),
-        ("checkpoint_freq", c.checkpoint_freq),
-    ])?;
-    if c.start_train == 0 {
-        return Err((
-            "start_train",
-            "must be >= 1: training starts once an episode has been collected".into(),
-        ));
-    }
-    if !c.total_epi.is_multiple_of(c.eval_freq) {
-        return Err((
-            "total_epi",
-            format!(
-                "must be a multiple of eval_freq ({}), got {}: the last {} episodes would never be evaluated",
-                c.eval_freq,
-                c.total_epi,
-                c.total_epi % c.eval_freq
-            ),
-        ));
-    }
-    limits::check_sizes(c, horizon)?;
-    check_unit(&[
-        ("eps_end", c.eps_end),
-        ("discount", c.discount),
-        ("init_h", c.init_h),
-        ("end_h", c.end_h),
-    ])?;
-    if c.discount == 0.0 {
-        // Evaluation returns and exported policies need a positive discount.
-        return Err(("discount", "must be in (0, 1], got 0".into()));
-    }
-    check_rates(&[("l_rate", c.l_rate)])?;
-    if method.requires_episode_buffer() && !c.sample_epi {
-        // `docs/ALGORITHMS.md` Q10: the reference's windowed path for Our-2 crashes; we keep Our-2 episode-based.
-        return Err((
-            "sample_epi",
-            "our2 needs the episode buffer (sample_epi = true), as in the reference (`docs/ALGORITHMS.md` Q10)"
-                .into(),
-        ));
-    }
-    Ok(())
-}
-
-/// [`validate`] for an actor-critic method's keys.
-fn validate_actor_critic(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
-    check_positive(&[
-        ("env_terminate_step", horizon),
-        ("total_epi", c.total_epi),
-        ("n_env", c.n_env),
-        ("train_freq", c.train_freq),
-        ("c_target_update_freq", c.c_target_update_freq),
-        ("a_rnn_layer_size", c.a_rnn_layer_size),
-        ("c_rnn_layer_size", c.c_rnn_layer_size),
-        ("c_mid_layer_size", c.c_mid_layer_size),
-        ("eval_freq", c.eval_freq),
-        ("eval_num_epi", c.eval_num_epi),
-        ("checkpoint_freq", c.checkpoint_freq),
-    ])?;
-    limits::check_actor_critic_sizes(c, horizon)?;
-    check_unit(&[
-        ("gamma", c.gamma),
-        ("eps_start", c.eps_start),
-        ("eps_end", c.eps_end),
-    ])?;
-    if c.gamma == 0.0 {
-        // Evaluation returns and exported policies need a positive discount.
-        return Err(("gamma", "must be in (0, 1], got 0".into()));
-    }
-    check_rates(&[("a_lr", c.a_lr), ("c_lr", c.c_lr)])
-}
-
-/// Every count named must be at least 1.
-fn check_positive(counts: &[(&'static str, usize)]) -> Result<(), (&'static str, String)> {
-    match counts.iter().find(|(_, v)| *v == 0) {
-        Some((key, _)) => Err((key, "must be > 0, got 0".into())),
-        None => Ok(()),
-    }
-}
-
-/// Every value named must lie in [0, 1].
-fn check_unit(values: &[(&'static str, f64)]) -> Result<(), (&'static str, String)> {
-    match values.iter().find(|(_, v)| !(0.0..=1.0).contains(v)) {
-        Some((key, v)) => Err((key, format!("must be in [0, 1], got {v}"))),
-        None => Ok(()),
-    }
-}
-
-/// Every learning rate named must be a positive number.
-fn check_rates(rates: &[(&'static str, f64)]) -> Result<(), (&'static str, String)> {
-    match rates.iter().find(|(_, lr)| !(*lr > 0.0 && lr.is_finite())) {
-        Some((key, lr)) => Err((key, format!("must be a positive number, got {lr}"))),
-        None => Ok(()),
-    }
+    method.check(c, horizon)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::value::method::ValueMethod;
 
     fn parse(text: &str, set: &[&str]) -> Result<Experiment, ConfigError> {
         let o = Overrides {
@@ -916,7 +849,11 @@ mod tests {
     #[test]
     fn env_name_alone_gives_the_papers_bp10_setting() {
         let e = parse("methods = [\"our1\"]\n[params]\nenv_name = \"BP_MA\"", &[]).unwrap();
-        let c = e.runs().unwrap()[0].config.value().unwrap().clone();
+        let c = e.runs().unwrap()[0]
+            .config
+            .of::<ValueMethod>()
+            .unwrap()
+            .clone();
         assert_eq!((c.total_epi, c.trace_len, c.batch_size), (15000, 15, 128));
         assert_eq!((c.dec_rnn_h_size, c.cen_rnn_h_size), (32, 64));
         assert!(c.cen_explore && !c.h_explore && !c.sample_epi);
@@ -929,15 +866,15 @@ mod tests {
         let runs = e.runs().unwrap();
         assert_eq!(
             (
-                runs[0].config.value().unwrap().init_h,
-                runs[0].config.value().unwrap().end_h
+                runs[0].config.of::<ValueMethod>().unwrap().init_h,
+                runs[0].config.of::<ValueMethod>().unwrap().end_h
             ),
             (0.2, 0.4)
         );
         assert_eq!(
             (
-                runs[1].config.value().unwrap().init_h,
-                runs[1].config.value().unwrap().end_h
+                runs[1].config.of::<ValueMethod>().unwrap().init_h,
+                runs[1].config.of::<ValueMethod>().unwrap().end_h
             ),
             (1.0, 1.0)
         );
@@ -950,7 +887,11 @@ mod tests {
             &["total_epi=300", "our1.l_rate=0.01"],
         )
         .unwrap();
-        let c = e.runs().unwrap()[0].config.value().unwrap().clone();
+        let c = e.runs().unwrap()[0]
+            .config
+            .of::<ValueMethod>()
+            .unwrap()
+            .clone();
         assert_eq!(c.total_epi, 300);
         assert_eq!(c.l_rate, 0.01);
     }
@@ -1000,7 +941,7 @@ mod tests {
             .iter()
             .find(|r| r.variant == "l_rate=0.01,trace_len=10")
             .unwrap();
-        let c = r.config.value().unwrap();
+        let c = r.config.of::<ValueMethod>().unwrap();
         assert_eq!((c.trace_len, c.l_rate), (10, 0.01));
     }
 
@@ -1011,7 +952,11 @@ mod tests {
             &[],
         )
         .unwrap();
-        let c = e.runs().unwrap()[0].config.value().unwrap().clone();
+        let c = e.runs().unwrap()[0]
+            .config
+            .of::<ValueMethod>()
+            .unwrap()
+            .clone();
         assert!(c.sample_epi && c.h_explore);
         assert_eq!((c.batch_size, c.train_freq, c.total_epi), (16, 30, 40000));
         assert_eq!(
@@ -1092,12 +1037,14 @@ mod tests {
 
     #[test]
     fn resolved_config_round_trips_through_toml() {
-        let e = parse(DEFAULT_EXPERIMENT, &[]).unwrap();
-        let c = e.runs().unwrap()[0].config.clone();
-        let text = toml::to_string(&c.to_table()).unwrap();
+        let e = parse(default_experiment().0, &[]).unwrap();
+        let run = &e.runs().unwrap()[0];
+        let text = toml::to_string(&run.config.to_table()).unwrap();
         assert_eq!(
-            RunConfig::from_table(toml::from_str(&text).unwrap()).unwrap(),
-            c
+            run.method
+                .config_from_table(toml::from_str(&text).unwrap())
+                .unwrap(),
+            run.config
         );
     }
 
@@ -1135,7 +1082,10 @@ mod tests {
             );
         }
         let o = Overrides {
-            methods: Some(vec![Method::Our1, Method::Our1]),
+            methods: Some(vec![
+                Method::Value(ValueMethod::Our1),
+                Method::Value(ValueMethod::Our1),
+            ]),
             ..Default::default()
         };
         assert!(Experiment::parse("", Path::new("t.toml"), "t", &o).is_err());
@@ -1232,26 +1182,6 @@ mod tests {
         let err = parse(&text, &[]).unwrap_err();
         assert!(matches!(err, ConfigError::TooManyRuns { .. }), "{err}");
         assert!(t0.elapsed().as_secs() < 5);
-    }
-
-    #[test]
-    fn actor_critic_bad_values_name_their_key() {
-        let mut c = AcConfig::reference_defaults();
-        assert!(validate_actor_critic(&c, 100).is_ok());
-        c.a_mlp_layer_size = vec![32];
-        assert_eq!(
-            validate_actor_critic(&c, 100).unwrap_err().0,
-            "a_mlp_layer_size"
-        );
-        c = AcConfig::reference_defaults();
-        c.gamma = 1.5;
-        assert_eq!(validate_actor_critic(&c, 100).unwrap_err().0, "gamma");
-        c = AcConfig::reference_defaults();
-        c.n_env = 0;
-        assert_eq!(validate_actor_critic(&c, 100).unwrap_err().0, "n_env");
-        c = AcConfig::reference_defaults();
-        c.c_lr = f64::NAN;
-        assert_eq!(validate_actor_critic(&c, 100).unwrap_err().0, "c_lr");
     }
 
     #[test]

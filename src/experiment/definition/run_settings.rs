@@ -5,11 +5,9 @@
 //! then every hyperparameter. Every existing run directory keeps reading and writing byte for
 //! byte the same.
 
-use crate::algos::hyper::RunConfig;
-use crate::algos::method::Method;
+use crate::algos::families::{Method, RunConfig};
 use crate::envs::EnvSpec;
-use crate::experiment::definition::paper::paper_defaults;
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Serialize, Serializer};
 
 /// The domain a run trains on and its hyperparameters: `config.toml`'s `[config]` table.
 #[derive(Debug, Clone, PartialEq)]
@@ -21,9 +19,9 @@ pub struct RunSettings {
 }
 
 impl RunSettings {
-    /// The paper's settings for `method` on `env` (see [`paper_defaults`]).
+    /// The papers' settings for `method` on `env` (see [`Method::defaults`]).
     pub fn paper(env: EnvSpec, method: Method) -> Self {
-        let config = paper_defaults(&env, method);
+        let config = method.defaults(&env);
         RunSettings { env, config }
     }
 
@@ -36,11 +34,11 @@ impl RunSettings {
         table
     }
 
-    /// Read the table [`Self::to_table`] writes. The domain is found by `env_name` (an alias
-    /// too); it takes its own keys and checks them, the rest must be exactly the
-    /// hyperparameters (unknown keys are refused, so a typo in a hand-edited config fails
-    /// instead of being ignored).
-    pub fn from_table(mut table: toml::Table) -> Result<Self, String> {
+    /// Read the table [`Self::to_table`] writes for a run of `method`. The domain is found by
+    /// `env_name` (an alias too); it takes its own keys and checks them, the rest must be
+    /// exactly the hyperparameters of the method's family (unknown keys are refused, so a typo
+    /// in a hand-edited config fails instead of being ignored).
+    pub fn from_table(method: Method, mut table: toml::Table) -> Result<Self, String> {
         let name = match table.remove("env_name") {
             Some(toml::Value::String(name)) => name,
             Some(other) => return Err(format!("`env_name` is not a name: {other}")),
@@ -51,7 +49,7 @@ impl RunSettings {
         for key in env.keys().keys() {
             table.remove(key);
         }
-        let config = RunConfig::from_table(table)?;
+        let config = method.config_from_table(table)?;
         Ok(RunSettings { env, config })
     }
 }
@@ -62,25 +60,26 @@ impl Serialize for RunSettings {
     }
 }
 
-impl<'de> Deserialize<'de> for RunSettings {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let table = toml::Table::deserialize(d)?;
-        RunSettings::from_table(table).map_err(serde::de::Error::custom)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::algos::method::Method;
 
-    fn paper(env: EnvSpec, method: Method) -> RunSettings {
-        RunSettings::paper(env, method)
+    fn method(name: &str) -> Method {
+        name.parse().unwrap()
+    }
+
+    fn paper(env: EnvSpec, name: &str) -> RunSettings {
+        RunSettings::paper(env, method(name))
+    }
+
+    fn read(name: &str, text: &str) -> Result<RunSettings, String> {
+        let table: toml::Table = toml::from_str(text).map_err(|e| e.message().to_string())?;
+        RunSettings::from_table(method(name), table)
     }
 
     #[test]
     fn the_domain_is_written_as_the_four_reference_keys_first() {
-        let c = paper(crate::envs::warehouse::paper_spec(), Method::Our2);
+        let c = paper(crate::envs::warehouse::paper_spec(), "our2");
         let text = toml::to_string(&c).unwrap();
         assert!(
             text.starts_with(
@@ -88,7 +87,7 @@ mod tests {
             ),
             "{text}"
         );
-        let back: RunSettings = toml::from_str(&text).unwrap();
+        let back = read("our2", &text).unwrap();
         assert_eq!(back, c);
         // The hyperparameters alone are the same keys without the domain's.
         let alone = toml::to_string(&c.config.to_table()).unwrap();
@@ -98,21 +97,23 @@ mod tests {
 
     #[test]
     fn unknown_keys_are_refused_and_unused_domain_keys_are_not_read() {
-        let c = paper(crate::envs::box_pushing::paper_spec(10), Method::Our1);
+        let c = paper(crate::envs::box_pushing::paper_spec(10), "our1");
         let text = toml::to_string(&c).unwrap();
-        let err = toml::from_str::<RunSettings>(&format!("{text}trace_lenn = 3\n")).unwrap_err();
-        assert!(err.message().contains("trace_lenn"), "{err}");
-        let err = toml::from_str::<RunSettings>(&text.replace("BP_MA", "Pong")).unwrap_err();
-        assert!(
-            err.message().contains("Pong") && err.message().contains("OSD_S_4"),
-            "{err}"
-        );
+        let err = read("our1", &format!("{text}trace_lenn = 3\n")).unwrap_err();
+        assert!(err.contains("trace_lenn"), "{err}");
+        let err = read("our1", &text.replace("BP_MA", "Pong")).unwrap_err();
+        assert!(err.contains("Pong") && err.contains("OSD_S_4"), "{err}");
+        // The method's family reads the keys: an ICRA config is not an actor-critic one.
+        let err = read("mac-iac", &text).unwrap_err();
+        assert!(err.contains("unknown field"), "{err}");
         // A Box Pushing config's tb_m_noisy is not part of its domain.
         let noisy = text.replace("tb_m_noisy = 0.0", "tb_m_noisy = 0.3");
         assert_ne!(noisy, text);
-        assert_eq!(toml::from_str::<RunSettings>(&noisy).unwrap().env, c.env);
+        assert_eq!(read("our1", &noisy).unwrap().env, c.env);
         // A hyperparameter table refuses the domain's keys: the learner's config names none.
-        let err = RunConfig::from_table(toml::from_str(&text).unwrap()).unwrap_err();
+        let err = method("our1")
+            .config_from_table(toml::from_str(&text).unwrap())
+            .unwrap_err();
         assert!(err.contains("env_name"), "{err}");
     }
 }

@@ -11,8 +11,8 @@
 //! `b"MACDECCK"`, `u32` version, `u32` identity length, identity (JSON), `u64` payload length,
 //! 32-byte SHA-256 of the payload, payload.
 
-use crate::algos::any_loop::AnyLoop;
-use crate::algos::method::Method;
+use crate::algos::families::AnyLoop;
+use crate::algos::families::Method;
 use crate::experiment::definition::run_settings::RunSettings;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -20,10 +20,12 @@ use sha2::{Digest, Sha256};
 /// First bytes of every checkpoint.
 pub const MAGIC: &[u8; 8] = b"MACDECCK";
 /// The format version this build writes and reads.
+/// Version 4: each family's learner holds its own typed config and method (one list of
+/// families, issue 40); runs checkpointed by version 3 restart.
 /// Version 3: evaluation points and actor-critic recorders carry the undiscounted return.
 /// Version 2: the payload is the family-tagged training loop (`AnyLoop`); version 1 held the
 /// value-based trainer alone.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 /// Longest identity header accepted (names are at most 200 bytes each).
 const MAX_IDENTITY_BYTES: usize = 4096;
 
@@ -212,17 +214,31 @@ pub fn decode(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::value::method::ValueMethod;
 
     use crate::experiment::run::train_run::run_rngs;
 
     fn tiny() -> (CheckpointIdentity, AnyLoop) {
-        let mut c = RunSettings::paper(crate::envs::box_pushing::paper_spec(8), Method::Our1);
-        let v = c.config.value_mut().unwrap();
+        let mut c = RunSettings::paper(
+            crate::envs::box_pushing::paper_spec(8),
+            Method::Value(ValueMethod::Our1),
+        );
+        let v = c.config.of_mut::<ValueMethod>().unwrap();
         v.batch_size = 4;
         v.replay_buffer_size = 50;
         let env = c.env.clone();
-        let t = AnyLoop::new(&c.config, Method::Our1, 3, run_rngs(3), || env.build()).unwrap();
-        (CheckpointIdentity::new("e", Method::Our1, "", 3, &c), t)
+        let t = AnyLoop::new(
+            &c.config,
+            Method::Value(ValueMethod::Our1),
+            3,
+            run_rngs(3),
+            || env.build(),
+        )
+        .unwrap();
+        (
+            CheckpointIdentity::new("e", Method::Value(ValueMethod::Our1), "", 3, &c),
+            t,
+        )
     }
 
     #[test]
@@ -294,9 +310,9 @@ mod tests {
         assert_eq!(e, CheckpointError::NoHeader);
         assert!(e.to_string().contains("older macdec"), "{e}");
         assert!(e.to_string().contains("delete it"), "{e}");
-        // Versions 1 (the value-based trainer before the learner seam) and 2 (before the
-        // undiscounted return), and any future version.
-        for found in [1, 2, 4] {
+        // Versions 1 (the value-based trainer before the learner seam), 2 (before the
+        // undiscounted return) and 3 (before the one list of families), and any future version.
+        for found in [1, 2, 3, 5] {
             let mut other = encode(&tiny().0, &t).unwrap();
             other[8] = found as u8;
             assert_eq!(

@@ -9,8 +9,8 @@
 //! Every file is written atomically; a killed run resumes from its last checkpoint and ends with
 //! the metrics an uninterrupted run would have written.
 
-use crate::algos::any_loop::AnyLoop;
-use crate::algos::method::Method;
+use crate::algos::families::AnyLoop;
+use crate::algos::families::Method;
 use crate::algos::training_loop::{Advance, RunRngs, TrainError};
 use crate::experiment::definition::config::RunSpec;
 use crate::experiment::definition::run_settings::RunSettings;
@@ -64,7 +64,8 @@ struct RecordedManifest {
     method: Method,
     variant: String,
     seed: u64,
-    config: RunSettings,
+    /// Read as the method's family's keys once `method` is known.
+    config: toml::Table,
     #[serde(default)]
     provenance: Option<Provenance>,
 }
@@ -78,7 +79,7 @@ impl TryFrom<RecordedManifest> for RunManifest {
             method: r.method,
             variant: r.variant,
             seed: r.seed,
-            config: r.config,
+            config: RunSettings::from_table(r.method, r.config)?,
             provenance: r.provenance,
         };
         manifest
