@@ -8,8 +8,8 @@
 //! where they differ, its typed config and its checks, its published settings, its quick start,
 //! its errors, its learner and its goldens (README "Adding a method family").
 
-use crate::algos::family::{FamilyConfig, FamilyFacts, FamilyMethod};
-use crate::algos::learner::SavedNets;
+use crate::algos::family::{FamilyFacts, FamilyMethod};
+use crate::algos::learner::{FamilyConfig, MethodName, SavedNets};
 use crate::algos::training_loop::{Advance, EvalPoint, RunRngs, TrainError, TrainingLoop};
 use crate::envs::{AnyEnv, EnvError, EnvSpec, MacroEnv};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -245,7 +245,7 @@ macro_rules! families {
                     $((Method::$family(m), RunConfig::$family(c)) => Ok(AnyLoop::$family(
                         Box::new(TrainingLoop::new(c, m, seed, rngs, make_env)?),
                     )),)+
-                    _ => Err(TrainError::WrongFamily { method }),
+                    _ => Err(TrainError::WrongFamily { method: method.name() }),
                 }
             }
 

@@ -3,9 +3,9 @@
 //! quick starts ([`FamilyFacts`]). The one list of families ([`crate::algos::families`]) builds
 //! [`crate::algos::families::Method`], [`crate::algos::families::RunConfig`] and
 //! [`crate::algos::families::AnyLoop`] from these, so nothing outside a family's folder matches on
-//! one of its methods.
+//! one of its methods. (The config trait, [`FamilyConfig`], is the loop's: `algos::learner`.)
 
-use crate::algos::learner::Learner;
+use crate::algos::learner::{FamilyConfig, Learner, MethodName};
 use crate::envs::EnvSpec;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -30,26 +30,11 @@ pub struct FamilyFacts {
     pub evaluated_return: &'static str,
 }
 
-/// A family's resolved hyperparameters: every key concrete, under the family's reference's flag
-/// names. What the training loop and the run layer need of every family's config.
-pub trait FamilyConfig:
-    Clone + PartialEq + Debug + Serialize + DeserializeOwned + Send + Sync + 'static
-{
-    /// Training episodes (`total_epi`).
-    fn total_epi(&self) -> usize;
-    /// Set the number of training episodes (a shortened run in a benchmark or test).
-    fn set_total_epi(&mut self, episodes: usize);
-    /// Training episodes between checkpoints.
-    fn checkpoint_freq(&self) -> usize;
-    /// The discount per primitive step of evaluation returns and exported policies.
-    fn discount(&self) -> f64;
-}
-
 /// One family's methods: a small enum (the `--methods` names) and everything the rest of macdec
 /// may ask of a method. Where methods of a family differ in training, the family's own code
 /// matches on this enum; nothing outside the folder does.
 pub trait FamilyMethod:
-    Copy + Eq + Ord + Hash + Debug + Send + Sync + Serialize + DeserializeOwned + 'static
+    MethodName + Eq + Ord + Hash + Debug + Send + Sync + Serialize + DeserializeOwned + 'static
 {
     /// The family's resolved keys.
     type Config: FamilyConfig;
@@ -60,8 +45,6 @@ pub trait FamilyMethod:
     /// Every method of the family, in the order its papers introduce them.
     const ALL: &'static [Self];
 
-    /// The command-line and directory name (`our1`, `mac-iac`).
-    fn name(self) -> &'static str;
     /// The name in the papers' figure legends (`Our-1`, `Mac-IAC`).
     fn legend(self) -> &'static str;
     /// The papers' settings for this method on `env`, before the user's keys.

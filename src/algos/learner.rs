@@ -11,8 +11,6 @@
 //! its methods' enum implementing [`crate::algos::family::FamilyMethod`], and one line in the
 //! list of families ([`crate::algos::families`]).
 
-use crate::algos::families::Method;
-use crate::algos::family::FamilyConfig;
 use crate::algos::train_error::TrainError;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::QNet;
@@ -97,6 +95,27 @@ pub struct SavedNets<'a> {
     pub evaluated_is_centralized: bool,
 }
 
+/// A family's method as the training loop names it in messages.
+pub trait MethodName: Copy + std::fmt::Debug {
+    /// The command-line and directory name (`our1`, `mac-iac`).
+    fn name(self) -> &'static str;
+}
+
+/// A family's resolved hyperparameters: every key concrete, under the family's reference's flag
+/// names. What the training loop and the run layer need of every family's config.
+pub trait FamilyConfig:
+    Clone + PartialEq + std::fmt::Debug + Serialize + DeserializeOwned + Send + Sync + 'static
+{
+    /// Training episodes (`total_epi`).
+    fn total_epi(&self) -> usize;
+    /// Set the number of training episodes (a shortened run in a benchmark or test).
+    fn set_total_epi(&mut self, episodes: usize);
+    /// Training episodes between checkpoints.
+    fn checkpoint_freq(&self) -> usize;
+    /// The discount per primitive step of evaluation returns and exported policies.
+    fn discount(&self) -> f64;
+}
+
 /// A method family, as the training loop drives it. The learner is saved inside every checkpoint
 /// (with its lanes' state), so a resumed run continues with exactly the numbers of an
 /// uninterrupted one.
@@ -105,7 +124,7 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
     /// episode being recorded, the lane's replay.
     type Lane: Clone + std::fmt::Debug + Serialize + DeserializeOwned;
     /// The family's methods.
-    type Method: Copy + std::fmt::Debug + Into<Method>;
+    type Method: MethodName;
     /// The family's resolved keys.
     type Config: FamilyConfig;
 

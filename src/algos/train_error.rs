@@ -1,11 +1,10 @@
 //! Why a training loop stopped early: what the loop, the environments and a learner can fail with.
 
-use crate::algos::families::Method;
 use crate::envs::EnvError;
 
 impl TrainError {
     /// A non-finite loss or parameter of `method`'s run `seed` at `episode`.
-    pub fn non_finite(method: Method, seed: u64, what: &'static str, episode: u64) -> Self {
+    pub fn non_finite(method: &'static str, seed: u64, what: &'static str, episode: u64) -> Self {
         TrainError::NonFinite {
             method,
             seed,
@@ -28,8 +27,8 @@ pub enum TrainError {
     /// A loss or parameter became NaN or infinite.
     #[error("{method} seed {seed}: non-finite {what} at episode {episode}")]
     NonFinite {
-        /// The method trained.
-        method: Method,
+        /// The method trained (its command-line name).
+        method: &'static str,
         /// The run's seed.
         seed: u64,
         /// `loss` or `parameter`.
@@ -43,14 +42,14 @@ pub enum TrainError {
     /// The config is another family's.
     #[error("{method}: the config holds another method family's keys")]
     WrongFamily {
-        /// The method asked for.
-        method: Method,
+        /// The method asked for (its command-line name).
+        method: &'static str,
     },
     /// More training lanes (parallel environments) than a run has random streams for.
     #[error("{method} asks for {asked} training lanes; runs have random streams for {available}")]
     TooManyLanes {
-        /// The method.
-        method: Method,
+        /// The method (its command-line name).
+        method: &'static str,
         /// Lanes the config asks for.
         asked: usize,
         /// The most lanes a run supports (`MAX_LANES`).

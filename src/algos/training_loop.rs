@@ -5,8 +5,7 @@
 //! The whole loop is one serializable value, so a checkpoint is the loop itself and a resumed run
 //! continues with exactly the numbers of an uninterrupted one.
 
-use crate::algos::family::FamilyConfig;
-use crate::algos::learner::{Learner, LearnerRngs, SavedNets, Schedule};
+use crate::algos::learner::{FamilyConfig, Learner, LearnerRngs, MethodName, SavedNets, Schedule};
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -124,7 +123,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         let plans = learner.lanes();
         if plans.len() > MAX_LANES {
             return Err(TrainError::TooManyLanes {
-                method: method.into(),
+                method: method.name(),
                 asked: plans.len(),
                 available: MAX_LANES,
             });

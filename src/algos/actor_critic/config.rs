@@ -8,7 +8,7 @@ use crate::algos::config_checks::{
     check_at_most, check_discount, check_positive, check_rates, check_unit, MAX_BATCH_ELEMENTS,
     MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
 };
-use crate::algos::family::FamilyConfig;
+use crate::algos::learner::FamilyConfig;
 use crate::envs::EnvSpec;
 use serde::{Deserialize, Serialize};
 

@@ -14,7 +14,9 @@ use super::episode::{Episode, EpisodeRecorder};
 use super::method::{AcActor, AcCritic, AcDesign, AcMethod};
 use super::nets::{AcNets, NetSizes};
 use super::update::{update, UpdateParams, UpdateTrace};
-use crate::algos::learner::{EvalReturns, LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
+use crate::algos::learner::{
+    EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+};
 use crate::algos::training_loop::TrainError;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -153,7 +155,7 @@ impl AcLearner {
     }
 
     fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
-        TrainError::non_finite(self.method.into(), self.seed, what, episodes)
+        TrainError::non_finite(self.method.name(), self.seed, what, episodes)
     }
 }
 

@@ -1,10 +1,7 @@
 //! MacroMARL's actor-critic methods (`docs/MACROMARL.md` §2.7) as a small value naming only what
 //! the paper varies between them: whose actor acts and what the critic sees ([`AcMethod::design`]).
 
-use crate::algos::actor_critic::config::{self, AcConfig};
-use crate::algos::actor_critic::learner::AcLearner;
-use crate::algos::family::{FamilyFacts, FamilyMethod};
-use crate::envs::EnvSpec;
+use crate::algos::learner::MethodName;
 use serde::{Deserialize, Serialize};
 
 /// One of MacroMARL's actor-critic methods, by its command-line name.
@@ -25,26 +22,7 @@ pub enum AcMethod {
     MacIaisc,
 }
 
-impl FamilyMethod for AcMethod {
-    type Config = AcConfig;
-    type Learner = AcLearner;
-    const FACTS: FamilyFacts = FamilyFacts {
-        name: "actor-critic",
-        description: "MacroMARL's macro-action actor-critic methods",
-        quick_start: include_str!("quick_start.toml"),
-        quick_start_name: "quickstart_bp6",
-        list_keys: &config::LIST_KEYS,
-        evaluated_return: "the discounted return of sampled actions",
-    };
-    const ALL: &'static [AcMethod] = &[
-        AcMethod::MacIac,
-        AcMethod::MacCac,
-        AcMethod::NaiveMacIacc,
-        AcMethod::NaiveMacIasc,
-        AcMethod::MacIaicc,
-        AcMethod::MacIaisc,
-    ];
-
+impl MethodName for AcMethod {
     fn name(self) -> &'static str {
         match self {
             AcMethod::MacIac => "mac-iac",
@@ -54,25 +32,6 @@ impl FamilyMethod for AcMethod {
             AcMethod::MacIaicc => "mac-iaicc",
             AcMethod::MacIaisc => "mac-iaisc",
         }
-    }
-
-    fn legend(self) -> &'static str {
-        match self {
-            AcMethod::MacIac => "Mac-IAC",
-            AcMethod::MacCac => "Mac-CAC",
-            AcMethod::NaiveMacIacc => "Naive Mac-IACC",
-            AcMethod::NaiveMacIasc => "Naive Mac-IASC",
-            AcMethod::MacIaicc => "Mac-IAICC",
-            AcMethod::MacIaisc => "Mac-IAISC",
-        }
-    }
-
-    fn defaults(self, env: &EnvSpec) -> AcConfig {
-        config::published_defaults(env, self)
-    }
-
-    fn check(self, c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
-        config::check(c, horizon)
     }
 }
 
@@ -137,6 +96,7 @@ pub struct AcDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::family::FamilyMethod;
 
     #[test]
     fn designs_match_the_reference_classes() {

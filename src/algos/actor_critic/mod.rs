@@ -10,6 +10,7 @@
 pub mod acting;
 pub mod config;
 pub mod episode;
+pub mod family;
 pub mod learner;
 pub mod method;
 pub mod nets;

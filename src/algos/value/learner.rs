@@ -2,7 +2,9 @@
 //! exploration, replay, training iteration and evaluated policy (`docs/ALGORITHMS.md` §4-7).
 //! Where the methods differ, [`ValueMethod`]'s exhaustive `match`es decide.
 
-use crate::algos::learner::{EvalReturns, LanePlan, Learner, LearnerRngs, SavedNets, Schedule};
+use crate::algos::learner::{
+    EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+};
 use crate::algos::training_loop::TrainError;
 use crate::algos::value::acting::{select_cen, select_dec, ActScratch, Explore};
 use crate::algos::value::config::ValueConfig;
@@ -92,7 +94,7 @@ impl ValueLearner {
     }
 
     fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
-        TrainError::non_finite(self.method.into(), self.seed, what, episodes)
+        TrainError::non_finite(self.method.name(), self.seed, what, episodes)
     }
 }
 

@@ -2,11 +2,8 @@
 //! naming only what the paper varies between them: which nets exist, who picks the action inside
 //! each target, how the training env(s) explore, and whether a loss is hysteretic.
 
-use crate::algos::family::{FamilyFacts, FamilyMethod};
-use crate::algos::value::config::{self, ValueConfig};
-use crate::algos::value::learner::ValueLearner;
+use crate::algos::learner::MethodName;
 use crate::algos::value::schedule::HysteresisSchedule;
-use crate::envs::EnvSpec;
 use serde::{Deserialize, Serialize};
 
 /// One of the ICRA paper's methods, by its command-line name.
@@ -24,56 +21,6 @@ pub enum ValueMethod {
     Our1R,
     /// Parallel-MacDec-MADDRQN, "Our-2": separate centralized and decentralized envs (`docs/ALGORITHMS.md` §5.5).
     Our2,
-}
-
-impl FamilyMethod for ValueMethod {
-    type Config = ValueConfig;
-    type Learner = ValueLearner;
-    const FACTS: FamilyFacts = FamilyFacts {
-        name: "value",
-        description: "the ICRA 2020 macro-action Q-learning methods",
-        quick_start: include_str!("quick_start.toml"),
-        quick_start_name: "quickstart_bp10",
-        list_keys: &[],
-        evaluated_return: "the greedy discounted return",
-    };
-    const ALL: &'static [ValueMethod] = &[
-        ValueMethod::DecHddrqn,
-        ValueMethod::CenDdrqn,
-        ValueMethod::Our1,
-        ValueMethod::Our1R,
-        ValueMethod::Our2,
-    ];
-
-    /// The command-line and directory name.
-    fn name(self) -> &'static str {
-        match self {
-            ValueMethod::DecHddrqn => "dec-hddrqn",
-            ValueMethod::CenDdrqn => "cen-ddrqn",
-            ValueMethod::Our1 => "our1",
-            ValueMethod::Our1R => "our1-r",
-            ValueMethod::Our2 => "our2",
-        }
-    }
-
-    /// The name in the paper's figure legends.
-    fn legend(self) -> &'static str {
-        match self {
-            ValueMethod::DecHddrqn => "Dec-HDDRQN",
-            ValueMethod::CenDdrqn => "Cen-DDRQN",
-            ValueMethod::Our1 => "Our-1",
-            ValueMethod::Our1R => "Our-1-R",
-            ValueMethod::Our2 => "Our-2",
-        }
-    }
-
-    fn defaults(self, env: &EnvSpec) -> ValueConfig {
-        config::paper_defaults(env, self)
-    }
-
-    fn check(self, c: &ValueConfig, horizon: usize) -> Result<(), (&'static str, String)> {
-        config::check(c, self, horizon)
-    }
 }
 
 /// Who chooses a*_i inside agent i's decentralized target.
@@ -94,6 +41,18 @@ pub enum Exploration {
     Centralized,
     /// Our-2: a decentralized-exploring env and a centralized-exploring env in lockstep (5.5).
     Parallel,
+}
+
+impl MethodName for ValueMethod {
+    fn name(self) -> &'static str {
+        match self {
+            ValueMethod::DecHddrqn => "dec-hddrqn",
+            ValueMethod::CenDdrqn => "cen-ddrqn",
+            ValueMethod::Our1 => "our1",
+            ValueMethod::Our1R => "our1-r",
+            ValueMethod::Our2 => "our2",
+        }
+    }
 }
 
 impl ValueMethod {
@@ -283,6 +242,7 @@ pub enum EvaluatedPolicy {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::algos::family::FamilyMethod;
 
     #[test]
     fn our1_and_our1_r_differ_only_in_the_dec_target_action() {

@@ -16,6 +16,7 @@ pub mod cond_argmax;
 pub mod config;
 pub mod episode_buffer;
 pub mod evaluate;
+pub mod family;
 pub mod learner;
 pub mod method;
 pub mod published;

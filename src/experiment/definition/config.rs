@@ -1153,6 +1153,37 @@ mod tests {
     }
 
     #[test]
+    fn an_unknown_keys_hint_comes_from_the_methods_own_family() {
+        // An ICRA key given to an actor-critic method: the hint names MacroMARL's learning rates
+        // and the family `l_rate` belongs to, never `l_rate` itself.
+        let err = parse("methods = [\"mac-iac\"]\n[params]\nl_rate = 0.01", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("unknown key `l_rate` for mac-iac"), "{err}");
+        assert!(
+            err.contains("did you mean `a_lr`") || err.contains("did you mean `c_lr`"),
+            "{err}"
+        );
+        assert!(err.contains("is a key of the ICRA 2020"), "{err}");
+        assert!(!err.contains("e.g. total_epi, replay_buffer_size"), "{err}");
+        // And the other way round.
+        let err = parse("methods = [\"our1\"]\n[params]\na_lr = 0.01", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`a_lr` is a key of MacroMARL's"), "{err}");
+        assert!(
+            err.contains("our1 takes the keys of the ICRA 2020"),
+            "{err}"
+        );
+        // A typo of the family's own key.
+        let err = parse("methods = [\"our1\"]\n[params]\ntrace_lne = 3", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("did you mean `trace_len`?"), "{err}");
+        assert!(!err.contains("is a key of"), "{err}");
+    }
+
+    #[test]
     fn sweeps_are_bounded_and_never_empty() {
         let err = parse("[params]\ntrace_len = []", &[]).unwrap_err();
         assert!(
