@@ -9,25 +9,51 @@ use rand_chacha::ChaCha8Rng;
 use crate::nn::sampling::{conditioned_joint, mixture, sample_weighted, Pick};
 use crate::nn::{GruActor, GruActorState};
 
-/// Decentralized actors: each free agent, in index order, samples from its actor on its own
-/// observation; busy agents keep their running macro-action (`running[i]`).
+/// The acting path's reusable buffers: once warm, choosing macro-actions allocates nothing per
+/// primitive step. Scratch only: a fresh (empty) one acts identically.
+#[derive(Debug, Default)]
+pub struct ActBuffers {
+    /// The sampling distribution of the agent (or the joint action) being decided.
+    pub probs: Vec<f64>,
+    /// Mac-CAC's joint observation.
+    pub joint: Vec<f32>,
+}
+
+impl Clone for ActBuffers {
+    /// Scratch is not state: a clone starts empty.
+    fn clone(&self) -> Self {
+        ActBuffers::default()
+    }
+}
+
+impl ActBuffers {
+    /// The joint-observation buffer resized to `len` (its contents are to be overwritten).
+    pub fn joint(&mut self, len: usize) -> &mut Vec<f32> {
+        self.joint.resize(len, 0.0);
+        &mut self.joint
+    }
+}
+
+/// Decentralized actors: each free agent `i`, in index order, samples from its actor
+/// `actor(i)` on its own observation `obs(i)`; busy agents keep their running macro-action
+/// (`running[i]`).
 #[allow(clippy::too_many_arguments)]
-pub fn act_decentralized(
-    actors: &[&GruActor],
+pub fn act_decentralized<'n, 'o>(
+    actor: &dyn Fn(usize) -> &'n GruActor,
     states: &mut [GruActorState],
-    obs: &dyn Fn(usize) -> Vec<f32>,
+    obs: &dyn Fn(usize) -> &'o [f32],
     free: &[bool],
     running: &[usize],
     eps: Option<f64>,
     rng: &mut ChaCha8Rng,
+    probs: &mut Vec<f64>,
     actions: &mut [usize],
 ) {
-    let mut probs = Vec::new();
-    for (i, actor) in actors.iter().enumerate() {
+    for (i, state) in states.iter_mut().enumerate() {
         if free[i] {
-            let logp = actor.act_step(&obs(i), &mut states[i]);
-            mixture(logp, eps, &mut probs);
-            actions[i] = sample_weighted(&probs, rng);
+            let logp = actor(i).act_step(obs(i), state);
+            mixture(logp, eps, probs);
+            actions[i] = sample_weighted(probs, rng);
         } else {
             actions[i] = running[i];
         }
@@ -48,6 +74,7 @@ pub fn act_centralized(
     n_actions: &[usize],
     eps: Option<f64>,
     rng: &mut ChaCha8Rng,
+    probs: &mut Vec<f64>,
     actions: &mut [usize],
 ) {
     if !free.iter().any(|&f| f) {
@@ -55,7 +82,6 @@ pub fn act_centralized(
         return;
     }
     let logp = actor.act_step(joint_obs, state);
-    let mut probs = Vec::new();
     conditioned_joint(
         logp,
         eps,
@@ -63,7 +89,7 @@ pub fn act_centralized(
         running,
         n_actions,
         Pick::Sample(rng),
-        &mut probs,
+        probs,
         actions,
     );
 }
@@ -87,6 +113,7 @@ mod tests {
         let mut state = actor.zero_state();
         let obs = [0.1, -0.4, 0.7, 0.0, 1.0];
         let mut actions = [0, 0];
+        let mut probs = Vec::new();
         let mut seen = [false; 3];
         for _ in 0..200 {
             let free = [true, false];
@@ -99,6 +126,7 @@ mod tests {
                 &[3, 4],
                 Some(0.5),
                 &mut rng,
+                &mut probs,
                 &mut actions,
             );
             assert_eq!(actions[1], 2, "a busy agent keeps its macro-action");
@@ -118,6 +146,7 @@ mod tests {
             &[3, 4],
             None,
             &mut rng,
+            &mut probs,
             &mut actions,
         );
         assert_eq!(

@@ -125,9 +125,13 @@ impl EpisodeRecorder {
         e.terminate.clear();
         e.valid.clear();
         self.push_observation(env);
-        self.last_valid = vec![true; n];
-        self.acc = vec![0.0; n];
-        self.mac_steps = vec![0; n];
+        // Reused across episodes: nothing is allocated per episode once warm.
+        self.last_valid.clear();
+        self.last_valid.resize(n, true);
+        self.acc.clear();
+        self.acc.resize(n, 0.0);
+        self.mac_steps.clear();
+        self.mac_steps.resize(n, 0);
         self.acc_joint = 0.0;
         self.joint_steps = 0;
         self.ret = 0.0;

@@ -8,7 +8,7 @@ use std::collections::VecDeque;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::acting::{act_centralized, act_decentralized};
+use super::acting::{act_centralized, act_decentralized, ActBuffers};
 use super::config::AcConfig;
 use super::episode::{Episode, EpisodeRecorder};
 use super::method::{AcActor, AcCritic, AcDesign, AcMethod};
@@ -20,7 +20,7 @@ use crate::algos::learner::{
 use crate::algos::training_loop::TrainError;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
-use crate::nn::{GruActor, GruActorState};
+use crate::nn::GruActorState;
 
 /// The family's `metrics.csv` columns: the exploration weight of the batch before the
 /// evaluation, the mean critic and actor losses over the updates since the previous row (mean
@@ -54,6 +54,9 @@ pub struct AcLearner {
     return_count: u64,
     #[serde(skip, default)]
     tape: TapeCell,
+    /// The acting path's scratch.
+    #[serde(skip, default)]
+    buffers: ActBuffers,
 }
 
 /// The learner's tape: scratch, rebuilt empty after a resume.
@@ -110,42 +113,6 @@ impl AcLearner {
         &mut self.nets
     }
 
-    /// Choose the free agents' macro-actions: `eps` is the exploration mixture's weight while
-    /// training, `None` when evaluated.
-    fn choose<E: MacroEnv>(
-        &self,
-        env: &E,
-        free: &[bool],
-        states: &mut [GruActorState],
-        eps: Option<f64>,
-        rng: &mut ChaCha8Rng,
-        actions: &mut [usize],
-    ) {
-        let running: Vec<usize> = env.executed().to_vec();
-        match self.design().actor {
-            AcActor::Decentralized => {
-                let actors: Vec<&GruActor> = self.nets.actors.iter().map(|a| &a.net).collect();
-                let obs = |i: usize| env.obs(i).to_vec();
-                act_decentralized(&actors, states, &obs, free, &running, eps, rng, actions);
-            }
-            AcActor::Centralized => {
-                let mut joint = vec![0.0; env.joint_obs_size()];
-                env.write_joint_obs(&mut joint);
-                act_centralized(
-                    &self.nets.actors[0].net,
-                    &mut states[0],
-                    &joint,
-                    free,
-                    &running,
-                    &self.sizes.n_actions,
-                    eps,
-                    rng,
-                    actions,
-                );
-            }
-        }
-    }
-
     fn zero_states(&self) -> Vec<GruActorState> {
         self.nets
             .actors
@@ -156,6 +123,54 @@ impl AcLearner {
 
     fn non_finite(&self, what: &'static str, episodes: u64) -> TrainError {
         TrainError::non_finite(self.method.name(), self.seed, what, episodes)
+    }
+}
+
+/// Choose the free agents' macro-actions with `nets`' actors (`actor` says who acts): `eps` is
+/// the exploration mixture's weight while training, `None` when evaluated. Allocates nothing
+/// once `buffers` are warm.
+#[allow(clippy::too_many_arguments)]
+fn choose<E: MacroEnv>(
+    nets: &AcNets,
+    actor: AcActor,
+    n_actions: &[usize],
+    env: &E,
+    free: &[bool],
+    states: &mut [GruActorState],
+    eps: Option<f64>,
+    rng: &mut ChaCha8Rng,
+    buffers: &mut ActBuffers,
+    actions: &mut [usize],
+) {
+    let running = env.executed();
+    match actor {
+        AcActor::Decentralized => act_decentralized(
+            &|i| &nets.actors[i].net,
+            states,
+            &|i| env.obs(i),
+            free,
+            running,
+            eps,
+            rng,
+            &mut buffers.probs,
+            actions,
+        ),
+        AcActor::Centralized => {
+            let joint = buffers.joint(env.joint_obs_size());
+            env.write_joint_obs(joint);
+            act_centralized(
+                &nets.actors[0].net,
+                &mut states[0],
+                &buffers.joint,
+                free,
+                running,
+                n_actions,
+                eps,
+                rng,
+                &mut buffers.probs,
+                actions,
+            );
+        }
     }
 }
 
@@ -195,6 +210,7 @@ impl Learner for AcLearner {
             return_sum: 0.0,
             return_count: 0,
             tape: TapeCell::default(),
+            buffers: ActBuffers::default(),
         })
     }
 
@@ -241,17 +257,18 @@ impl Learner for AcLearner {
     }
 
     fn act<E: MacroEnv>(&mut self, lane: &mut AcLane, env: &E, actions: &mut [usize]) {
-        let mut rng = std::mem::replace(&mut self.explore_rng, rand::SeedableRng::seed_from_u64(0));
-        let free = lane.recorder.free().to_vec();
-        self.choose(
+        choose(
+            &self.nets,
+            self.method.design().actor,
+            &self.sizes.n_actions,
             env,
-            &free,
+            lane.recorder.free(),
             &mut lane.states,
             Some(self.eps),
-            &mut rng,
+            &mut self.explore_rng,
+            &mut self.buffers,
             actions,
         );
-        self.explore_rng = rng;
     }
 
     fn record<E: MacroEnv>(
@@ -282,9 +299,10 @@ impl Learner for AcLearner {
     }
 
     fn train_iteration(&mut self, _lanes: &[&AcLane], episodes: u64) -> Result<(), TrainError> {
-        let batch: Vec<Episode> = self.memory.iter().cloned().collect();
-        let eps = self.eps;
-        let trace = self.update_traced(&batch, eps);
+        // The batch is the memory itself, in order: nothing is copied.
+        let p = self.update_params();
+        let batch = self.memory.make_contiguous();
+        let trace = update(&mut self.nets, &p, batch, &mut self.tape.0);
         let critic: Vec<f64> = trace
             .critics
             .iter()
@@ -334,10 +352,22 @@ impl Learner for AcLearner {
         }
         let mut returns = Vec::new();
         let mut actions = vec![0; n_agents];
+        let mut buffers = ActBuffers::default();
+        let actor = self.design().actor;
         while returns.len() < c.eval_num_epi {
             for k in 0..envs.len() {
-                let free = recorders[k].free().to_vec();
-                self.choose(&*envs[k], &free, &mut states[k], None, rng, &mut actions);
+                choose(
+                    &self.nets,
+                    actor,
+                    &self.sizes.n_actions,
+                    &*envs[k],
+                    recorders[k].free(),
+                    &mut states[k],
+                    None,
+                    rng,
+                    &mut buffers,
+                    &mut actions,
+                );
                 let outcome = envs[k].step(&actions, rng)?;
                 recorders[k].record(&*envs[k], outcome);
                 if outcome.done {

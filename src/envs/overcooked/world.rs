@@ -106,7 +106,7 @@ pub struct Cook {
 }
 
 /// Everything that moves or is held, and the map beside it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, PartialEq, Serialize, Deserialize)]
 pub struct World {
     /// Side of the square map in cells (at most `MAX_SIDE`).
     pub side: usize,
@@ -122,6 +122,32 @@ pub struct World {
     pub delivery: Station,
     /// The agents, in agent order.
     pub cooks: Vec<Cook>,
+}
+
+impl Clone for World {
+    fn clone(&self) -> Self {
+        World {
+            side: self.side,
+            map: self.map,
+            foods: self.foods,
+            plates: self.plates,
+            knives: self.knives,
+            delivery: self.delivery,
+            cooks: self.cooks.clone(),
+        }
+    }
+
+    /// Every reset copies the start kitchen into the running one: reuse the agents' buffer so
+    /// resetting allocates nothing.
+    fn clone_from(&mut self, source: &Self) {
+        self.side = source.side;
+        self.map = source.map;
+        self.foods = source.foods;
+        self.plates = source.plates;
+        self.knives = source.knives;
+        self.delivery = source.delivery;
+        self.cooks.clone_from(&source.cooks);
+    }
 }
 
 /// Why a start map cannot make a kitchen (the reference's maps always can).
