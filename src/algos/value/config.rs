@@ -148,7 +148,7 @@ pub fn paper_defaults(env: &EnvSpec, method: ValueMethod) -> ValueConfig {
         .unwrap_or_else(|e| panic!("{}'s paper settings do not type-check: {e}", env.env_name()))
 }
 
-/// The value family's range checks (see [`FamilyMethod::check`]).
+/// The value family's range checks (see [`FamilyMethod::check`](crate::algos::family::FamilyMethod::check)).
 pub fn check(
     c: &ValueConfig,
     method: ValueMethod,

@@ -1,6 +1,6 @@
 //! One training iteration of any of the five methods (`docs/ALGORITHMS.md` §5 and 12).
 //!
-//! Every method runs the same steps; the [`Method`] value decides which of them exist:
+//! Every method runs the same steps; the [`ValueMethod`] value decides which of them exist:
 //! A, the centralized TD step (Cen-DDRQN, Our-1, Our-1-R, Our-2); B, the conditional joint argmax
 //! with the just-updated centralized net (Our-1, Our-2; quirk Q2); C, one TD step per agent, whose
 //! target action comes from B or from the agent's own double-Q selection.
