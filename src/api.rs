@@ -18,7 +18,7 @@ use crate::experiment::definition::run_settings::RunSettings;
 use crate::experiment::run::train_run::run_rngs;
 use crate::nn::ActingNet;
 use crate::policy_files::policy_env::PolicyEnv;
-use crate::policy_files::{Manifest, RunInfo};
+use crate::policy_files::{Manifest, NetRole, RunInfo};
 use std::path::Path;
 
 /// The `experiment` an exported library policy names in its `policy.json`.
@@ -101,16 +101,18 @@ pub fn train_policy<E: MacroEnv>(
     while trainer.advance()? != Advance::Finished {
         on_episode(&trainer);
     }
+    // Agent i's net at i, the team's centralized net beside them: read off the learner's list.
     let nets = trainer.saved_nets();
-    let actors = nets.actors.iter().map(|&a| ActingNet::Actor(a.clone()));
-    let (agents, team): (Vec<ActingNet>, Option<ActingNet>) = if nets.actors.is_empty() {
-        let agents = nets.dec.iter().map(|&q| ActingNet::Q(q.clone())).collect();
-        (agents, nets.cen.map(|q| ActingNet::Q(q.clone())))
-    } else if nets.evaluated_is_centralized {
-        (Vec::new(), actors.into_iter().next())
-    } else {
-        (actors.collect(), None)
-    };
+    let mut agents: Vec<(usize, ActingNet)> = nets
+        .iter()
+        .filter_map(|n| n.agent.map(|a| (a, n.net.to_net())))
+        .collect();
+    agents.sort_by_key(|(a, _)| *a);
+    let agents = agents.into_iter().map(|(_, net)| net).collect();
+    let team = nets
+        .iter()
+        .find(|n| n.role == NetRole::Cen)
+        .map(|n| n.net.to_net());
     Ok(TrainedPolicy {
         method,
         seed,

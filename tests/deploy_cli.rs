@@ -244,6 +244,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
     use macdec::envs::MacroEnv;
     use macdec::experiment::run::results_tree::CHECKPOINT;
     use macdec::experiment::run::train_run::load_checkpoint;
+    use macdec::nn::{ActingNetRef, QNet};
 
     let dir = tempfile::tempdir().unwrap();
     let results = common::train_config(dir.path(), TINY);
@@ -295,7 +296,15 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
 
     // In-process greedy evaluation of the checkpoint's nets, same seed (the run's), same stream.
     let trainer = load_checkpoint(&run.join(CHECKPOINT)).unwrap();
-    let nets = trainer.saved_nets().dec;
+    let saved = trainer.saved_nets();
+    let nets: Vec<&QNet> = saved
+        .iter()
+        .filter(|n| n.agent.is_some())
+        .map(|n| match n.net {
+            ActingNetRef::Q(q) => q,
+            ActingNetRef::Actor(_) => unreachable!("an our1 run's agents have Q-nets"),
+        })
+        .collect();
     let mut env = manifest.env.build().unwrap();
     let mut rng = stream(3, Role::EvalEnv);
     for trace in &deployed {

@@ -7,9 +7,9 @@
 
 use macdec::deploy::policy::export::export_run;
 use macdec::deploy::policy::net_policy::load_net;
-use macdec::nn::QNet;
+use macdec::nn::{ActingNet, QNet};
 use macdec::policy_files::{
-    load_all, read_policy_files, read_qnets, Manifest, NetKind, NetRole, PolicyEnv, FORMAT_VERSION,
+    load_all, read_nets, read_policy_files, Manifest, NetKind, NetRole, PolicyEnv, FORMAT_VERSION,
     POLICY_FILE,
 };
 use std::path::{Path, PathBuf};
@@ -50,6 +50,11 @@ fn q_trace(net: &QNet) -> Trace {
         .collect()
 }
 
+/// The Q-nets of a version-1 policy (every net of that version is one).
+fn q_nets(nets: &[ActingNet]) -> Vec<QNet> {
+    nets.iter().map(|n| n.as_q().unwrap().clone()).collect()
+}
+
 #[test]
 fn a_version_1_run_policy_dir_loads_with_its_nets_and_layout() {
     let policy = read_policy_files(&fixtures().join("run")).unwrap();
@@ -69,16 +74,18 @@ fn a_version_1_run_policy_dir_loads_with_its_nets_and_layout() {
     assert_eq!((m.nets[2].input, m.nets[2].output), (10, 64));
 
     let want = expected();
-    assert_eq!(policy.dec.len(), 2);
-    for (agent, net) in policy.dec.iter().enumerate() {
+    let dec = q_nets(&policy.agents);
+    assert_eq!(dec.len(), 2);
+    for (agent, net) in dec.iter().enumerate() {
         assert_eq!(q_trace(net), want.dec[agent], "agent {agent}");
     }
-    assert_eq!(q_trace(policy.cen.as_ref().unwrap()), want.cen);
+    let cen = policy.team.as_ref().and_then(|n| n.as_q()).unwrap();
+    assert_eq!(q_trace(cen), want.cen);
 }
 
 #[test]
 fn version_1_exports_load_for_robots_with_the_same_nets() {
-    let run_nets = read_policy_files(&fixtures().join("run")).unwrap().dec;
+    let run_nets = q_nets(&read_policy_files(&fixtures().join("run")).unwrap().agents);
     let want = expected();
     for (dir, env_name, discount) in [
         ("export", "box-pushing", 0.98),
@@ -106,7 +113,7 @@ fn version_1_exports_load_for_robots_with_the_same_nets() {
             );
             assert_eq!(q_trace(&net), want.dec[v.index]);
         }
-        assert_eq!(read_qnets(&dir).unwrap().dec, run_nets);
+        assert_eq!(q_nets(&read_nets(&dir).unwrap().agents), run_nets);
     }
     let custom = Manifest::read(&fixtures().join("export-custom")).unwrap();
     assert!(matches!(custom.env, PolicyEnv::Custom(_)));
@@ -131,8 +138,8 @@ fn a_version_1_run_exports_to_the_current_format_and_evaluates() {
     assert!(text.contains("\"format_version\": 2"), "{text}");
     assert_eq!(Manifest::read(&out).unwrap(), written);
     assert_eq!(written.nets.len(), 2, "only the decentralized nets");
-    let run_nets = read_policy_files(&fixtures().join("run")).unwrap().dec;
-    assert_eq!(read_qnets(&out).unwrap().dec, run_nets);
+    let run_nets = q_nets(&read_policy_files(&fixtures().join("run")).unwrap().agents);
+    assert_eq!(q_nets(&read_nets(&out).unwrap().agents), run_nets);
 
     // The commands read old exports as they read new ones, and give the same episodes.
     let episodes = |policy: &Path| {

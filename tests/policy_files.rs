@@ -5,6 +5,7 @@
 
 use macdec::experiment::run::results_tree::CHECKPOINT;
 use macdec::experiment::run::train_run::load_checkpoint;
+use macdec::nn::ActingNet;
 use macdec::policy_files::{read_policy_files, NetRole, POLICY_DIR, POLICY_FILE};
 use std::path::Path;
 use std::process::Command;
@@ -86,9 +87,14 @@ fn policy_files_outlive_the_checkpoint_and_tolerate_added_and_missing_keys() {
         .exists());
     let trainer = load_checkpoint(&our1.join(CHECKPOINT)).unwrap();
     let policy = read_policy_files(&our1).unwrap();
-    let dec: Vec<_> = policy.dec.iter().collect();
-    assert_eq!(dec, trainer.saved_nets().dec);
-    assert_eq!(policy.cen.as_ref(), trainer.saved_nets().cen);
+    let saved: Vec<ActingNet> = trainer
+        .saved_nets()
+        .iter()
+        .map(|n| n.net.to_net())
+        .collect();
+    let read: Vec<ActingNet> = policy.agents.iter().chain(&policy.team).cloned().collect();
+    assert_eq!(read, saved);
+    assert_eq!(read.len(), 3);
     assert_eq!(
         (
             policy.manifest.run.method.as_str(),

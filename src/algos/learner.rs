@@ -13,7 +13,6 @@
 
 use crate::algos::train_error::TrainError;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
-use crate::nn::QNet;
 use rand_chacha::ChaCha8Rng;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -82,18 +81,11 @@ pub struct LearnerRngs {
     pub replay: ChaCha8Rng,
 }
 
-/// The nets a learner saves as the run's policy files, and which of them the evaluated policy is.
-pub struct SavedNets<'a> {
-    /// The actor-critic methods' actors: agent i's is `actors[i]`, or the one centralized actor
-    /// (Mac-CAC); empty for the value methods.
-    pub actors: Vec<&'a crate::nn::GruActor>,
-    /// Agent i's decentralized Q-net is `dec[i]` (empty when the method has none).
-    pub dec: Vec<&'a QNet>,
-    /// The centralized Q-net, when the method trains one.
-    pub cen: Option<&'a QNet>,
-    /// Whether evaluation acts with the centralized net (Cen-DDRQN) or the decentralized ones.
-    pub evaluated_is_centralized: bool,
-}
+/// The nets a learner saves as the run's policy files: one list, each entry saying what the net is
+/// (a Q-net or an actor), whose (one agent's, or the team's centralized net) and whether the
+/// evaluated policy acts with it. The run writer, `api` and the policy files read only this list,
+/// so nothing outside a family's folder asks which family it is.
+pub type SavedNets<'a> = Vec<crate::policy_files::SavedNet<'a>>;
 
 /// A family's method as the training loop names it in messages.
 pub trait MethodName: Copy + std::fmt::Debug {

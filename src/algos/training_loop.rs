@@ -510,12 +510,7 @@ mod tests {
             String::new()
         }
         fn saved_nets(&self) -> SavedNets<'_> {
-            SavedNets {
-                actors: Vec::new(),
-                dec: Vec::new(),
-                cen: None,
-                evaluated_is_centralized: false,
-            }
+            Vec::new()
         }
     }
 

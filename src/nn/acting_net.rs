@@ -17,6 +17,26 @@ pub enum ActingNet {
     Actor(GruActor),
 }
 
+/// An [`ActingNet`] borrowed from whoever owns it: how a learner hands its nets over to be saved
+/// (at every checkpoint) without copying them, Q-net or actor alike.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ActingNetRef<'a> {
+    /// A Q-net.
+    Q(&'a QNet),
+    /// An actor.
+    Actor(&'a GruActor),
+}
+
+impl ActingNetRef<'_> {
+    /// An owned copy, for a caller that keeps the net after its owner is gone.
+    pub fn to_net(self) -> ActingNet {
+        match self {
+            ActingNetRef::Q(q) => ActingNet::Q(q.clone()),
+            ActingNetRef::Actor(a) => ActingNet::Actor(a.clone()),
+        }
+    }
+}
+
 /// The recurrent state an [`ActingNet`] carries between an agent's decisions.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ActingState {

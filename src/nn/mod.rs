@@ -32,7 +32,7 @@ mod update;
 /// can make the process allocate beyond what a net needs (README "Limits and guarantees").
 pub const MAX_NET_WIDTH: usize = 2_048;
 
-pub use acting_net::{ActingNet, ActingState};
+pub use acting_net::{ActingNet, ActingNetRef, ActingState};
 pub use adam::{Adam, AdamConfig};
 pub use argmax::argmax;
 pub use gru::{GruState, GRU_TENSOR_NAMES};

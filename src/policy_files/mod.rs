@@ -62,6 +62,6 @@ pub use manifest::{
 };
 pub use policy_env::{CustomEnv, NotInBinary, PolicyEnv};
 pub use run_nets::{
-    dec_file_name, read_policy_files, read_qnets, write_actor_policy_files, write_policy_files,
-    PolicyNets, CEN_FILE, POLICY_DIR,
+    dec_file_name, read_nets, read_policy_files, write_policy_files, PolicyNets, SavedNet,
+    CEN_FILE, POLICY_DIR,
 };

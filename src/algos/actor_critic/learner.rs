@@ -422,11 +422,21 @@ impl Learner for AcLearner {
     }
 
     fn saved_nets(&self) -> SavedNets<'_> {
-        SavedNets {
-            actors: self.nets.actors.iter().map(|a| &a.net).collect(),
-            dec: Vec::new(),
-            cen: None,
-            evaluated_is_centralized: self.design().actor == AcActor::Centralized,
-        }
+        use crate::nn::ActingNetRef;
+        use crate::policy_files::SavedNet;
+        // Actors only (critics are for training): agent i's, or Mac-CAC's one for the team;
+        // the evaluated policy is the actors either way.
+        let central = self.design().actor == AcActor::Centralized;
+        let actors = self.nets.actors.iter().enumerate();
+        actors
+            .map(|(i, a)| {
+                let net = ActingNetRef::Actor(&a.net);
+                if central {
+                    SavedNet::team(net, true)
+                } else {
+                    SavedNet::agent(i, net, true)
+                }
+            })
+            .collect()
     }
 }

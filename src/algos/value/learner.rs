@@ -372,13 +372,16 @@ impl Learner for ValueLearner {
     }
 
     fn saved_nets(&self) -> SavedNets<'_> {
-        SavedNets {
-            actors: Vec::new(),
-            dec: self.dec_policies(),
-            cen: self.cen_policy(),
-            evaluated_is_centralized: self.method.evaluated_policy()
-                == EvaluatedPolicy::Centralized,
-        }
+        use crate::nn::ActingNetRef;
+        use crate::policy_files::SavedNet;
+        let central = self.method.evaluated_policy() == EvaluatedPolicy::Centralized;
+        let dec = self.dec_policies().into_iter().enumerate();
+        dec.map(|(i, q)| SavedNet::agent(i, ActingNetRef::Q(q), !central))
+            .chain(
+                self.cen_policy()
+                    .map(|q| SavedNet::team(ActingNetRef::Q(q), central)),
+            )
+            .collect()
     }
 }
 

@@ -28,9 +28,7 @@ use crate::files::bounded_read::{
 use crate::files::links::{
     check_real_dirs, create_real_dirs, explain_no_follow, open_options_no_follow,
 };
-use crate::policy_files::{
-    write_actor_policy_files, write_policy_files, AgentLayout, NetRole, PolicyError, RunInfo,
-};
+use crate::policy_files::{write_policy_files, AgentLayout, PolicyError, RunInfo};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -437,14 +435,9 @@ fn save_checkpoint(
     write_atomic(path, &bytes).map_err(|e| io(path, e))
 }
 
-/// Write the trainer's nets as the run's policy files (see [`crate::policy_files`]).
+/// Write the trainer's nets as the run's policy files (see [`crate::policy_files`]): the list its
+/// learner hands over, whatever the family.
 fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<(), RunError> {
-    let nets = trainer.saved_nets();
-    let evaluated = if nets.evaluated_is_centralized {
-        NetRole::Cen
-    } else {
-        NetRole::Dec
-    };
     let config = trainer.config();
     let run = RunInfo {
         experiment: spec.experiment.clone(),
@@ -460,28 +453,13 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<()
     };
     // The layout robots and `render` check the nets against; building the domain draws nothing.
     let domain = spec.env.build().map_err(|e| io(dir, e))?;
-    if !nets.actors.is_empty() {
-        write_actor_policy_files(
-            dir,
-            spec.env.clone().into(),
-            AgentLayout::of_domain(&domain),
-            config.discount(),
-            run,
-            &nets.actors,
-            nets.evaluated_is_centralized,
-        )
-        .map_err(Box::new)?;
-        return Ok(());
-    }
     write_policy_files(
         dir,
         spec.env.clone().into(),
         AgentLayout::of_domain(&domain),
         config.discount(),
-        evaluated,
         run,
-        &nets.dec,
-        nets.cen,
+        &trainer.saved_nets(),
     )
     .map_err(Box::new)?;
     Ok(())
