@@ -18,7 +18,7 @@ use crate::experiment::definition::run_settings::RunSettings;
 use crate::experiment::run::train_run::run_rngs;
 use crate::nn::ActingNet;
 use crate::policy_files::policy_env::PolicyEnv;
-use crate::policy_files::{Manifest, NetRole, RunInfo};
+use crate::policy_files::{Manifest, NetKind, NetRole, RunInfo};
 use std::path::Path;
 
 /// The `experiment` an exported library policy names in its `policy.json`.
@@ -157,6 +157,17 @@ impl TrainedPolicy {
             episodes_trained: self.episodes_trained,
             config,
         };
+        if self.agents.is_empty() {
+            // A policy that acts only centrally: say which net it is.
+            return Err(ExportError::NotDecentralized {
+                dir: out.to_path_buf(),
+                method: run.method,
+                centralized: self
+                    .team
+                    .as_ref()
+                    .map(|t| NetKind::of(t).centralized_name()),
+            });
+        }
         let agents: Vec<&ActingNet> = self.agents.iter().collect();
         export_nets(out, domain, env, self.config.discount(), run, &agents)
     }
@@ -270,7 +281,11 @@ mod tests {
         let err = cen
             .export(&dir.path().join("cen"), &env, spec.into())
             .unwrap_err();
-        assert!(err.to_string().contains("no decentralized nets"), "{err}");
+        let err = err.to_string();
+        assert!(
+            err.contains("no decentralized nets") && err.contains("its centralized Q-net"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -319,8 +334,12 @@ mod tests {
         assert_eq!(team.n_actions(), env.n_joint_actions());
         let err = cac
             .export(&dir.path().join("cac"), &env, spec.into())
-            .unwrap_err();
-        assert!(err.to_string().contains("no decentralized nets"), "{err}");
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no decentralized nets") && err.contains("its centralized actor"),
+            "{err}"
+        );
     }
 
     #[test]

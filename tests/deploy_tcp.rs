@@ -6,8 +6,8 @@
 use macdec::algos::value::evaluate::{greedy_episode, GreedyPolicy};
 use macdec::deploy::drive::driver::{run_episodes, EpisodeTrace};
 use macdec::deploy::drive::link::{JsonLink, LocalLink};
-use macdec::deploy::drive::local_eval::eval_policy;
 use macdec::deploy::drive::remote::run_with_robots_at;
+use macdec::deploy::drive::team::eval_policy;
 use macdec::deploy::policy::mock::{mock_manifest, mock_policies, MockPolicy};
 use macdec::deploy::policy::net_policy::{load_net, net_factory};
 use macdec::deploy::serve::robot::RobotSpec;

@@ -30,19 +30,51 @@ pub(super) struct EpisodeArgs {
 /// A loaded policy directory and the evaluation stream its episodes draw from.
 pub(super) struct EpisodeRun {
     pub(super) manifest: crate::policy_files::Manifest,
-    pub(super) verified: Vec<crate::policy_files::VerifiedAgent>,
     /// `--seed`, or the run's seed.
     pub(super) seed: u64,
     pub(super) rng: crate::envs::EnvRng,
 }
 
 impl EpisodeArgs {
-    /// The policy (manifest and verified weights) and the evaluation env's stream of the seed.
-    /// Every episode command simulates the domain, so a custom domain's policy is refused here.
+    /// The policy, every agent's net verified (robots serve them one by one: a policy that acts
+    /// only centrally is refused, naming its centralized net), and the evaluation env's stream
+    /// of the seed. Every episode command simulates the domain, so a custom domain's policy is
+    /// refused here.
     pub(super) fn load(&self) -> Result<EpisodeRun> {
-        use crate::experiment::definition::seeds::{stream, Role};
-        let (manifest, verified) = crate::policy_files::load_all(&self.policy)
+        let (manifest, _verified) = crate::policy_files::load_all(&self.policy)
             .with_context(|| format!("loading policy {}", self.policy.display()))?;
+        self.episode_run(manifest)
+    }
+
+    /// The policy's evaluated nets as one [`Team`](crate::deploy::drive::team::Team) acting in
+    /// this process (the agents' own nets, or the centralized net of a policy that acts only
+    /// centrally), choosing by `choice`, with the evaluation env's stream of the seed.
+    pub(super) fn load_team(
+        &self,
+        choice: crate::deploy::drive::local_eval::Choice,
+    ) -> Result<(EpisodeRun, crate::deploy::drive::team::Team)> {
+        let run = self.load_description()?;
+        let team = crate::deploy::drive::team::Team::load(
+            &run.manifest,
+            &self.policy,
+            run.manifest.evaluated,
+            choice,
+            &run.rng,
+        )
+        .with_context(|| format!("loading policy {}", self.policy.display()))?;
+        Ok((run, team))
+    }
+
+    /// The description (checked) and the evaluation stream, no weights read yet.
+    fn load_description(&self) -> Result<EpisodeRun> {
+        let manifest = crate::policy_files::Manifest::read(&self.policy)
+            .with_context(|| format!("loading policy {}", self.policy.display()))?;
+        self.episode_run(manifest)
+    }
+
+    /// `manifest` with the evaluation stream of the seed, once its domain is known here.
+    fn episode_run(&self, manifest: crate::policy_files::Manifest) -> Result<EpisodeRun> {
+        use crate::experiment::definition::seeds::{stream, Role};
         manifest
             .env
             .known()
@@ -50,7 +82,6 @@ impl EpisodeArgs {
         let seed = self.seed.unwrap_or(manifest.run.seed);
         Ok(EpisodeRun {
             manifest,
-            verified,
             seed,
             rng: stream(seed, Role::EvalEnv),
         })

@@ -14,29 +14,38 @@ pub(super) struct EvalArgs {
     sample: bool,
 }
 
-/// Play the episodes in this process and print each one's line, then the summary.
+/// Play the episodes in this process and print each one's line, then the summary. The policy
+/// acts with the nets its evaluations used: each agent's own, or its centralized net for the
+/// team (Cen-DDRQN, Mac-CAC), which only `eval` and `render` can run.
 pub(super) fn run(args: EvalArgs) -> Result<()> {
+    use crate::deploy::drive::local_eval::Choice;
+    use crate::deploy::drive::team::eval_team;
     let sample = args.sample;
     let args = args.episodes;
-    let mut run = args.load()?;
-    let mut printer = EpisodePrinter::new(args.trajectories);
     let choice = if sample {
-        crate::deploy::drive::local_eval::Choice::Sampled
+        Choice::Sampled
     } else {
-        crate::deploy::drive::local_eval::Choice::Greedy
+        Choice::Greedy
     };
-    crate::deploy::drive::local_eval::eval_policy(
+    let (mut run, mut team) = args.load_team(choice)?;
+    let mut printer = EpisodePrinter::new(args.trajectories);
+    eval_team(
         &run.manifest,
-        &run.verified,
+        &mut team,
         args.episodes,
-        choice,
         &mut run.rng,
         |trace| printer.print(trace),
     )
     .with_context(|| format!("evaluating {}", args.policy.display()))?;
+    let place = match team {
+        crate::deploy::drive::team::Team::Agents(_) => "in-process".to_string(),
+        crate::deploy::drive::team::Team::Central(c) => {
+            format!("in-process, acting centrally with its {}", c.kind_name())
+        }
+    };
     eprintln!(
         "{}, mean undiscounted {:.4}",
-        printer.summary(&run, "in-process"),
+        printer.summary(&run, &place),
         printer.mean_undiscounted()
     );
     Ok(())

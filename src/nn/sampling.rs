@@ -63,27 +63,51 @@ pub fn conditioned_joint(
 ) {
     mixture(logp, eps, probs);
     for (j, p) in probs.iter_mut().enumerate() {
-        let mut rest = j;
-        for i in (0..n_actions.len()).rev() {
-            let a = rest % n_actions[i];
-            rest /= n_actions[i];
-            if !free[i] && a != running[i] {
-                *p = 0.0;
-                break;
-            }
+        if !keeps_busy_agents(j, free, running, n_actions) {
+            *p = 0.0;
         }
     }
     let mut j = match pick {
         Pick::Sample(rng) => sample_weighted(probs, rng),
-        Pick::MostProbable => {
-            let mut best = 0;
-            for (j, &p) in probs.iter().enumerate() {
-                if p > probs[best] {
-                    best = j;
-                }
-            }
-            best
+        Pick::MostProbable => return conditioned_argmax(logp, free, running, n_actions, actions),
+    };
+    for i in (0..n_actions.len()).rev() {
+        actions[i] = j % n_actions[i];
+        j /= n_actions[i];
+    }
+}
+
+/// Whether joint macro-action `joint` (C order, agent 0 most significant) keeps every busy
+/// agent's running macro-action (`running[i]` where `!free[i]`).
+fn keeps_busy_agents(joint: usize, free: &[bool], running: &[usize], n_actions: &[usize]) -> bool {
+    let mut rest = joint;
+    for i in (0..n_actions.len()).rev() {
+        if !free[i] && rest % n_actions[i] != running[i] {
+            return false;
         }
+        rest /= n_actions[i];
+    }
+    true
+}
+
+/// The greedy joint macro-action of a centralized net's `scores` (Q-values or an actor's
+/// log-probabilities, one per joint macro-action): the highest score among the joint
+/// macro-actions that keep every busy agent's running macro-action, the first in C order on ties
+/// and a NaN never winning ([`crate::nn::argmax`]'s rule), unravelled into `actions`. For a
+/// centralized Q-net this is the conditional argmax (`docs/ALGORITHMS.md` §4.3); for Mac-CAC's
+/// actor, its most probable allowed joint macro-action. A busy agent's part is left as
+/// `running[i]`. With no allowed joint macro-action (a `running[i]` out of range), `actions` is
+/// left as it was.
+pub fn conditioned_argmax(
+    scores: &[f32],
+    free: &[bool],
+    running: &[usize],
+    n_actions: &[usize],
+    actions: &mut [usize],
+) {
+    let allowed = (0..scores.len()).filter(|&j| keeps_busy_agents(j, free, running, n_actions));
+    let Some(mut j) = super::argmax::first_argmax(allowed.map(|j| (j, scores[j]))) else {
+        return;
     };
     for i in (0..n_actions.len()).rev() {
         actions[i] = j % n_actions[i];

@@ -144,8 +144,9 @@ pub enum PolicyError {
         /// Agents the policy has.
         n_agents: usize,
     },
-    /// The policy has no per-agent Q-net for this agent (e.g. a centralized-only method).
-    #[error("{path}: agent {agent} has no decentralized Q-net in this policy (method {method})")]
+    /// The policy has no net of this agent's own: it acts only through a centralized net (or
+    /// holds none for the agent), so no robot can serve the agent.
+    #[error("{path}: agent {agent} has no decentralized net in this policy (method {method}){}", acts_centrally(*.centralized))]
     NoAgentNet {
         /// The description file.
         path: PathBuf,
@@ -153,13 +154,32 @@ pub enum PolicyError {
         agent: usize,
         /// The policy's method name.
         method: String,
+        /// What the policy's centralized net is (`centralized Q-net`, `centralized actor`), if
+        /// it has one.
+        centralized: Option<&'static str>,
+    },
+    /// A centralized net was asked of a policy without one.
+    #[error("the policy has no centralized net (method {method})")]
+    NoCentralNet {
+        /// The policy's method name.
+        method: String,
     },
     /// Sampling was asked of a Q-net policy, which only acts greedily.
-    #[error("agent {agent}'s net is a Q-net: sampling (--sample) needs an actor policy, whose scores are log-probabilities; Q-net policies act greedily")]
+    #[error("{whose} is a Q-net: sampling (--sample) needs an actor policy, whose scores are log-probabilities; Q-net policies act greedily")]
     NotAnActor {
-        /// Agent index whose net is a Q-net.
-        agent: usize,
+        /// Whose net it is: `agent 0's net`, `the centralized net`.
+        whose: String,
     },
+}
+
+/// Why a policy with only a centralized net cannot be served agent by agent, or nothing.
+fn acts_centrally(centralized: Option<&'static str>) -> String {
+    match centralized {
+        Some(net) => format!(
+            ": it acts only through its {net}, which reads every agent's observation and picks the team's joint macro-action, so no robot can serve one agent of it; run it centrally with `macdec eval --policy DIR`"
+        ),
+        None => String::new(),
+    }
 }
 
 impl PolicyError {

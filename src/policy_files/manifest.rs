@@ -38,6 +38,23 @@ pub enum NetKind {
 }
 
 impl NetKind {
+    /// What `net` computes.
+    pub fn of(net: &ActingNet) -> NetKind {
+        match net {
+            ActingNet::Q(_) => NetKind::Q,
+            ActingNet::Actor(_) => NetKind::Actor,
+        }
+    }
+
+    /// The words for a centralized net of this kind, for messages: `centralized Q-net`,
+    /// `centralized actor`.
+    pub fn centralized_name(self) -> &'static str {
+        match self {
+            NetKind::Q => "centralized Q-net",
+            NetKind::Actor => "centralized actor",
+        }
+    }
+
     /// What a net of `architecture` computes: an actor for [`GRU_ACTOR`], else Q-values.
     pub fn of_architecture(architecture: &Architecture) -> NetKind {
         if architecture.kind == GRU_ACTOR {
@@ -727,7 +744,8 @@ impl Manifest {
             .position(|n| matches!(n.kind, NetKind::Q | NetKind::Actor) && n.role == NetRole::Cen)
     }
 
-    /// The index in `nets` of agent `agent`'s decentralized Q-net: the net a robot runs.
+    /// The index in `nets` of agent `agent`'s decentralized net (a Q-net or an actor): the net a
+    /// robot runs. A policy that acts only centrally is refused, naming its centralized net.
     pub fn agent_net(&self, agent: usize) -> Result<usize, PolicyError> {
         if agent >= self.agents.len() {
             return Err(PolicyError::AgentOutOfRange {
@@ -746,6 +764,7 @@ impl Manifest {
                 path: PathBuf::from(POLICY_FILE),
                 agent,
                 method: self.run.method.clone(),
+                centralized: self.cen_net().map(|i| self.nets[i].kind.centralized_name()),
             })
     }
 

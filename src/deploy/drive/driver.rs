@@ -80,6 +80,53 @@ pub enum DeployError {
     Output(#[from] std::io::Error),
 }
 
+/// Whoever picks the free agents' macro-actions in an episode: one robot per agent over its link
+/// ([`Robots`]), or a team acting in this process
+/// ([`crate::deploy::drive::team::Team`]). The episode loop ([`play_episode`]) is the same for
+/// all, so `eval`'s episodes of a centralized policy are counted and reported as deploy's are.
+pub trait TeamDecisions {
+    /// A new episode (the environment was just reset): zero every hidden state.
+    fn reset(&mut self) -> Result<(), DeployError>;
+    /// Write each free agent's next macro-action into `actions`; busy agents' entries stay.
+    fn decide<E: MacroEnv + ?Sized>(
+        &mut self,
+        env: &E,
+        actions: &mut [usize],
+    ) -> Result<(), DeployError>;
+}
+
+/// One robot per agent, in agent order: each gets its agent's observation and whether its
+/// macro-action just finished, every primitive step.
+pub struct Robots<'a, L>(pub &'a mut [L]);
+
+impl<L: RobotLink> TeamDecisions for Robots<'_, L> {
+    fn reset(&mut self) -> Result<(), DeployError> {
+        for (agent, robot) in self.0.iter_mut().enumerate() {
+            robot
+                .reset()
+                .map_err(|source| DeployError::Link { agent, source })?;
+        }
+        Ok(())
+    }
+
+    fn decide<E: MacroEnv + ?Sized>(
+        &mut self,
+        env: &E,
+        actions: &mut [usize],
+    ) -> Result<(), DeployError> {
+        for (agent, robot) in self.0.iter_mut().enumerate() {
+            let free = env.is_free(agent);
+            let chosen = robot
+                .observe(env.obs(agent), free)
+                .map_err(|source| DeployError::Link { agent, source })?;
+            if let Some(a) = chosen {
+                actions[agent] = a;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Run one episode from reset to done. Every primitive step, each agent's robot gets that agent's
 /// observation and whether its macro-action just finished (all agents after reset); the robots
 /// of free agents answer with their next macro-action. Robots are reset first.
@@ -90,28 +137,36 @@ pub fn run_episode<E: MacroEnv + ?Sized, L: RobotLink>(
     rng: &mut EnvRng,
     episode: usize,
 ) -> Result<EpisodeTrace, DeployError> {
-    let n = env.n_agents();
-    if robots.len() != n {
+    check_robot_count(env, robots.len())?;
+    play_episode(env, &mut Robots(robots), discount, rng, episode)
+}
+
+fn check_robot_count<E: MacroEnv + ?Sized>(env: &E, robots: usize) -> Result<(), DeployError> {
+    if robots != env.n_agents() {
         return Err(DeployError::RobotCount {
-            expected: n,
-            got: robots.len(),
+            expected: env.n_agents(),
+            got: robots,
         });
     }
-    let link = |agent| move |source| DeployError::Link { agent, source };
+    Ok(())
+}
+
+/// One episode from reset to done with `team` choosing: the environment is reset, then the
+/// team; every primitive step the team decides, the environment steps and the step is recorded.
+pub fn play_episode<E: MacroEnv + ?Sized, T: TeamDecisions>(
+    env: &mut E,
+    team: &mut T,
+    discount: f64,
+    rng: &mut EnvRng,
+    episode: usize,
+) -> Result<EpisodeTrace, DeployError> {
     env.reset(rng);
-    for (agent, robot) in robots.iter_mut().enumerate() {
-        robot.reset().map_err(link(agent))?;
-    }
-    let mut actions = vec![0usize; n];
+    team.reset()?;
+    let mut actions = vec![0usize; env.n_agents()];
     let mut trajectory = Vec::new();
     let (mut discounted, mut undiscounted, mut weight) = (0.0, 0.0, 1.0);
     loop {
-        for (agent, robot) in robots.iter_mut().enumerate() {
-            let free = env.is_free(agent);
-            if let Some(a) = robot.observe(env.obs(agent), free).map_err(link(agent))? {
-                actions[agent] = a;
-            }
-        }
+        team.decide(&*env, &mut actions)?;
         let out = env.step(&actions, rng)?;
         discounted += weight * out.reward;
         undiscounted += out.reward;
@@ -160,10 +215,31 @@ pub fn run_episodes_with<E: MacroEnv + ?Sized, L: RobotLink>(
     discount: f64,
     episodes: usize,
     rng: &mut EnvRng,
+    on_episode: impl FnMut(EpisodeTrace) -> Result<(), DeployError>,
+) -> Result<(), DeployError> {
+    check_robot_count(env, robots.len())?;
+    play_episodes_with(
+        env,
+        &mut Robots(robots),
+        discount,
+        episodes,
+        rng,
+        on_episode,
+    )
+}
+
+/// [`run_episodes_with`] for any [`TeamDecisions`]: `episodes` episodes of [`play_episode`] in a
+/// row on one random stream, each handed to `on_episode` as it ends.
+pub fn play_episodes_with<E: MacroEnv + ?Sized, T: TeamDecisions>(
+    env: &mut E,
+    team: &mut T,
+    discount: f64,
+    episodes: usize,
+    rng: &mut EnvRng,
     mut on_episode: impl FnMut(EpisodeTrace) -> Result<(), DeployError>,
 ) -> Result<(), DeployError> {
     for k in 0..episodes {
-        on_episode(run_episode(env, robots, discount, rng, k)?)?;
+        on_episode(play_episode(env, team, discount, rng, k)?)?;
     }
     Ok(())
 }

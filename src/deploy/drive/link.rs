@@ -334,13 +334,28 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
                 ProtocolError::NonFiniteQ { action, value }.to_string(),
             ));
         }
-        Ok(Some(match &mut self.sampler {
-            None => greedy_action(&self.q),
-            Some(rng) => {
-                crate::nn::sampling::mixture(&self.q, None, &mut self.probs);
-                crate::nn::sampling::sample_weighted(&self.probs, rng)
-            }
-        }))
+        Ok(Some(choose_action(
+            &self.q,
+            self.sampler.as_mut(),
+            &mut self.probs,
+        )))
+    }
+}
+
+/// An agent's macro-action from its net's `scores`: the greedy one, or with `sampler` a draw from
+/// the distribution exp(score) (an actor's log-probabilities; MacroMARL's evaluation), as
+/// `macdec eval` and `eval --sample` choose. `probs` is scratch space.
+pub fn choose_action(
+    scores: &[f32],
+    sampler: Option<&mut rand_chacha::ChaCha8Rng>,
+    probs: &mut Vec<f64>,
+) -> usize {
+    match sampler {
+        None => greedy_action(scores),
+        Some(rng) => {
+            crate::nn::sampling::mixture(scores, None, probs);
+            crate::nn::sampling::sample_weighted(probs, rng)
+        }
     }
 }
 

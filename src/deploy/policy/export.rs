@@ -20,13 +20,16 @@ pub enum ExportError {
     /// Reading the run's policy or writing the export failed.
     #[error(transparent)]
     Policy(#[from] PolicyError),
-    /// The run's method has only centralized nets (e.g. Cen-DDRQN), which no single robot can run.
-    #[error("{dir}: the run trained {method}, which has no decentralized nets to put on robots (export a dec-hddrqn, our1, our1-r, our2 run or a decentralized actor-critic run)")]
+    /// The run's policy acts only through a centralized net (Cen-DDRQN's Q-net, Mac-CAC's
+    /// actor), which no single robot can run.
+    #[error("{dir}: the run trained {method}, which has no decentralized nets to put on robots{}", centralized_only(*.centralized))]
     NotDecentralized {
         /// The run directory.
         dir: PathBuf,
         /// The method's name.
         method: String,
+        /// What its centralized net is (`centralized Q-net`, `centralized actor`), if it has one.
+        centralized: Option<&'static str>,
     },
     /// A file could not be read or written.
     #[error("{path}: {message}")]
@@ -46,6 +49,16 @@ pub enum ExportError {
         /// Decentralized nets found.
         got: usize,
     },
+}
+
+/// What a run whose policy is one centralized net can do instead of an export.
+fn centralized_only(centralized: Option<&'static str>) -> String {
+    match centralized {
+        Some(net) => format!(
+            ": its policy is its {net}, which reads every agent's observation and picks the team's joint macro-action, so no robot can run it; evaluate it centrally (`macdec eval --policy RUN/policy`, `macdec render --run RUN`)"
+        ),
+        None => String::new(),
+    }
 }
 
 /// Export the run in `run_dir` (its `policy/` files of any format version, see
@@ -87,10 +100,11 @@ fn agent_net_files(run_dir: &Path, dir: &Path, m: &Manifest) -> Result<Vec<NetFi
     for agent in 0..m.agents.len() {
         let verified = match m.verify_agent(dir, agent) {
             Ok(v) => v,
-            Err(PolicyError::NoAgentNet { .. }) => {
+            Err(PolicyError::NoAgentNet { centralized, .. }) => {
                 return Err(ExportError::NotDecentralized {
                     dir: run_dir.to_path_buf(),
                     method: m.run.method.clone(),
+                    centralized,
                 })
             }
             Err(e) => return Err(e.into()),
@@ -128,6 +142,7 @@ pub fn export_nets(
         return Err(ExportError::NotDecentralized {
             dir: out.to_path_buf(),
             method: run.method,
+            centralized: None,
         });
     }
     if nets.len() != domain.n_agents() {
