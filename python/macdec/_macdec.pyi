@@ -83,6 +83,7 @@ class Policy:
     obs_sizes: List[int]
     n_actions: List[int]
     kinds: List[str]
+    centralized: bool
     discount: float
     run: Dict[str, Any]
     @staticmethod
@@ -91,5 +92,8 @@ class Policy:
     def action_names(self) -> List[List[str]]: ...
     def reset(self) -> None: ...
     def act(
-        self, obs: Sequence[npt.NDArray[np.float32]], mac_done: Sequence[bool]
+        self,
+        obs: Sequence[npt.NDArray[np.float32]],
+        mac_done: Sequence[bool],
+        sample: bool = False,
     ) -> Tuple[List[Optional[int]], List[Optional[npt.NDArray[np.float32]]]]: ...

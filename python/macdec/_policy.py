@@ -11,11 +11,16 @@ from . import _macdec
 
 
 class Policy:
-    """A policy directory's decentralized nets (Q-nets or actors) with their hidden states.
+    """A policy directory's nets (Q-nets or actors) with their hidden states, acting as
+    ``macdec eval`` runs them.
 
-    Load one with :meth:`Policy.load`. Each agent acts on its own macro-observation only, and
-    only when its macro-action is done: its hidden state then advances one macro-step and it
-    picks the highest score (ties to the lowest index), exactly as ``macdec eval`` and robots do.
+    Load one with :meth:`Policy.load`. Most policies are one net per agent: each agent acts on
+    its own macro-observation only, and only when its macro-action is done: its hidden state then
+    advances one macro-step and it picks the highest score (ties to the lowest index), exactly
+    as ``macdec eval`` and robots do. A policy that acts only centrally (Cen-DDRQN's Q-net,
+    Mac-CAC's actor; :attr:`centralized`) is one net for the whole team: whenever an agent is
+    done it reads every agent's observation and picks a joint macro-action that keeps the busy
+    agents' running ones, as ``macdec eval`` runs it (no robot can serve it).
     """
 
     def __init__(self, core: "_macdec.Policy") -> None:
@@ -25,9 +30,11 @@ class Policy:
 
     @classmethod
     def load(cls, path: Union[str, os.PathLike]) -> "Policy":
-        """Load a policy directory: a run's ``policy/`` (or the run directory itself), a
-        ``macdec export`` or ``macdec import`` output. Every weight file is checked (SHA-256,
-        shapes, domain layout); a problem raises ValueError naming it."""
+        """Load a policy directory: a run's ``policy/`` (or the run directory itself) of any
+        method, a ``macdec export`` or ``macdec import`` output. The nets loaded are the ones the
+        run's evaluations used (each agent's own, or the team's centralized net). Every weight
+        file is checked (SHA-256, shapes, domain layout); a problem raises ValueError naming
+        it."""
         return cls(_macdec.Policy.load(os.fspath(path)))
 
     @property
@@ -39,6 +46,11 @@ class Policy:
     def kinds(self) -> list:
         """Each agent's net: ``"q"`` (scores are Q-values) or ``"actor"`` (log-probabilities)."""
         return self._core.kinds
+
+    @property
+    def centralized(self) -> bool:
+        """Whether the policy is one centralized net acting for the whole team."""
+        return self._core.centralized
 
     @property
     def discount(self) -> float:
@@ -80,14 +92,21 @@ class Policy:
         obs: Union[Mapping[str, Any], Sequence[Any]],
         mac_done: Union[Mapping[str, Any], Sequence[bool]],
         return_scores: bool = False,
+        sample: bool = False,
     ):
         """Each agent's macro-action for one primitive step: ``{agent: action}``.
 
         ``obs`` and ``mac_done`` are dicts by agent (as ``parallel_env`` gives them; ``mac_done``
         may also be the ``infos`` dict) or lists in agent order. Agents whose ``mac_done`` is
         true decide (their hidden state advances); the others keep their running macro-action.
-        The deciding agents' raw scores (Q-values or log-probabilities) are in ``self.scores``,
-        and also returned with ``return_scores=True`` as ``(actions, scores)``.
+        Greedy by default; ``sample=True`` draws each decision from the actors' distributions
+        as MacroMARL evaluates (the streams ``macdec eval --sample`` draws from, seeded by the
+        run's seed and continuing across :meth:`reset`); a Q-net policy refuses it with
+        ValueError, since Q-values are not probabilities. The raw scores of the decision
+        (Q-values or log-probabilities) are in ``self.scores`` and also returned with
+        ``return_scores=True`` as ``(actions, scores)``: by deciding agent, or for a centralized
+        policy as ``{"team": scores}`` over joint macro-actions (C order, agent 0 most
+        significant).
         """
         obs_list = [self._pick(obs, i, a) for i, a in enumerate(self.agents)]
         done_list = []
@@ -97,8 +116,9 @@ class Policy:
                 d = d["mac_done"]
             done_list.append(bool(d))
         obs_arrays = [np.ascontiguousarray(o, dtype=np.float32).reshape(-1) for o in obs_list]
-        actions, scores = self._core.act(obs_arrays, done_list)
-        self.scores = {a: s for a, s in zip(self.agents, scores) if s is not None}
+        actions, scores = self._core.act(obs_arrays, done_list, sample)
+        names = ["team"] if self.centralized else self.agents
+        self.scores = {a: s for a, s in zip(names, scores) if s is not None}
         acts = {a: int(x) for a, x in zip(self.agents, actions) if x is not None}
         return (acts, dict(self.scores)) if return_scores else acts
 
