@@ -93,11 +93,11 @@ fn keeps_busy_agents(joint: usize, free: &[bool], running: &[usize], n_actions: 
 /// The greedy joint macro-action of a centralized net's `scores` (Q-values or an actor's
 /// log-probabilities, one per joint macro-action): the highest score among the joint
 /// macro-actions that keep every busy agent's running macro-action, the first in C order on ties
-/// and a NaN never winning ([`crate::nn::argmax`]'s rule), unravelled into `actions`. For a
-/// centralized Q-net this is the conditional argmax (`docs/ALGORITHMS.md` §4.3); for Mac-CAC's
-/// actor, its most probable allowed joint macro-action. A busy agent's part is left as
-/// `running[i]`. With no allowed joint macro-action (a `running[i]` out of range), `actions` is
-/// left as it was.
+/// and a NaN never winning ([`crate::nn::argmax::first_argmax`]'s rule), unravelled into
+/// `actions`. For a centralized Q-net this is the conditional argmax (`docs/ALGORITHMS.md` §4.3);
+/// for Mac-CAC's actor, its most probable allowed joint macro-action. A busy agent's part is left
+/// as `running[i]`. With no allowed joint macro-action (a `running[i]` out of range), `actions`
+/// is left as it was.
 pub fn conditioned_argmax(
     scores: &[f32],
     free: &[bool],

@@ -7,9 +7,12 @@
 //! It sits beside [`crate::files`] on the ground floor: it knows domains ([`crate::envs`]) and
 //! nets ([`crate::nn`]), never a learner, a run or a robot, so every layer may read and write it.
 //!
-//! Nets are described by kind (`q`; later `actor`, `critic`), role (`dec` with an agent, or
-//! `cen`), their input and output lengths and their architecture, so a policy of another family
-//! (MacroMARL's per-agent actors and centralized critics) is written and loaded the same way. An
+//! Nets are described by kind (`q` or `actor`; a critic would be another), role (`dec` with an
+//! agent, or `cen`), their input and output lengths and their architecture, so every family's
+//! policy is written and loaded the same way: a training run's learner hands over one list of
+//! nets, each saying its kind, role and agent and whether the evaluated policy acts with it
+//! ([`SavedNet`]), and [`write_policy_files`] writes that list without asking which family
+//! trained it. An
 //! export is a policy directory holding fewer nets: each agent's decentralized net (`evaluated`
 //! `dec`) beside the per-agent layout robots need.
 //!
