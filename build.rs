@@ -13,14 +13,14 @@ fn git(args: &[&str]) -> Option<String> {
 }
 
 fn main() {
-    for path in [
-        ".git/HEAD",
-        ".git/index",
-        "src",
-        "Cargo.toml",
-        "Cargo.lock",
-        "build.rs",
-    ] {
+    // Git's own paths: in a linked worktree `.git` is a file and HEAD and the index live
+    // elsewhere; watching a path that does not exist would rebuild the crate every time.
+    for name in ["HEAD", "index"] {
+        let path =
+            git(&["rev-parse", "--git-path", name]).unwrap_or_else(|| format!(".git/{name}"));
+        println!("cargo:rerun-if-changed={path}");
+    }
+    for path in ["src", "Cargo.toml", "Cargo.lock", "build.rs"] {
         println!("cargo:rerun-if-changed={path}");
     }
     let commit = match git(&["rev-parse", "HEAD"]) {

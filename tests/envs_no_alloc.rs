@@ -65,8 +65,16 @@ fn stepping_and_resetting_allocate_nothing() {
         specs.push(EnvSpec::new(id, &toml::Table::new()).unwrap());
         specs.push(EnvSpec::new(id, &noisy).unwrap());
     }
-    // Not yet Overcooked: its reset copies the start kitchen and its A* buffers grow, so it
-    // allocates as it steps (docs/PERFORMANCE.md).
+    // Overcooked's maps A-C with 2 and 3 agents, both grid sizes.
+    for map in ["A", "B", "C"] {
+        for (n_agent, side) in [(2, 7), (3, 7), (3, 9)] {
+            let mut keys = toml::Table::new();
+            keys.insert("map_type".into(), map.into());
+            keys.insert("n_agent".into(), n_agent.into());
+            keys.insert("grid_dim".into(), vec![side, side].into());
+            specs.push(EnvSpec::new("Overcooked-MA-v1", &keys).unwrap());
+        }
+    }
     for spec in specs {
         let mut env = spec.build().unwrap();
         let mut policy_rng = ChaCha8Rng::seed_from_u64(3);

@@ -36,14 +36,22 @@ fn lt(a: &Node, b: &Node) -> bool {
     }
 }
 
-/// A binary heap with CPython's `heapq` algorithm and `lt` as `<`. The buffer is reused, so
-/// searching allocates nothing once it has grown to the largest frontier.
+/// A binary heap with CPython's `heapq` algorithm and `lt` as `<`. The buffer is reused and
+/// sized for the whole grid before the first search, so searching never allocates again.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct PyHeap {
     items: Vec<Node>,
 }
 
 impl PyHeap {
+    /// An empty heap with room for every cell of a `side` x `side` grid, the most a search
+    /// ever holds, so no search on that grid allocates.
+    pub fn for_grid(side: usize) -> PyHeap {
+        PyHeap {
+            items: Vec::with_capacity(side * side),
+        }
+    }
+
     /// Remove every node, keeping the allocation.
     pub fn clear(&mut self) {
         self.items.clear();
@@ -125,6 +133,10 @@ pub fn navigate(pomap: &Cells, side: usize, from: Cell, target: Cell, heap: &mut
             || v[c.x as usize][c.y as usize]
     };
     heap.clear();
+    // Every cell is pushed at most once (it is marked visited when pushed), so the frontier
+    // never outgrows the grid. A heap made by `for_grid` already has the room; a default one
+    // (a deserialized environment's) gets it at its first search.
+    heap.items.reserve(side * side);
     heap.push(Node {
         at: from,
         g: 0,

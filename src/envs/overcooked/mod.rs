@@ -169,7 +169,7 @@ impl Overcooked {
             t: 0,
             done: false,
             primitive: vec![STAY; n],
-            heap: PyHeap::default(),
+            heap: PyHeap::for_grid(params.side),
             params,
         };
         env.reset_state();
