@@ -12,8 +12,7 @@ use crate::algos::families::Method;
 use crate::algos::families::RunConfig;
 use crate::algos::training_loop::{Advance, EvalPoint, TrainError};
 use crate::deploy::policy::export::{export_nets, ExportError};
-use crate::envs::{EnvError, MacroEnv};
-use crate::experiment::definition::config::validate;
+use crate::envs::{EnvError, EnvShape, MacroEnv};
 use crate::experiment::definition::run_settings::RunSettings;
 use crate::experiment::run::train_run::run_rngs;
 use crate::nn::ActingNet;
@@ -93,9 +92,11 @@ pub fn train_policy<E: MacroEnv>(
     seed: u64,
     mut on_episode: impl FnMut(&AnyLoop<E>),
 ) -> Result<TrainedPolicy, LibraryTrainError> {
-    // The domain's horizon bounds the episode buffer's sequences: ask one instance.
-    let horizon = make_env().map_err(TrainError::from)?.horizon();
-    validate(config, method, horizon)
+    // The domain's sizes (horizon, observation and macro-action counts) bound the nets and
+    // batches: ask one instance.
+    let shape = EnvShape::of_env(&make_env().map_err(TrainError::from)?);
+    method
+        .check(config, &shape)
         .map_err(|(key, message)| LibraryTrainError::Config { key, message })?;
     let mut trainer = AnyLoop::new(config, method, seed, run_rngs(seed), make_env)?;
     while trainer.advance()? != Advance::Finished {

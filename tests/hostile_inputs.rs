@@ -536,3 +536,60 @@ fn a_robot_reads_its_weight_file_before_building_a_net_the_manifest_sizes() {
     let err = refused(&out);
     assert!(err.contains("dec_agent_0.safetensors"), "{err}");
 }
+
+#[test]
+fn a_joint_action_net_beyond_the_memory_bound_is_refused_before_any_run_starts() {
+    // Mac-CAC on Overcooked B scores 15^3 = 3375 joint macro-actions: 200 episodes per update
+    // would need more than 5 GB. Within 2 GB of address space the batch is refused by name
+    // before any of its runs starts, so no run (Mac-IAICC's included) is lost half-way.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("results");
+    let config = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/experiments/macromarl/overcooked_b.toml"
+    );
+    let err = refused(&macdec_within(
+        &[
+            "train",
+            "--config",
+            config,
+            "--methods",
+            "mac-iaicc,mac-cac",
+            "--seeds",
+            "0",
+            "--set",
+            "n_env=200",
+            "--set",
+            "train_freq=200",
+            "--out",
+            s(&out),
+            "--quiet",
+            "--no-plot",
+        ],
+        Duration::from_secs(60),
+        Some(2 << 30),
+    ));
+    assert!(
+        err.contains("train_freq") && err.contains("widest output 3375"),
+        "{err}"
+    );
+    let runs = walkdir_count(&out);
+    assert_eq!(runs, 0, "{err}");
+}
+
+/// Files under `dir` (0 when it does not exist).
+fn walkdir_count(dir: &Path) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .map(|e| {
+            if e.file_type().is_ok_and(|t| t.is_dir()) {
+                walkdir_count(&e.path())
+            } else {
+                1
+            }
+        })
+        .sum()
+}

@@ -60,6 +60,16 @@ def test_bad_configs_are_named(tmp_path):
     assert not any(tmp_path.iterdir())
 
 
+def test_a_joint_action_net_beyond_the_memory_bound_is_a_value_error(tmp_path):
+    # Mac-CAC on Overcooked B scores 15^3 = 3375 joint macro-actions: 200 episodes per update
+    # would need more than 5 GB. It is refused by name before anything is allocated, instead of
+    # aborting the interpreter.
+    config = {"methods": ["mac-cac"], "params": {"env_name": "Overcooked-MA-v1", "map_type": "B"}}
+    with pytest.raises(ValueError, match="widest output 3375"):
+        macdec.train(config, out=tmp_path, overrides={"n_env": 200, "train_freq": 200})
+    assert not any(tmp_path.iterdir())
+
+
 def test_ctrl_c_stops_cleanly_and_training_again_resumes_to_the_same_metrics(tmp_path, run_cli):
     config = tmp_path / "long.toml"
     config.write_text(TINY.replace("total_epi = 60", "total_epi = 3000").replace('seeds = "0..2"', 'seeds = "0"')

@@ -13,6 +13,54 @@ pub use crate::nn::MAX_NET_WIDTH;
 /// Elements of one batch activation: batch x sequence length x widest layer (2^28 f32 = 1 GiB;
 /// paper: about 1.5e5).
 pub const MAX_BATCH_ELEMENTS: u128 = 1 << 28;
+/// Copies of an output-width array one update keeps per sequence step: the logits or Q-values,
+/// their softmax, log-softmax and masks, and each one's gradient (measured: Mac-CAC on Overcooked
+/// B, 3375 joint macro-actions, needs about 15 per element of train_freq x horizon x 3375).
+pub const OUTPUT_COPIES: u128 = 16;
+/// Copies of a hidden-width array per sequence step: a recurrent cell's gates (4 for an LSTM).
+pub const HIDDEN_COPIES: u128 = 4;
+
+/// The widths one update's activations are made of, per sequence step of one batch sequence.
+#[derive(Debug, Clone, Copy)]
+pub struct NetWidths {
+    /// The widest hidden layer of any net.
+    pub hidden: u128,
+    /// The widest input of any net (a centralized net's joint observation).
+    pub input: u128,
+    /// The widest output of any net (a centralized actor's or Q-net's joint macro-actions).
+    pub output: u128,
+}
+
+/// One update's batch activations, `sequences` x `seq_len` steps of `widths` (hidden layers
+/// [`HIDDEN_COPIES`] times, outputs [`OUTPUT_COPIES`] times, so a joint-action output counts for
+/// what it costs), must stay within [`MAX_BATCH_ELEMENTS`]. `key` and `seq_key` name the two
+/// factors in the message.
+pub fn check_batch_activations(
+    (key, sequences): (&'static str, usize),
+    (seq_key, seq_len): (&'static str, usize),
+    widths: NetWidths,
+) -> Result<(), (&'static str, String)> {
+    let per_step = (HIDDEN_COPIES * widths.hidden)
+        .saturating_add(widths.input)
+        .saturating_add(OUTPUT_COPIES.saturating_mul(widths.output));
+    let elements = (sequences as u128)
+        .saturating_mul(seq_len as u128)
+        .saturating_mul(per_step);
+    if elements > MAX_BATCH_ELEMENTS {
+        return Err((
+            key,
+            format!(
+                "{key} x {seq_key} x the nets' widths per step = {sequences} x {seq_len} x {per_step} \
+                 = {elements} activations in one update, at most {MAX_BATCH_ELEMENTS} (widths per \
+                 step: {HIDDEN_COPIES} x the widest hidden layer {}, the widest input {}, \
+                 {OUTPUT_COPIES} x the widest output {}, a centralized net's joint macro-actions)",
+                widths.hidden, widths.input, widths.output
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Training episodes, `total_epi` (paper: 40000).
 pub const MAX_TOTAL_EPI: usize = 100_000_000;
 /// Evaluation rows a run keeps, total_epi / eval_freq (paper: 4000).

@@ -11,7 +11,7 @@
 use crate::algos::family::{FamilyFacts, FamilyMethod};
 use crate::algos::learner::{FamilyConfig, MethodName, SavedNets};
 use crate::algos::training_loop::{Advance, EvalPoint, RunRngs, TrainError, TrainingLoop};
-use crate::envs::{AnyEnv, EnvError, EnvSpec, MacroEnv};
+use crate::envs::{AnyEnv, EnvError, EnvShape, EnvSpec, MacroEnv};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::fmt;
 use std::str::FromStr;
@@ -119,11 +119,11 @@ macro_rules! families {
             pub fn check(
                 self,
                 config: &RunConfig,
-                horizon: usize,
+                shape: &EnvShape,
             ) -> Result<(), (&'static str, String)> {
                 #[allow(unreachable_patterns)]
                 match (self, config) {
-                    $((Method::$family(m), RunConfig::$family(c)) => m.check(c, horizon),)+
+                    $((Method::$family(m), RunConfig::$family(c)) => m.check(c, shape),)+
                     _ => Err((
                         "config",
                         format!(
@@ -443,8 +443,9 @@ mod tests {
         let our1: Method = "our1".parse().unwrap();
         let mac_iac: Method = "mac-iac".parse().unwrap();
         let c = our1.defaults(&env);
-        assert!(our1.check(&c, 100).is_ok());
-        let (key, why) = mac_iac.check(&c, 100).unwrap_err();
+        let shape = crate::envs::EnvShape::of(&env).unwrap();
+        assert!(our1.check(&c, &shape).is_ok());
+        let (key, why) = mac_iac.check(&c, &shape).unwrap_err();
         assert_eq!(key, "config");
         assert!(
             why.contains("actor-critic") && why.contains("value"),

@@ -6,7 +6,7 @@
 //! one of its methods. (The config trait, [`FamilyConfig`], is the loop's: `algos::learner`.)
 
 use crate::algos::learner::{FamilyConfig, Learner, MethodName};
-use crate::envs::EnvSpec;
+use crate::envs::{EnvShape, EnvSpec};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::fmt::Debug;
@@ -52,8 +52,9 @@ pub trait FamilyMethod:
     /// Panics if a domain's published settings name a key the family does not have or give it
     /// the wrong type: they are code, checked for every built-in domain by the family's tests.
     fn defaults(self, env: &EnvSpec) -> Self::Config;
-    /// Range checks types cannot express, for a domain whose episodes last at most `horizon`
-    /// primitive steps: the offending key and why. Every size the run allocates by is bounded
-    /// here, with all its factors, before anything is allocated.
-    fn check(self, config: &Self::Config, horizon: usize) -> Result<(), (&'static str, String)>;
+    /// Range checks types cannot express, for a domain of this shape (horizon, observation and
+    /// macro-action counts): the offending key and why. Every size the run allocates by is
+    /// bounded here, with all its factors (a centralized net's joint input and output widths
+    /// included), before anything is allocated.
+    fn check(self, config: &Self::Config, shape: &EnvShape) -> Result<(), (&'static str, String)>;
 }

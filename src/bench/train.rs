@@ -48,7 +48,9 @@ impl TrainBench {
 pub fn suite() -> Vec<(EnvSpec, Method)> {
     let bp10 = crate::envs::box_pushing::paper_spec(10);
     // A method whose paper settings a domain refuses (Our-2 on windows) is not benchmarked there.
-    let runs_on = |env: &EnvSpec, m: Method| m.check(&m.defaults(env), env.horizon()).is_ok();
+    let runs_on = |env: &EnvSpec, m: Method| {
+        crate::envs::EnvShape::of(env).is_ok_and(|shape| m.check(&m.defaults(env), &shape).is_ok())
+    };
     let value = Family::Value.methods();
     let mut v: Vec<(EnvSpec, Method)> = value
         .iter()

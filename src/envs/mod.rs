@@ -23,11 +23,13 @@ pub mod osd;
 pub mod overcooked;
 pub mod registry;
 pub mod replay;
+pub mod shape;
 pub mod spec;
 pub mod warehouse;
 
 pub use built_in::AnyEnv;
 pub use domain::Domain;
+pub use shape::EnvShape;
 pub use spec::EnvSpec;
 
 /// The random stream an environment draws from (Warehouse's optional movement noise). Owned by the

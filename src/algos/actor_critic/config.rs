@@ -3,13 +3,13 @@
 //! where no published experiment sets a key. The published values per domain and method are
 //! [`super::published`].
 
-use crate::algos::actor_critic::method::AcMethod;
+use crate::algos::actor_critic::method::{AcActor, AcCritic, AcMethod};
 use crate::algos::config_checks::{
-    check_at_most, check_discount, check_positive, check_rates, check_unit, MAX_BATCH_ELEMENTS,
-    MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
+    check_at_most, check_batch_activations, check_discount, check_positive, check_rates,
+    check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
-use crate::envs::EnvSpec;
+use crate::envs::{EnvShape, EnvSpec};
 use serde::{Deserialize, Serialize};
 
 /// The resolved hyperparameters of one actor-critic run. Unknown keys are refused.
@@ -164,9 +164,13 @@ pub fn published_defaults(env: &EnvSpec, method: AcMethod) -> AcConfig {
 
 /// The actor-critic family's range checks (see
 /// [`crate::algos::family::FamilyMethod::check`]).
-pub fn check(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+pub fn check(
+    c: &AcConfig,
+    method: AcMethod,
+    shape: &EnvShape,
+) -> Result<(), (&'static str, String)> {
     check_positive(&[
-        ("env_terminate_step", horizon),
+        ("env_terminate_step", shape.horizon),
         ("total_epi", c.total_epi),
         ("n_env", c.n_env),
         ("train_freq", c.train_freq),
@@ -178,7 +182,7 @@ pub fn check(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)>
         ("eval_num_epi", c.eval_num_epi),
         ("checkpoint_freq", c.checkpoint_freq),
     ])?;
-    check_sizes(c, horizon)?;
+    check_sizes(c, method, shape)?;
     check_unit(&[
         ("gamma", c.gamma),
         ("eps_start", c.eps_start),
@@ -189,8 +193,14 @@ pub fn check(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)>
 }
 
 /// Check an actor-critic config's sizes against the bounds above and [`MAX_N_ENV`], for a
-/// domain whose episodes last at most `horizon` primitive steps. Returns the key and why.
-fn check_sizes(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+/// domain of this shape (its horizon, observation and macro-action counts). Returns the key
+/// and why.
+fn check_sizes(
+    c: &AcConfig,
+    method: AcMethod,
+    shape: &EnvShape,
+) -> Result<(), (&'static str, String)> {
+    let horizon = shape.horizon;
     check_at_most(&[
         ("env_terminate_step", horizon, MAX_HORIZON),
         ("total_epi", c.total_epi, MAX_TOTAL_EPI),
@@ -215,23 +225,33 @@ fn check_sizes(c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String
             ));
         }
     }
-    // One update's batch activations: train_freq episodes x horizon x the widest layer (x3,
-    // the GRU's gates).
     let widest = [c.a_rnn_layer_size, c.c_rnn_layer_size, c.c_mid_layer_size]
         .into_iter()
         .chain(c.a_mlp_layer_size.iter().copied())
         .chain(c.c_mlp_layer_size.iter().copied())
         .max()
         .unwrap_or(1) as u128;
-    let elements = c.train_freq as u128 * horizon as u128 * widest * 3;
-    if elements > MAX_BATCH_ELEMENTS {
-        return Err((
-            "train_freq",
-            format!(
-                "train_freq x env_terminate_step x the widest layer is {elements} activations, beyond {MAX_BATCH_ELEMENTS}"
-            ),
-        ));
-    }
+    // Every method but Mac-IAC has a critic on the joint observation or the state; Mac-CAC's
+    // actor reads the joint observation and scores every joint macro-action.
+    let design = method.design();
+    let input = match design.critic {
+        AcCritic::OwnHistory => shape.widest_obs(),
+        _ => shape.joint_obs_size().max(shape.state_size as u128),
+    };
+    let output = match design.actor {
+        AcActor::Decentralized => shape.widest_actions(),
+        AcActor::Centralized => shape.n_joint_actions(),
+    };
+    // One update runs over the last train_freq episodes, each up to the horizon.
+    check_batch_activations(
+        ("train_freq", c.train_freq),
+        ("env_terminate_step", shape.horizon),
+        NetWidths {
+            hidden: widest,
+            input,
+            output,
+        },
+    )?;
     Ok(())
 }
 
@@ -292,18 +312,41 @@ mod tests {
 
     #[test]
     fn actor_critic_bad_values_name_their_key() {
+        let bp = EnvShape::of(&crate::envs::bp_ma_v0::spec(6, 100)).unwrap();
+        let check = |c: &AcConfig| check(c, AcMethod::MacIaicc, &bp);
         let mut c = AcConfig::reference_defaults();
-        assert!(check(&c, 100).is_ok());
+        assert!(check(&c).is_ok());
         c.a_mlp_layer_size = vec![32];
-        assert_eq!(check(&c, 100).unwrap_err().0, "a_mlp_layer_size");
+        assert_eq!(check(&c).unwrap_err().0, "a_mlp_layer_size");
         c = AcConfig::reference_defaults();
         c.gamma = 1.5;
-        assert_eq!(check(&c, 100).unwrap_err().0, "gamma");
+        assert_eq!(check(&c).unwrap_err().0, "gamma");
         c = AcConfig::reference_defaults();
         c.n_env = 0;
-        assert_eq!(check(&c, 100).unwrap_err().0, "n_env");
+        assert_eq!(check(&c).unwrap_err().0, "n_env");
         c = AcConfig::reference_defaults();
         c.c_lr = f64::NAN;
-        assert_eq!(check(&c, 100).unwrap_err().0, "c_lr");
+        assert_eq!(check(&c).unwrap_err().0, "c_lr");
+    }
+
+    #[test]
+    fn mac_cac_counts_its_joint_action_output() {
+        // Overcooked B with three agents: 15^3 = 3375 joint macro-actions. The published
+        // Mac-CAC row (8 environments) fits; 200 environments and episodes per update would need
+        // more than 5 GB and are refused before anything is allocated, naming the joint width.
+        let spec =
+            crate::envs::EnvSpec::new("Overcooked-MA-v1", &toml::toml! { map_type = "B" }).unwrap();
+        let shape = EnvShape::of(&spec).unwrap();
+        assert_eq!(shape.n_joint_actions(), 3375);
+        let mut c = published_defaults(&spec, AcMethod::MacCac);
+        assert!(check(&c, AcMethod::MacCac, &shape).is_ok());
+        (c.n_env, c.train_freq) = (200, 200);
+        let (key, why) = check(&c, AcMethod::MacCac, &shape).unwrap_err();
+        assert_eq!(key, "train_freq");
+        assert!(why.contains("widest output 3375"), "{why}");
+        // The decentralized actors of Mac-IAICC output 15 each: the same sizes fit.
+        let mut c = published_defaults(&spec, AcMethod::MacIaicc);
+        (c.n_env, c.train_freq) = (200, 200);
+        assert!(check(&c, AcMethod::MacIaicc, &shape).is_ok());
     }
 }

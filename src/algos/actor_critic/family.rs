@@ -5,7 +5,7 @@ use crate::algos::actor_critic::config::{self, AcConfig};
 use crate::algos::actor_critic::learner::AcLearner;
 use crate::algos::actor_critic::method::AcMethod;
 use crate::algos::family::{FamilyFacts, FamilyMethod};
-use crate::envs::EnvSpec;
+use crate::envs::{EnvShape, EnvSpec};
 
 impl FamilyMethod for AcMethod {
     type Config = AcConfig;
@@ -42,7 +42,7 @@ impl FamilyMethod for AcMethod {
         config::published_defaults(env, self)
     }
 
-    fn check(self, c: &AcConfig, horizon: usize) -> Result<(), (&'static str, String)> {
-        config::check(c, horizon)
+    fn check(self, c: &AcConfig, shape: &EnvShape) -> Result<(), (&'static str, String)> {
+        config::check(c, self, shape)
     }
 }

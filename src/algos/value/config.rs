@@ -2,12 +2,13 @@
 //! §10), the paper's settings per domain and method, and the family's range checks.
 
 use crate::algos::config_checks::{
-    check_at_most, check_discount, check_eval_rows, check_positive, check_rates, check_unit,
-    MAX_BATCH_ELEMENTS, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
+    check_at_most, check_batch_activations, check_discount, check_eval_rows, check_positive,
+    check_rates, check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH,
+    MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
 use crate::algos::value::method::ValueMethod;
-use crate::envs::EnvSpec;
+use crate::envs::{EnvShape, EnvSpec};
 use serde::{Deserialize, Serialize};
 
 /// Window length `trace_len` and minimum kept records `sub_trace_len` (paper: 15 and 45).
@@ -17,6 +18,9 @@ pub const MAX_BATCH_SIZE: usize = 65_536;
 /// Records the replay buffer may hold when full: replay_buffer_size x sequence length
 /// (paper: 1.2e6).
 pub const MAX_REPLAY_RECORDS: u128 = 1 << 26;
+/// Values (observation entries, actions, rewards, flags) the full replay buffer holds: records x
+/// (2 x the joint observation + 5 per agent + 1), 2^30 = 4 GiB of f32 (paper: about 1e8).
+pub const MAX_REPLAY_VALUES: u128 = 1 << 30;
 
 /// The value methods' resolved hyperparameters (the ICRA code's flags). Unknown keys are refused,
 /// so a typo in a hand-edited config fails instead of being ignored.
@@ -152,10 +156,10 @@ pub fn paper_defaults(env: &EnvSpec, method: ValueMethod) -> ValueConfig {
 pub fn check(
     c: &ValueConfig,
     method: ValueMethod,
-    horizon: usize,
+    shape: &EnvShape,
 ) -> Result<(), (&'static str, String)> {
     check_positive(&[
-        ("env_terminate_step", horizon),
+        ("env_terminate_step", shape.horizon),
         ("total_epi", c.total_epi),
         ("replay_buffer_size", c.replay_buffer_size),
         ("h_stable_at", c.h_stable_at),
@@ -190,7 +194,7 @@ pub fn check(
             ),
         ));
     }
-    check_sizes(c, horizon)?;
+    check_sizes(c, method, shape)?;
     check_unit(&[
         ("eps_end", c.eps_end),
         ("discount", c.discount),
@@ -210,9 +214,14 @@ pub fn check(
     Ok(())
 }
 
-/// Check a value config's sizes against the bounds, for a domain whose episodes last at
-/// most `horizon` primitive steps. Returns the key and why.
-fn check_sizes(c: &ValueConfig, horizon: usize) -> Result<(), (&'static str, String)> {
+/// Check a value config's sizes against the bounds, for a domain of this shape (its horizon,
+/// observation and macro-action counts). Returns the key and why.
+fn check_sizes(
+    c: &ValueConfig,
+    method: ValueMethod,
+    shape: &EnvShape,
+) -> Result<(), (&'static str, String)> {
+    let horizon = shape.horizon;
     check_at_most(&[
         ("env_terminate_step", horizon, MAX_HORIZON),
         ("trace_len", c.trace_len, MAX_TRACE_LEN),
@@ -239,18 +248,22 @@ fn check_sizes(c: &ValueConfig, horizon: usize) -> Result<(), (&'static str, Str
     ]
     .into_iter()
     .max()
-    .unwrap_or(1);
-    let elements = c.batch_size as u128 * seq_len as u128 * widest as u128;
-    if elements > MAX_BATCH_ELEMENTS {
-        return Err((
-            "batch_size",
-            format!(
-                "batch_size x {seq_key} x widest layer = {} x {seq_len} x {widest} = {elements} \
-                 elements per batch tensor, at most {MAX_BATCH_ELEMENTS}",
-                c.batch_size
-            ),
-        ));
-    }
+    .unwrap_or(1) as u128;
+    // The centralized Q-net reads the joint observation and scores every joint macro-action.
+    let (input, output) = if method.has_cen_net() {
+        (shape.joint_obs_size(), shape.n_joint_actions())
+    } else {
+        (shape.widest_obs(), shape.widest_actions())
+    };
+    check_batch_activations(
+        ("batch_size", c.batch_size),
+        (seq_key, seq_len),
+        NetWidths {
+            hidden: widest,
+            input,
+            output,
+        },
+    )?;
     let records = c.replay_buffer_size as u128 * seq_len as u128;
     if records > MAX_REPLAY_RECORDS {
         return Err((
@@ -258,6 +271,20 @@ fn check_sizes(c: &ValueConfig, horizon: usize) -> Result<(), (&'static str, Str
             format!(
                 "replay_buffer_size x {seq_key} = {} x {seq_len} = {records} records when full, \
                  at most {MAX_REPLAY_RECORDS}",
+                c.replay_buffer_size
+            ),
+        ));
+    }
+    // A record holds the joint observation and the next one, and per agent its action, its
+    // macro-reward and three flags.
+    let record_values = 2 * shape.joint_obs_size() + 5 * shape.n_actions.len() as u128 + 1;
+    let values = records.saturating_mul(record_values);
+    if values > MAX_REPLAY_VALUES {
+        return Err((
+            "replay_buffer_size",
+            format!(
+                "replay_buffer_size x {seq_key} x a record's values = {} x {seq_len} x \
+                 {record_values} = {values} values when full, at most {MAX_REPLAY_VALUES}",
                 c.replay_buffer_size
             ),
         ));
@@ -284,22 +311,22 @@ mod tests {
         assert_eq!(bp10.discount, 0.98);
     }
 
+    fn shape(spec: &EnvSpec) -> EnvShape {
+        EnvShape::of(spec).unwrap()
+    }
+
     #[test]
     fn the_papers_settings_are_within_every_bound() {
         use ValueMethod::{CenDdrqn, DecHddrqn, Our1, Our2};
         for grid in [10, 30] {
             for m in [DecHddrqn, CenDdrqn, Our1] {
                 let env = crate::envs::box_pushing::paper_spec(grid);
-                check(&paper_defaults(&env, m), m, env.horizon()).unwrap();
+                check(&paper_defaults(&env, m), m, &shape(&env)).unwrap();
             }
         }
         for m in [DecHddrqn, CenDdrqn, Our2] {
-            check(
-                &paper_defaults(&crate::envs::warehouse::paper_spec(), m),
-                m,
-                150,
-            )
-            .unwrap();
+            let env = crate::envs::warehouse::paper_spec();
+            check(&paper_defaults(&env, m), m, &shape(&env)).unwrap();
         }
     }
 
@@ -323,10 +350,49 @@ mod tests {
                 c.eval_freq = 1;
             }),
         ];
+        let bp10 = shape(&crate::envs::box_pushing::paper_spec(10));
         for (key, edit) in cases {
-            let (mut c, mut horizon) = (base.clone(), 100);
-            edit(&mut c, &mut horizon);
-            assert_eq!(check_sizes(&c, horizon).unwrap_err().0, key);
+            let (mut c, mut bp10) = (base.clone(), bp10.clone());
+            edit(&mut c, &mut bp10.horizon);
+            assert_eq!(
+                check_sizes(&c, ValueMethod::Our1, &bp10).unwrap_err().0,
+                key
+            );
         }
+    }
+
+    #[test]
+    fn a_joint_q_net_counts_its_joint_action_output_and_a_full_replay_its_observations() {
+        // Cen-DDRQN on a domain of four agents with 40 macro-actions each: 2.56 M joint
+        // macro-actions. The paper's batch of 32 windows of 15 would need 32 x 15 x 16 x 2.56 M
+        // values in one update; the decentralized Dec-HDDRQN outputs only 40 per agent.
+        let wide = EnvShape {
+            horizon: 100,
+            obs_sizes: vec![10; 4],
+            n_actions: vec![40; 4],
+            state_size: 0,
+        };
+        let c = paper_defaults(
+            &crate::envs::box_pushing::paper_spec(10),
+            ValueMethod::CenDdrqn,
+        );
+        let (key, why) = check(&c, ValueMethod::CenDdrqn, &wide).unwrap_err();
+        assert_eq!(key, "batch_size");
+        assert!(why.contains("2560000"), "{why}");
+        let mut dec = c.clone();
+        dec.replay_buffer_size = 1000;
+        assert!(check(&dec, ValueMethod::DecHddrqn, &wide).is_ok());
+        // A full replay of huge observations is refused although its record count is allowed.
+        let huge_obs = EnvShape {
+            obs_sizes: vec![1_000_000; 2],
+            n_actions: vec![4; 2],
+            ..wide
+        };
+        let mut big = c.clone();
+        big.replay_buffer_size = 10_000;
+        big.batch_size = 1;
+        let (key, why) = check(&big, ValueMethod::DecHddrqn, &huge_obs).unwrap_err();
+        assert_eq!(key, "replay_buffer_size", "{why}");
+        assert!(why.contains("values when full"), "{why}");
     }
 }

@@ -5,7 +5,7 @@ use crate::algos::family::{FamilyFacts, FamilyMethod};
 use crate::algos::value::config::{self, ValueConfig};
 use crate::algos::value::learner::ValueLearner;
 use crate::algos::value::method::ValueMethod;
-use crate::envs::EnvSpec;
+use crate::envs::{EnvShape, EnvSpec};
 
 impl FamilyMethod for ValueMethod {
     type Config = ValueConfig;
@@ -40,7 +40,7 @@ impl FamilyMethod for ValueMethod {
         config::paper_defaults(env, self)
     }
 
-    fn check(self, c: &ValueConfig, horizon: usize) -> Result<(), (&'static str, String)> {
-        config::check(c, self, horizon)
+    fn check(self, c: &ValueConfig, shape: &EnvShape) -> Result<(), (&'static str, String)> {
+        config::check(c, self, shape)
     }
 }

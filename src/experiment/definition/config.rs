@@ -7,7 +7,7 @@
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
 use crate::algos::families::{Family, Method, RunConfig};
-use crate::envs::EnvSpec;
+use crate::envs::{EnvShape, EnvSpec};
 use crate::experiment::definition::limits;
 use crate::experiment::definition::names::{check_curve_name, check_experiment_name, NameError};
 use crate::experiment::definition::run_settings::RunSettings;
@@ -722,8 +722,7 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
     }
     let config = RunSettings::from_table(method, table.clone()).map_err(|e| bad("config", e))?;
     // Bad values first, so `l_rate = nan` is named as a bad value, not as an unused key.
-    validate(&config.config, method, config.env.horizon())
-        .map_err(|(key, message)| bad(key, message))?;
+    validate(&config.config, method, &config.env).map_err(|(key, message)| bad(key, message))?;
     // A domain key the chosen domain does not use (`grid_dim` for OSD_S_4, `tb_m_noisy` for
     // BP_MA) would be dropped and recorded as its default: refuse it instead of ignoring it.
     // (`env_name` itself is recorded by its reference name even when written as an alias.)
@@ -821,16 +820,17 @@ fn same_value(recorded: &toml::Value, given: &toml::Value) -> bool {
     }
 }
 
-/// Range checks that types cannot express, for a domain whose episodes last at most `horizon`
-/// primitive steps: the method's family's ([`Method::check`]). Returns the offending key and
+/// Range checks that types cannot express, for the sizes of `env`'s environment (built once to
+/// read them): the method's family's ([`Method::check`]). Returns the offending key and
 /// why. The library entry point [`crate::train`] runs them too, so a config built in code is held
 /// to the same rules.
 pub fn validate(
     c: &RunConfig,
     method: Method,
-    horizon: usize,
+    env: &EnvSpec,
 ) -> Result<(), (&'static str, String)> {
-    method.check(c, horizon)
+    let shape = EnvShape::of(env).map_err(|e| ("env_name", e.to_string()))?;
+    method.check(c, &shape)
 }
 
 #[cfg(test)]

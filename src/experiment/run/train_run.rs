@@ -105,7 +105,7 @@ impl RunManifest {
         crate::experiment::definition::config::validate(
             &self.config.config,
             self.method,
-            self.config.env.horizon(),
+            &self.config.env,
         )
     }
 
