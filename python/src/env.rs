@@ -328,14 +328,20 @@ struct Outputs {
     mask: Vec<bool>,
 }
 
+/// Copies one vector environment may hold (checked at 65 536; every copy is a whole
+/// environment, so the bound keeps `vector_env(id, 10**7)` a ValueError instead of an abort).
+pub const MAX_NUM_ENVS: usize = 65_536;
+
 #[pymethods]
 impl VectorEnv {
     /// `num_envs` copies of the domain `env_id` with its keys `params`.
     #[new]
     #[pyo3(signature = (env_id, num_envs, params=None))]
     fn new(env_id: &str, num_envs: usize, params: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        if num_envs == 0 {
-            return Err(PyValueError::new_err("num_envs must be at least 1"));
+        if num_envs == 0 || num_envs > MAX_NUM_ENVS {
+            return Err(PyValueError::new_err(format!(
+                "num_envs must be 1..={MAX_NUM_ENVS}, got {num_envs}"
+            )));
         }
         let spec = spec_of(env_id, params)?;
         let first = build(&spec)?;

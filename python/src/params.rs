@@ -5,8 +5,14 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString, PyTuple};
 
-/// One Python value as TOML: bool, int, float, str, list/tuple, dict. `key` names it in errors.
-pub fn to_toml(key: &str, value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+/// How deeply lists and dicts may nest in a parameter value (every domain key is at most two
+/// deep, `grid_dim = [6, 6]`); deeper values are refused before the conversion recurses, so a
+/// value nested 100 000 deep is a ValueError, not a stack overflow.
+pub const MAX_PARAM_DEPTH: usize = 16;
+
+/// One Python value as TOML, nested `depth` lists or dicts deep: bool, int, float, str,
+/// list/tuple, dict. `key` names it in errors.
+fn to_toml(key: &str, value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Value> {
     if value.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(value.extract()?));
     }
@@ -22,16 +28,24 @@ pub fn to_toml(key: &str, value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     if let Ok(f) = value.extract::<f64>() {
         return Ok(toml::Value::Float(f));
     }
+    let nests = value.is_instance_of::<PyList>()
+        || value.is_instance_of::<PyTuple>()
+        || value.is_instance_of::<PyDict>();
+    if nests && depth >= MAX_PARAM_DEPTH {
+        return Err(PyValueError::new_err(format!(
+            "parameter `{key}`: lists and dicts nested more than {MAX_PARAM_DEPTH} deep"
+        )));
+    }
     if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
         let items = value
             .iter()?
             .enumerate()
-            .map(|(i, v)| to_toml(&format!("{key}[{i}]"), &v?))
+            .map(|(i, v)| to_toml(&format!("{key}[{i}]"), &v?, depth + 1))
             .collect::<PyResult<Vec<_>>>()?;
         return Ok(toml::Value::Array(items));
     }
     if let Ok(dict) = value.downcast::<PyDict>() {
-        return Ok(toml::Value::Table(to_table(dict, Some(key))?));
+        return Ok(toml::Value::Table(table_at(dict, Some(key), depth + 1)?));
     }
     Err(PyValueError::new_err(format!(
         "parameter `{key}`: {} is not a parameter value (expected a bool, int, float, str, or a list or dict of them)",
@@ -41,6 +55,11 @@ pub fn to_toml(key: &str, value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
 
 /// A dict of parameters as a TOML table; keys must be strings.
 pub fn to_table(dict: &Bound<'_, PyDict>, within: Option<&str>) -> PyResult<toml::Table> {
+    table_at(dict, within, 0)
+}
+
+/// [`to_table`] of a dict nested `depth` lists or dicts deep.
+fn table_at(dict: &Bound<'_, PyDict>, within: Option<&str>, depth: usize) -> PyResult<toml::Table> {
     let mut table = toml::Table::new();
     for (k, v) in dict.iter() {
         let key: String = k.extract().map_err(|_| {
@@ -53,7 +72,7 @@ pub fn to_table(dict: &Bound<'_, PyDict>, within: Option<&str>) -> PyResult<toml
             Some(outer) => format!("{outer}.{key}"),
             None => key.clone(),
         };
-        table.insert(key, to_toml(&path, &v)?);
+        table.insert(key, to_toml(&path, &v, depth)?);
     }
     Ok(table)
 }

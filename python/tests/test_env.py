@@ -125,6 +125,16 @@ def test_bad_input_raises_errors_naming_the_problem():
         env.step({"agent_0": 0, "agent_1": 0, "agent_7": 0})
     with pytest.raises(ValueError, match="num_envs"):
         macdec.vector_env("BP_MA", 0)
+    for too_many in (10**7, 2**62):
+        with pytest.raises(ValueError, match=r"num_envs must be 1..=65536"):
+            macdec.vector_env("BP_MA", too_many)
+    deep = 6
+    for _ in range(100_000):
+        deep = [deep]
+    with pytest.raises(ValueError, match=r"parameter `grid_dim`: .*nested more than 16 deep"):
+        macdec.parallel_env("BP_MA", grid_dim=deep)
+    with pytest.raises(ValueError, match="nested more than 16 deep"):
+        macdec.vector_env("BP_MA", 2, grid_dim=deep)
     venv = macdec.vector_env("BP_MA", 2)
     venv.reset(seed=0)
     with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\)"):
