@@ -183,6 +183,15 @@ pub fn check(
         ("checkpoint_freq", c.checkpoint_freq),
     ])?;
     check_sizes(c, method, shape)?;
+    if c.train_freq > c.total_epi {
+        return Err((
+            "train_freq",
+            format!(
+                "must be at most total_epi ({}), got {}: an update runs every train_freq episodes, so none would",
+                c.total_epi, c.train_freq
+            ),
+        ));
+    }
     check_unit(&[
         ("gamma", c.gamma),
         ("eps_start", c.eps_start),
@@ -327,6 +336,11 @@ mod tests {
         c = AcConfig::reference_defaults();
         c.c_lr = f64::NAN;
         assert_eq!(check(&c).unwrap_err().0, "c_lr");
+        c = AcConfig::reference_defaults();
+        (c.total_epi, c.train_freq) = (10, 11);
+        assert_eq!(check(&c).unwrap_err().0, "train_freq");
+        c.train_freq = 10;
+        assert!(check(&c).is_ok());
     }
 
     #[test]

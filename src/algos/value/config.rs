@@ -183,6 +183,15 @@ pub fn check(
             "must be >= 1: training starts once an episode has been collected".into(),
         ));
     }
+    if c.start_train > c.total_epi {
+        return Err((
+            "start_train",
+            format!(
+                "must be at most total_epi ({}), got {}: training starts after start_train episodes, so no update would run",
+                c.total_epi, c.start_train
+            ),
+        ));
+    }
     if !c.total_epi.is_multiple_of(c.eval_freq) {
         return Err((
             "total_epi",
