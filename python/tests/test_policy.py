@@ -16,7 +16,7 @@ VALUE = {
 ACTOR = {
     "name": "pol_ac", "methods": ["mac-iac"], "seeds": "2",
     "params": {"env_name": "BP-MA-v0", "grid_dim": [6, 6], "env_terminate_step": 40, "total_epi": 16,
-               "eval_freq": 8},
+               "n_env": 4, "train_freq": 8, "eval_freq": 8},
 }
 
 
