@@ -5,9 +5,10 @@
 //! `tensorboard --logdir DIR` shows each run as `experiment/curve/seed-k`). At each evaluation
 //! the row [`metrics`](super::metrics) records becomes one event: its step is the `episode`
 //! column (training episodes completed) and each other column is a scalar tagged by its
-//! `metrics.csv` name (`eval_return`, `eval_return_undiscounted`, `env_steps`, `updates`, the
-//! family's own such as `epsilon`, `loss`, `actor_loss`, `critic_loss`, and `wall_seconds`; an
-//! empty cell is no scalar). Plot against environment steps by reading the `env_steps` tag.
+//! `metrics.csv` name: `env_steps`, `updates`, `eval_return`, `eval_return_undiscounted`, the
+//! family's own (value-based `epsilon`, `hysteresis`, `loss`; actor-critic `eps`,
+//! `critic_loss`, `actor_loss`, `train_return`) and `wall_seconds`; an empty cell is no scalar.
+//! Plot against environment steps by reading the `env_steps` tag.
 //! Values are 32-bit floats, TensorBoard's `simple_value`.
 //!
 //! The file is flushed after each evaluation. Each time a run trains (first start, resume,

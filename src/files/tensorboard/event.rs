@@ -9,8 +9,8 @@
 
 use super::protobuf::{fields, put_bytes, put_f32, put_f64, put_varint_field, Field};
 
-/// The `file_version` of the first event of every file: TensorBoard reads `brain.Event:2` files
-/// with `SessionLog` restarts (and rejects no other content of this module).
+/// The `file_version` of the first event of every file: in a version-2 file TensorBoard takes
+/// a `SessionLog.START` as a restart (and no longer guesses restarts from steps going back).
 pub const FILE_VERSION: &str = "brain.Event:2";
 
 /// `SessionLog.START`: the program (re)started at this step. TensorBoard's reader then drops
@@ -32,7 +32,8 @@ pub struct Scalar {
 pub enum What {
     /// The format version, first in every file ([`FILE_VERSION`]).
     FileVersion(String),
-    /// A (re)start of the writing program ([`SESSION_START`]'s meaning).
+    /// `SessionLog.START`: the writing program (re)started here; TensorBoard drops the run's
+    /// events it read before at this step or later.
     SessionStart,
     /// Scalars at this step, one `Summary.Value` each.
     Scalars(Vec<Scalar>),
