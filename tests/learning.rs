@@ -34,6 +34,7 @@ fn bp10_methods_reach_the_optimum_in_four_of_five_seeds() {
         jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
         force: false,
         quiet: true,
+        tensorboard: None,
     };
     let statuses = run_all(&runs, &opts, |spec, dir, progress| {
         train_run(spec, dir, progress, false).map_err(|e| e.to_string())

@@ -93,6 +93,7 @@ pub fn train(
         jobs,
         force,
         quiet,
+        tensorboard: None,
     };
     let stop = StopSignal::new();
     let worker = {

@@ -350,6 +350,10 @@ impl<E: MacroEnv> AnyLoop<E> {
     pub fn saved_nets(&self) -> SavedNets<'_> {
         loop_dispatch!(self, l => l.saved_nets())
     }
+    /// Wall-clock seconds this run has trained, over all segments (the `wall_seconds` column).
+    pub fn wall_seconds(&self) -> f64 {
+        loop_dispatch!(self, l => l.wall_seconds())
+    }
     /// Fold the running segment's time into the saved total (call before checkpointing).
     pub fn mark_time(&mut self) {
         loop_dispatch!(self, l => l.mark_time())

@@ -23,10 +23,20 @@ pub(super) struct SlurmArgs {
     /// Extra #SBATCH lines, e.g. --sbatch=--partition=cpu (repeatable).
     #[arg(long = "sbatch", value_name = "LINE", allow_hyphen_values = true)]
     sbatch: Vec<String>,
+    /// Each task also logs TensorBoard scalars below this directory, shared by the nodes (as
+    /// `macdec train --tensorboard`).
+    #[arg(long, value_name = "DIR")]
+    tensorboard: Option<PathBuf>,
 }
 
 /// Print the job-array script; the array tasks rerun this selection with `--run-index`.
 pub(super) fn run(args: SlurmArgs) -> Result<()> {
+    print!("{}", script(args)?);
+    Ok(())
+}
+
+/// The job-array script of `args`.
+fn script(args: SlurmArgs) -> Result<String> {
     let sel = args.select;
     let mut train_args = Vec::new();
     if let Some(m) = &sel.methods {
@@ -49,10 +59,17 @@ pub(super) fn run(args: SlurmArgs) -> Result<()> {
         .map(|r| results_tree::run_label(&r.curve_name(), r.seed))
         .collect();
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    if let Some(dir) = &args.tensorboard {
+        let dir = absolute(dir);
+        let dir = dir
+            .to_str()
+            .with_context(|| format!("--tensorboard {}: not a UTF-8 path", dir.display()))?;
+        train_args.extend(["--tensorboard".to_string(), dir.to_string()]);
+    }
     let config = absolute(config);
     let out = absolute(&args.out);
     let binary = std::env::current_exe().context("locating the macdec binary")?;
-    let script = job_script(
+    Ok(job_script(
         &experiment.name,
         &labels,
         &SlurmOptions {
@@ -64,9 +81,7 @@ pub(super) fn run(args: SlurmArgs) -> Result<()> {
             mem: &args.mem,
             extra_sbatch: args.sbatch,
         },
-    )?;
-    print!("{script}");
-    Ok(())
+    )?)
 }
 
 #[cfg(test)]
@@ -90,6 +105,29 @@ mod tests {
         assert_eq!(args.time, "12:00:00");
         assert_eq!(args.mem, "4G");
         assert!(args.sbatch.is_empty());
+        assert_eq!(args.tensorboard, None);
+    }
+
+    #[test]
+    fn slurm_passes_an_absolute_tensorboard_dir_to_every_task() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("e.toml");
+        std::fs::write(&config, "methods = [\"our1\"]\nseeds = \"0..2\"\n").unwrap();
+        let tb = dir.path().join("tb logs");
+        let args = parse(&[
+            "--config",
+            config.to_str().unwrap(),
+            "--tensorboard",
+            tb.to_str().unwrap(),
+        ]);
+        assert_eq!(args.tensorboard.as_deref(), Some(tb.as_path()));
+        // The script quotes the path (it holds a space); the tasks train with the flag.
+        let script = script(args).unwrap();
+        let quoted = crate::experiment::cluster::slurm::shell_quote(tb.to_str().unwrap());
+        assert!(
+            script.contains(&format!(" --tensorboard {quoted} --jobs 1 ")),
+            "{script}"
+        );
     }
 
     #[test]

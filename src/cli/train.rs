@@ -36,6 +36,11 @@ pub(super) struct TrainArgs {
     /// Run only the run with this index in the experiment's run list (Slurm array tasks).
     #[arg(long)]
     run_index: Option<usize>,
+    /// Also log every evaluation as TensorBoard scalars while training, one run per directory
+    /// <DIR>/<experiment>/<method>/seed-<k>/ (view with `tensorboard --logdir DIR`). Step is the
+    /// episode; tags are the metrics.csv columns. Not part of a run's identity.
+    #[arg(long, value_name = "DIR")]
+    tensorboard: Option<PathBuf>,
 }
 
 /// Train the selected runs (or one, with `--run-index`), report their curves and draw figures.
@@ -57,11 +62,16 @@ pub(super) fn run(args: TrainArgs) -> Result<()> {
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         runs.len(),
     );
+    if let Some(dir) = &args.tensorboard {
+        crate::experiment::run::tensorboard::check_root(dir)
+            .with_context(|| format!("--tensorboard {}", dir.display()))?;
+    }
     let opts = RunnerOptions {
         out: args.out.clone(),
         jobs,
         force: args.force,
         quiet: args.quiet,
+        tensorboard: args.tensorboard.clone(),
     };
     eprintln!(
         "{}: {} run(s) ({} method(s) x {} seed(s)), {} at a time, results in {}",
@@ -72,6 +82,13 @@ pub(super) fn run(args: TrainArgs) -> Result<()> {
         jobs,
         args.out.join(&experiment.name).display()
     );
+    if let Some(dir) = &args.tensorboard {
+        eprintln!(
+            "  TensorBoard logs in {} (view with: tensorboard --logdir {})",
+            dir.join(&experiment.name).display(),
+            dir.display()
+        );
+    }
     let selected = |curve: &String| experiment.methods.iter().any(|m| m.name() == curve);
     for (curve, home) in experiment.shared_curves.iter().filter(|(c, _)| selected(c)) {
         eprintln!(
@@ -161,6 +178,7 @@ mod tests {
         assert!(!args.force && !args.quiet && !args.no_plot);
         assert_eq!(args.plots, None);
         assert_eq!(args.run_index, None);
+        assert_eq!(args.tensorboard, None);
     }
 
     #[test]
@@ -200,6 +218,29 @@ mod tests {
             v,
             "expected a positive integer",
         );
+    }
+
+    #[test]
+    fn a_tensorboard_dir_that_is_a_file_is_refused_before_anything_is_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("results");
+        let file = dir.path().join("tb");
+        std::fs::write(&file, "").unwrap();
+        let args = parse(&[
+            "--out",
+            out.to_str().unwrap(),
+            "--no-plot",
+            "--tensorboard",
+            file.to_str().unwrap(),
+        ]);
+        assert_eq!(args.tensorboard.as_deref(), Some(file.as_path()));
+        let e = error_text(run(args));
+        assert!(
+            e.starts_with(&format!("Error: --tensorboard {}", file.display()))
+                && e.contains("exists and is not a directory"),
+            "{e}"
+        );
+        assert!(!out.exists(), "nothing is written before the refusal");
     }
 
     #[test]

@@ -29,6 +29,10 @@ pub struct RunnerOptions {
     /// on stderr that is the default anyway, with a line every
     /// [`HEARTBEAT`](crate::experiment::run::progress::HEARTBEAT) per run besides.
     pub quiet: bool,
+    /// Root of the live TensorBoard logs, if any ([`crate::experiment::run::tensorboard`]):
+    /// each run that trains logs its evaluations below it as they happen. Not part of any run's
+    /// identity.
+    pub tensorboard: Option<std::path::PathBuf>,
 }
 
 /// What became of one run.
@@ -226,6 +230,7 @@ mod tests {
             jobs: 2,
             force: false,
             quiet: true,
+            tensorboard: None,
         };
         let runs = runs(4);
         let work = |spec: &RunSpec, dir: &Path, _: &Progress| {
@@ -258,6 +263,7 @@ mod tests {
             jobs: 1,
             force: false,
             quiet: true,
+            tensorboard: None,
         };
         let o = Overrides {
             seeds: Some(vec![0, 1]),
@@ -306,6 +312,7 @@ mod tests {
             jobs: 1,
             force: false,
             quiet: true,
+            tensorboard: None,
         };
         let runs = runs(1);
         let ran = std::sync::atomic::AtomicUsize::new(0);

@@ -23,7 +23,15 @@ pub fn train_all(
         if stop.is_stopped() {
             return Ok(RunEnd::Stopped);
         }
-        train_run_until(spec, dir, progress, force, stop).map_err(|e| e.to_string())
+        train_run_until(
+            spec,
+            dir,
+            progress,
+            force,
+            stop,
+            opts.tensorboard.as_deref(),
+        )
+        .map_err(|e| e.to_string())
     })
 }
 
@@ -62,6 +70,7 @@ checkpoint_freq = 20
             jobs: 1,
             force: false,
             quiet: true,
+            tensorboard: None,
         }
     }
 
@@ -103,7 +112,7 @@ checkpoint_freq = 20
         stop.stop();
         let run_dir = runs[0].dir(&stopped);
         let first = run_all(&runs, &opts(&stopped), |spec, dir, progress| {
-            train_run_until(spec, dir, progress, false, &stop).map_err(|e| e.to_string())
+            train_run_until(spec, dir, progress, false, &stop, None).map_err(|e| e.to_string())
         });
         assert!(matches!(first[0], RunStatus::Stopped), "{first:?}");
         assert!(run_dir.join("checkpoint.bin").exists());

@@ -21,6 +21,7 @@ use crate::experiment::run::progress::{Progress, RunEnd};
 use crate::experiment::run::provenance::Provenance;
 use crate::experiment::run::results_tree::{self, CHECKPOINT, CONFIG, FINISHED, LOCK};
 use crate::experiment::run::stop::StopSignal;
+use crate::experiment::run::tensorboard::RunEvents;
 use crate::files::atomic::{remove_stale_temp_files, write_atomic};
 use crate::files::bounded_read::{
     read_in_tree, read_text_in_tree, MAX_CHECKPOINT_BYTES, MAX_TEXT_BYTES,
@@ -362,6 +363,14 @@ pub enum RunError {
     #[error(transparent)]
     /// Boxed: the policy-file error is large, and a run error travels through every job.
     PolicyFiles(#[from] Box<PolicyError>),
+    /// The run's TensorBoard log (`--tensorboard`) could not be written.
+    #[error("TensorBoard log: {0}")]
+    TensorBoard(String),
+}
+
+/// A TensorBoard log error (its message names the file).
+fn tensorboard_error(e: std::io::Error) -> RunError {
+    RunError::TensorBoard(e.to_string())
 }
 
 fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
@@ -480,19 +489,22 @@ pub fn train_run(
     progress: &Progress,
     force: bool,
 ) -> Result<RunEnd, RunError> {
-    train_run_until(spec, dir, progress, force, &StopSignal::new())
+    train_run_until(spec, dir, progress, force, &StopSignal::new(), None)
 }
 
 /// [`train_run`] that also ends when `stop` is raised: after the training episode during which
 /// it was raised, the run saves its metrics, checkpoint and policy files as at a checkpoint and
 /// returns [`RunEnd::Stopped`]; training it again resumes from there and ends with the metrics
-/// an uninterrupted run writes (wall-clock column aside).
+/// an uninterrupted run writes (wall-clock column aside). With `tensorboard`, a run that trains
+/// also logs each evaluation below that root as it happens ([`RunEvents`]); a run skipped or
+/// left to another process logs nothing.
 pub fn train_run_until(
     spec: &RunSpec,
     dir: &Path,
     progress: &Progress,
     force: bool,
     stop: &StopSignal,
+    tensorboard: Option<&Path>,
 ) -> Result<RunEnd, RunError> {
     // Held until this function returns, whatever the outcome.
     let _lock = match lock_run_dir(spec, dir) {
@@ -528,7 +540,22 @@ pub fn train_run_until(
             || env.build(),
         )?
     };
+    let mut events = tensorboard
+        .map(|root| {
+            RunEvents::open(
+                root,
+                spec,
+                trainer.metric_columns(),
+                trainer.evals(),
+                trainer.wall_seconds(),
+            )
+        })
+        .transpose()
+        .map_err(tensorboard_error)?;
     while let Advance::Episode { checkpoint_due } = trainer.advance()? {
+        if let Some(events) = &mut events {
+            events.log_new(trainer.evals()).map_err(tensorboard_error)?;
+        }
         progress.update(
             trainer.episodes(),
             format!(
@@ -546,6 +573,9 @@ pub fn train_run_until(
         if stopping {
             return Ok(RunEnd::Stopped);
         }
+    }
+    if let Some(events) = &mut events {
+        events.log_new(trainer.evals()).map_err(tensorboard_error)?;
     }
     save_metrics(dir, &trainer)?;
     save_checkpoint(&checkpoint, &identity, &mut trainer)?;
