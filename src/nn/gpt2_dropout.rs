@@ -90,6 +90,20 @@ mod tests {
     }
 
     #[test]
+    fn kept_values_are_scaled_as_pytorchs_dropout_scales_them() {
+        // The multipliers torch's nn.Dropout(0.1) applied in the fixture's recorded masks.
+        let f = crate::nn::acac_fixture::Fixture::load();
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        let ours = dropout_mask(1, 50, 0.1, &mut rng);
+        let keep = ours.iter().copied().fold(0.0f32, f32::max);
+        for (name, m) in f.json["gpt2_dropout"]["dropout"].as_object().unwrap() {
+            let (_, values) = crate::nn::acac_fixture::Fixture::tensor(m);
+            assert!(values.iter().all(|&v| v == 0.0 || v == keep), "{name}");
+            assert!(values.contains(&0.0) && values.contains(&keep), "{name}");
+        }
+    }
+
+    #[test]
     fn draw_sizes_every_mask_for_its_place() {
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         let d = Gpt2Dropout::draw(12, 8, 3, 2, 2, 0.1, &mut rng);
