@@ -43,7 +43,7 @@ pub enum WeightsError {
         /// The file.
         path: PathBuf,
         /// The tensor's name.
-        name: &'static str,
+        name: String,
         /// Its shape.
         expected: Vec<usize>,
     },
@@ -90,12 +90,14 @@ pub fn to_safetensors_bytes(params: &QNetParams) -> Vec<u8> {
 
 /// Named f32 tensors as safetensors bytes, with PyTorch's `{"format": "pt"}` metadata: the one
 /// writer behind every net's file.
-pub(crate) fn named_to_safetensors_bytes(named: &[(&'static str, ArrayViewD<'_, f32>)]) -> Vec<u8> {
+pub(crate) fn named_to_safetensors_bytes<S: AsRef<str>>(
+    named: &[(S, ArrayViewD<'_, f32>)],
+) -> Vec<u8> {
     let data: Vec<(&str, Vec<usize>, Vec<u8>)> = named
         .iter()
         .map(|(name, a)| {
             let bytes = a.iter().flat_map(|v| v.to_le_bytes()).collect();
-            (*name, a.shape().to_vec(), bytes)
+            (name.as_ref(), a.shape().to_vec(), bytes)
         })
         .collect();
     let views = data.iter().map(|(name, shape, bytes)| {
@@ -119,7 +121,7 @@ pub fn tensor_shape(
     })?;
     let view = st.tensor(name).map_err(|_| WeightsError::Missing {
         path: origin.to_path_buf(),
-        name,
+        name: name.to_string(),
         expected: vec![],
     })?;
     Ok(view.shape().to_vec())
@@ -160,7 +162,7 @@ pub fn read_exact(
     for (name, shape) in expected {
         let view = st.tensor(name).map_err(|_| WeightsError::Missing {
             path: path.clone(),
-            name,
+            name: name.to_string(),
             expected: shape.clone(),
         })?;
         if view.dtype() != Dtype::F32 {
@@ -217,7 +219,7 @@ pub fn config_of_safetensors(bytes: &[u8], origin: &Path) -> Result<QNetConfig, 
     let shape = |name: &'static str| -> Result<Vec<usize>, WeightsError> {
         let v = st.tensor(name).map_err(|_| WeightsError::Missing {
             path: path.clone(),
-            name,
+            name: name.to_string(),
             expected: vec![],
         })?;
         if v.shape().len() != 2 {
@@ -272,7 +274,7 @@ pub fn gru_from_safetensors_bytes(bytes: &[u8], origin: &Path) -> Result<GruPara
     let tensor = |name: &'static str| {
         st.tensor(name).map_err(|_| WeightsError::Missing {
             path: path.clone(),
-            name,
+            name: name.to_string(),
             expected: vec![],
         })
     };
@@ -461,10 +463,7 @@ mod tests {
         assert!(
             matches!(
                 err,
-                WeightsError::Missing {
-                    name: "lstm.bias_hh_l0",
-                    ..
-                }
+                WeightsError::Missing { ref name, .. } if name == "lstm.bias_hh_l0"
             ),
             "{err}"
         );

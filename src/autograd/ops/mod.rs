@@ -8,19 +8,31 @@
 //! | `elementwise.rs` | `add`, `sub`, `mul`, `scale`, `sigmoid`, `tanh`, `leaky_relu`, `square`, `exp`, `log` |
 //! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `linear` (fused) |
 //! | `softmax.rs` | `softmax`, `log_softmax`, `logsumexp` (row-wise) |
-//! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows` |
+//! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows`, `reshape` |
 //! | `reduce.rs` | `sum`, `mean`, `masked_mean` |
+//! | `groups.rs` | `row_group_mean`, `row_group_max` (pool each sample's n agent rows) |
+//! | `layer_norm.rs` | `layer_norm` (fused, row-wise, PyTorch's `nn.LayerNorm`) |
+//! | `gelu.rs` | `gelu_tanh` (fused, GPT-2's tanh approximation `gelu_new`) |
+//! | `attention.rs` | `self_attention` (fused multi-head attention within sets of n rows, optional additive mask and dropout multipliers) |
 //! | `lstm.rs` | `lstm`, `lstm_packed` (fused, over packed sequences) |
 //! | `gru.rs` | `gru`, `gru_packed` (fused, over packed sequences) |
+//!
+//! Dropout is `mul` by a constant mask of 0 and 1 / (1 - p) (PyTorch's `nn.Dropout` in
+//! training), so a caller can draw the mask or replay one a reference drew.
 
+mod attention;
 mod elementwise;
+mod gelu;
+mod groups;
 mod gru;
+mod layer_norm;
 mod lstm;
 mod matmul;
 mod reduce;
 mod shape;
 mod softmax;
 
+pub use attention::AttentionSpec;
 pub use gru::GruVars;
 pub use lstm::LstmVars;
 
@@ -114,6 +126,29 @@ pub(crate) enum Op {
         x: Var,
         index: Vec<usize>,
     },
+    Reshape {
+        x: Var,
+    },
+    RowGroupMean {
+        x: Var,
+        n: usize,
+    },
+    RowGroupMax {
+        x: Var,
+        n: usize,
+        arg: Var,
+    },
+    LayerNorm {
+        x: Var,
+        gain: Var,
+        bias: Var,
+        stats: Var,
+    },
+    GeluTanh {
+        x: Var,
+        t: Var,
+    },
+    SelfAttention(Box<attention::AttentionNode>),
     Sum {
         x: Var,
     },
@@ -156,6 +191,17 @@ impl Op {
             Op::SliceCols { x, start } => shape::slice_cols_backward(*x, *start, g, cx),
             Op::GatherCols { x, index } => shape::gather_cols_backward(*x, index, g, cx),
             Op::GatherRows { x, index } => shape::gather_rows_backward(*x, index, g, cx),
+            Op::Reshape { x } => shape::reshape_backward(*x, g, cx),
+            Op::RowGroupMean { x, n } => groups::row_group_mean_backward(*x, *n, g, cx),
+            Op::RowGroupMax { x, n, arg } => groups::row_group_max_backward(*x, *n, *arg, g, cx),
+            Op::LayerNorm {
+                x,
+                gain,
+                bias,
+                stats,
+            } => layer_norm::layer_norm_backward(*x, *gain, *bias, *stats, g, cx),
+            Op::GeluTanh { x, t } => gelu::gelu_tanh_backward(*x, *t, g, cx),
+            Op::SelfAttention(node) => node.backward(g, cx),
             Op::Sum { x } => reduce::sum_backward(*x, g, cx),
             Op::Mean { x } => reduce::mean_backward(*x, g, cx),
             Op::MaskedMean { x, mask } => reduce::masked_mean_backward(*x, *mask, g, cx),

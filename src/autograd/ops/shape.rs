@@ -1,5 +1,6 @@
 //! Ops that move values without arithmetic: concatenation along rows and along features,
-//! slicing features, and gathers (Q of the chosen action, row selection).
+//! slicing features, gathers (Q of the chosen action, row selection), and reshaping (the n
+//! agents' rows of a sample side by side in one row).
 
 use ndarray::{s, Array2, Axis};
 
@@ -72,6 +73,29 @@ impl Tape {
         let mut y = self.pool().array(rows, end - start);
         y.assign(&self.value(x).slice(s![.., start..end]));
         self.push_op(y, Op::SliceCols { x, start }, &[x])
+    }
+
+    /// y = x read in row-major order as [rows, cols]: e.g. [B n, d] -> [B, n d] puts the n
+    /// agent rows of each sample side by side (PyTorch's `reshape` on a contiguous tensor).
+    /// Panics if rows * cols differs from x's element count.
+    pub fn reshape(&mut self, x: Var, rows: usize, cols: usize) -> Var {
+        let (r, c) = self.shape(x);
+        assert_eq!(
+            r * c,
+            rows * cols,
+            "reshape: [{r}, {c}] has {} elements, [{rows}, {cols}] needs {}",
+            r * c,
+            rows * cols
+        );
+        let mut y = self.pool().array(rows, cols);
+        y.as_slice_mut()
+            .expect("pool arrays are contiguous")
+            .copy_from_slice(
+                self.value(x)
+                    .as_slice()
+                    .expect("tape arrays are contiguous"),
+            );
+        self.push_op(y, Op::Reshape { x }, &[x])
     }
 
     /// y[k, 0] = x[k, index\[k\]]: one column per row, e.g. the Q-value of the action taken.
@@ -152,6 +176,15 @@ pub(super) fn slice_cols_backward(x: Var, start: usize, g: &Array2<f32>, cx: &mu
     }
 }
 
+// dx = g read back in x's shape.
+pub(super) fn reshape_backward(x: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(x) {
+        let src = g.as_slice().expect("tape arrays are contiguous");
+        let dst = d.as_slice_mut().expect("tape arrays are contiguous");
+        put!(mode, dst, src; |g| g);
+    }
+}
+
 // dx[k, index[k]] += g[k, 0], zero elsewhere.
 pub(super) fn gather_cols_backward(x: Var, index: &[usize], g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
@@ -227,6 +260,31 @@ mod tests {
             },
             &[(3, 4)],
             Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn reshape_matches_finite_differences() {
+        grad_check(
+            |t, v| {
+                let y = t.reshape(v[0], 2, 6);
+                let back = t.reshape(y, 6, 2);
+                t.mul(back, v[0])
+            },
+            &[(6, 2)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn reshape_puts_each_samples_rows_side_by_side() {
+        let mut t = crate::autograd::Tape::new();
+        let x =
+            t.constant(ndarray::arr2(&[[1.0f32, 2.0], [3.0, 4.0], [5.0, 6.0], [7.0, 8.0]]).view());
+        let y = t.reshape(x, 2, 4);
+        assert_eq!(
+            t.value(y),
+            ndarray::arr2(&[[1.0f32, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]])
         );
     }
 
