@@ -19,6 +19,7 @@
 //!                                                        │
 //!            results/<experiment>/<curve>/seed-<k>/ ◄────┘
 //!              ├─► plot (figures, summaries)   ├─► experiment::run::tidy_table (one long CSV)
+//!              ├─► report (IQM, bootstrap CIs, profiles, marl-eval JSON)
 //!              ├─► render (GIF rollouts)       ├─► experiment::cluster::audit (retrain, compare)
 //!              └─► deploy (export, eval, robot server, robot drivers) via policy_files
 //! ```
@@ -40,6 +41,7 @@
 //!    finds a domain by name, and [`envs::replay`] of action logs.
 //! 5. [`nn`] on [`autograd`]: layers, the recurrent Q-net and actors, Adam, safetensors I/O.
 //! 6. After training: [`plot`] (learning curves and tables, statistics in [`curve_stats`]),
+//!    [`report`] (rliable's aggregate statistics with bootstrap intervals, and marl-eval's JSON),
 //!    [`experiment::run::tidy_table`], [`render`] (pictures drawn with [`draw`]), [`deploy`]
 //!    (export and import of [`policy_files`], the robot protocol and server, drivers),
 //!    [`experiment::cluster::audit`], and [`mod@bench`] for timings. [`files`] is the ground
@@ -48,8 +50,8 @@
 //! Lower layers never name higher ones: `autograd` knows no layers, `envs` no nets and no
 //! learner (a family's published settings for a domain live in the family's folder), `algos` no
 //! runner, `deploy` no learner. `tests/file_circles.rs` holds the order (files, draw,
-//! curve_stats < autograd < nn < envs < algos, policy_files < experiment, deploy, plot, render <
-//! cli, api, bench) and fails on an import against it.
+//! curve_stats < autograd < nn < envs < algos, policy_files < experiment, deploy, plot, render,
+//! report < cli, api, bench) and fails on an import against it.
 //!
 //! # Your own domain or program
 //!
@@ -75,6 +77,7 @@ pub mod nn;
 pub mod plot;
 pub mod policy_files;
 pub mod render;
+pub mod report;
 
 pub use algos::families::{AnyLoop, Method, RunConfig};
 pub use algos::training_loop::EvalPoint;

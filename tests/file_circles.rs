@@ -2,7 +2,7 @@
 //! tape records ops, ops push onto the tape): README "Where the code lives" (issue 26 item 6).
 //! And no lower layer names a higher one (issue 40 item 2): the ground floor (files, drawing,
 //! curve statistics) < autograd < nn < envs < algos and policy files < experiment, deploy, plot,
-//! render < cli, api, bench.
+//! render, report < cli, api, bench.
 //!
 //! A file names another when its code outside `#[cfg(test)]` holds a `crate::`, `super::` or
 //! `self::` path (in a `use`, grouped `use` items included, or inline) that resolves to an item
@@ -165,7 +165,7 @@ const LAYERS: [&[&str]; 7] = [
     &["nn"],
     &["envs"],
     &["algos", "policy_files"],
-    &["experiment", "deploy", "plot", "render"],
+    &["experiment", "deploy", "plot", "render", "report"],
     &["cli", "api", "bench", "lib", "main"],
 ];
 

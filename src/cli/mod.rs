@@ -20,6 +20,7 @@ mod import;
 mod plot;
 mod render;
 mod replay;
+mod report;
 mod results;
 mod robot;
 mod selection;
@@ -53,6 +54,10 @@ enum Command {
     Results(results::ResultsArgs),
     /// Draw every experiment's learning curves (PNG + SVG) and summary tables from a results tree.
     Plot(plot::PlotArgs),
+    /// Aggregate statistics per block and method (IQM, mean, median, optimality gap with 95%
+    /// bootstrap intervals, probability of improvement), performance profiles,
+    /// sample-efficiency curves, and the runs as marl-eval's JSON.
+    Report(report::ReportArgs),
     /// Animate a trained run's greedy policy as a GIF.
     Render(render::RenderArgs),
     /// Write a Slurm job-array script (one task per run) to stdout.
@@ -158,6 +163,7 @@ fn run() -> Result<()> {
         Command::Render(args) => render::run(args),
         Command::Results(args) => results::run(args),
         Command::Plot(args) => plot::run(args),
+        Command::Report(args) => report::run(args),
         Command::Demo(args) => demo::run(args),
         Command::Bench(args) => bench::run(args),
     }
@@ -220,8 +226,8 @@ mod tests {
         assert_eq!(
             names,
             [
-                "demo", "train", "replay", "results", "plot", "render", "slurm", "export", "robot",
-                "deploy", "audit", "import", "eval", "domain", "bench"
+                "demo", "train", "replay", "results", "plot", "report", "render", "slurm",
+                "export", "robot", "deploy", "audit", "import", "eval", "domain", "bench"
             ]
         );
     }

@@ -30,6 +30,9 @@ pub struct RunData {
     /// `(episode, value)` per evaluation of the plotted column (`eval_return` unless another
     /// was asked for; rows with an empty cell are left out), episodes strictly increasing.
     pub points: Vec<(u64, f64)>,
+    /// The `env_steps` column at the same rows as `points` (environment steps taken when each
+    /// evaluation ran), for figures and exports against steps rather than episodes.
+    pub env_steps: Vec<u64>,
     /// Whether the run wrote its `finished` marker.
     pub finished: bool,
     /// Wall-clock seconds at the run's last evaluation.
@@ -269,11 +272,11 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
             table.family_columns.join(", ")
         )));
     };
-    let points: Vec<(u64, f64)> = rows
+    let (points, env_steps): (Vec<(u64, f64)>, Vec<u64>) = rows
         .iter()
         .zip(values)
-        .filter_map(|(r, v)| v.map(|v| (r.episode, v)))
-        .collect();
+        .filter_map(|(r, v)| v.map(|v| ((r.episode, v), r.env_steps)))
+        .unzip();
     if let Some((episode, value)) = points.iter().find(|(_, v)| !v.is_finite()) {
         return Err(bad(format!("episode {episode}: {metric} is {value}")));
     }
@@ -292,6 +295,7 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
         seed,
         dir: dir.to_path_buf(),
         points,
+        env_steps,
         finished: results_tree::is_finished(dir),
         wall_seconds: rows.last().map_or(0.0, |r| r.wall_seconds),
         setting,
@@ -406,6 +410,8 @@ pub(crate) mod tests {
         );
         assert!(!our1.runs[0].finished && our1.runs[1].finished);
         assert_eq!(our1.runs[0].points, vec![(0, 1.0)]);
+        // write_run records env_steps = 50 x episode, row for row with the returns.
+        assert_eq!(our1.runs[1].env_steps, vec![0, 500]);
         assert_eq!(our1.runs[1].wall_seconds, 5.0);
         assert_eq!(
             our1.runs[1].setting.clone().unwrap().optimal_return(),

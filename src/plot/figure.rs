@@ -2,7 +2,7 @@
 //! point), its legend with the seed count, the optimal-return line, the partial-results mark, and
 //! the summary rows. Decides everything about the figure except pixels (`render` draws it).
 
-use super::discover::{CurveData, ExperimentData, EVAL_RETURN};
+use super::discover::{CurveData, ExperimentData, RunData, EVAL_RETURN};
 use super::stats::{
     aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training,
     run_mean_over_training, smooth, CurvePoint, Smoothing,
@@ -20,8 +20,35 @@ pub struct Series {
     pub label: String,
     /// The curve's colour (never red, which marks the optimum).
     pub colour: Rgb,
-    /// Smoothed mean and standard error per evaluation point (`docs/ALGORITHMS.md` §7.2).
-    pub points: Vec<CurvePoint>,
+    /// The line and its shaded band, point by point: for learning curves the smoothed mean
+    /// and mean ± standard error per evaluation (`docs/ALGORITHMS.md` §7.2); `macdec report`
+    /// draws bootstrap intervals, which need not be symmetric.
+    pub points: Vec<BandPoint>,
+}
+
+/// One point of a drawn curve: the line at `y`, the band from `low` to `high`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BandPoint {
+    /// Position on the x axis (training episodes, environment steps, a score threshold).
+    pub x: f64,
+    /// The line's height.
+    pub y: f64,
+    /// The band's lower edge.
+    pub low: f64,
+    /// The band's upper edge.
+    pub high: f64,
+}
+
+impl From<CurvePoint> for BandPoint {
+    /// A learning-curve point: the mean, with a band of one standard error either side.
+    fn from(p: CurvePoint) -> Self {
+        BandPoint {
+            x: p.episode as f64,
+            y: p.mean,
+            low: p.mean - p.se,
+            high: p.mean + p.se,
+        }
+    }
 }
 
 /// Everything a figure shows, independent of the backend.
@@ -37,6 +64,11 @@ pub struct Figure {
     pub partial: Option<String>,
     /// What the curves and bands are.
     pub caption: String,
+    /// The x axis: `training episodes` for learning curves.
+    pub x_label: String,
+    /// Whether the x axis starts at 0 whatever the data (training starts there); otherwise
+    /// it spans the data (a profile's score thresholds).
+    pub x_from_zero: bool,
     /// The y axis: `discounted return`, or the plotted metrics column's name.
     pub y_label: String,
 }
@@ -77,16 +109,9 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
     let mut notes = Vec::new();
     let (optimal, setting_text) = common_setting(exp, &mut notes);
     let optimal = optimal.filter(|_| metric == EVAL_RETURN);
-    // A method keeps its colour across figures unless a sweep puts it on the figure twice.
-    let one_per_method = exp.curves.iter().all(|c| c.method.is_some())
-        && exp.curves.windows(2).all(|w| w[0].method != w[1].method);
     let mut series = Vec::new();
     let mut summary = Vec::new();
-    for (i, curve) in exp.curves.iter().enumerate() {
-        let colour = match curve.method {
-            Some(m) if one_per_method => method_colour(m),
-            _ => PALETTE[i % PALETTE.len()],
-        };
+    for (curve, colour) in exp.curves.iter().zip(curve_colours(exp)) {
         let runs: Vec<&[(u64, f64)]> = curve.runs.iter().map(|r| r.points.as_slice()).collect();
         let mean = aggregate(&runs);
         let episodes: Vec<u64> = mean.iter().map(|p| p.episode).collect();
@@ -102,21 +127,11 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
         series.push(Series {
             label: label(curve),
             colour,
-            points,
+            points: points.into_iter().map(BandPoint::from).collect(),
         });
     }
-    let total: usize = exp.curves.iter().map(|c| c.runs.len()).sum();
-    let unfinished: usize = exp
-        .curves
-        .iter()
-        .map(|c| c.runs.iter().filter(|r| !r.finished).count())
-        .sum();
-    let partial =
-        (unfinished > 0).then(|| format!("partial: {unfinished} of {total} runs unfinished"));
-    let title = match setting_text {
-        Some(s) => format!("{}: {s}", exp.name),
-        None => exp.name.clone(),
-    };
+    let partial = partial_mark(exp);
+    let title = title(exp, setting_text);
     let quantity = if metric == EVAL_RETURN {
         // Each family says what its evaluation measures (the ICRA methods act greedily,
         // MacroMARL's actor-critic methods sample, P8); curves of no known method are the
@@ -149,6 +164,8 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
             optimal,
             partial,
             caption,
+            x_label: "training episodes".into(),
+            x_from_zero: true,
             y_label: if metric == EVAL_RETURN {
                 "discounted return".into()
             } else {
@@ -239,6 +256,59 @@ fn method_colour(m: Method) -> Rgb {
     PALETTE[method_rank(m) % PALETTE.len()]
 }
 
+/// Each curve's colour, in the experiment's curve order: a method keeps its colour across
+/// figures (and across `plot` and `report`) unless a sweep puts it on the figure twice, when
+/// the curves take the palette in turn.
+pub fn curve_colours(exp: &ExperimentData) -> Vec<Rgb> {
+    let one_per_method = exp.curves.iter().all(|c| c.method.is_some())
+        && exp.curves.windows(2).all(|w| w[0].method != w[1].method);
+    exp.curves
+        .iter()
+        .enumerate()
+        .map(|(i, curve)| match curve.method {
+            Some(m) if one_per_method => method_colour(m),
+            _ => PALETTE[i % PALETTE.len()],
+        })
+        .collect()
+}
+
+/// The figure title: the experiment's name, and the domain setting its runs share, if any.
+pub fn title(exp: &ExperimentData, setting_text: Option<String>) -> String {
+    match setting_text {
+        Some(s) => format!("{}: {s}", exp.name),
+        None => exp.name.clone(),
+    }
+}
+
+/// "partial: m of n runs unfinished" when any run of the experiment lacks its `finished`
+/// marker.
+pub fn partial_mark(exp: &ExperimentData) -> Option<String> {
+    let total: usize = exp.curves.iter().map(|c| c.runs.len()).sum();
+    let unfinished: usize = exp
+        .curves
+        .iter()
+        .map(|c| c.runs.iter().filter(|r| !r.finished).count())
+        .sum();
+    (unfinished > 0).then(|| format!("partial: {unfinished} of {total} runs unfinished"))
+}
+
+/// The runs whose final return the summary tables count: those that reach the curve's last
+/// evaluation episode (an unfinished run stopped short would be scored on an earlier stage of
+/// training). Seeds ascending, as discovered.
+pub fn complete_runs(curve: &CurveData) -> Vec<&RunData> {
+    let last = curve
+        .runs
+        .iter()
+        .filter_map(|r| r.points.last())
+        .map(|p| p.0)
+        .max();
+    curve
+        .runs
+        .iter()
+        .filter(|r| r.points.last().map(|p| p.0) == last)
+        .collect()
+}
+
 /// "Our-1 (n = 40 seeds)", or "(n = 3 seeds, 1 unfinished)" for partial curves.
 fn label(curve: &CurveData) -> String {
     let n = curve.runs.len();
@@ -268,15 +338,17 @@ fn summarize(
         .last()
         .expect("discover keeps only runs with at least one evaluation")
         .episode;
-    let complete = || {
-        curve
-            .runs
-            .iter()
-            .filter(move |r| r.points.last().is_some_and(|p| p.0 == final_episode))
-    };
-    let final_returns: Vec<f64> = complete().filter_map(|r| final_return(&r.points)).collect();
-    let best: Vec<f64> = complete().filter_map(|r| best_return(&r.points)).collect();
-    let training_means: Vec<f64> = complete()
+    let complete = complete_runs(curve);
+    let final_returns: Vec<f64> = complete
+        .iter()
+        .filter_map(|r| final_return(&r.points))
+        .collect();
+    let best: Vec<f64> = complete
+        .iter()
+        .filter_map(|r| best_return(&r.points))
+        .collect();
+    let training_means: Vec<f64> = complete
+        .iter()
         .filter_map(|r| run_mean_over_training(&r.points))
         .collect();
     let (final_mean, final_se) = mean_and_se(&final_returns).unwrap_or((f64::NAN, f64::NAN));
@@ -308,8 +380,12 @@ fn summarize(
 }
 
 /// The optimal return and title description shared by every run that has a readable config.
-/// Runs that disagree (e.g. a sweep over grid_dim) get no line and no description.
-fn common_setting(exp: &ExperimentData, notes: &mut Vec<String>) -> (Option<f64>, Option<String>) {
+/// Runs that disagree (e.g. a sweep over grid_dim) get no line and no description; `notes`
+/// says why.
+pub fn common_setting(
+    exp: &ExperimentData,
+    notes: &mut Vec<String>,
+) -> (Option<f64>, Option<String>) {
     let runs = exp.curves.iter().flat_map(|c| &c.runs);
     let settings: Vec<_> = runs.clone().filter_map(|r| r.setting.clone()).collect();
     let missing = runs.count() - settings.len();

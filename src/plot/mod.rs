@@ -117,14 +117,7 @@ pub fn plot_results_with(
         let png = out.join(format!("{stem}.png"));
         let svg = out.join(format!("{stem}.svg"));
         let summary_csv = out.join(format!("{stem}_summary.csv"));
-        render::render_png(&built.figure, &png)?;
-        let svg_text = render::render_svg(&built.figure, &svg)?;
-        crate::files::atomic::write_atomic(&svg, svg_text.as_bytes()).map_err(|source| {
-            PlotError::Write {
-                path: svg.clone(),
-                source,
-            }
-        })?;
+        render::render_files(&built.figure, &png, &svg)?;
         summary::write_csv(&summary_csv, &built.summary)?;
         let tests = summary::pairwise_tests(&built.summary);
         let tests_csv = out.join(format!("{stem}_welch.csv"));

@@ -1,5 +1,6 @@
 //! Drawing a [`Figure`] with plotters, as PNG and SVG from the same code: the paper's layout
-//! (curves with shaded standard-error bands, a red dash-dot optimal line) with large, readable
+//! (curves with shaded bands, standard errors for `plot`'s learning curves and bootstrap
+//! intervals for `report`'s figures, and a red dash-dot optimal line) with large, readable
 //! text.
 
 use super::error::PlotError;
@@ -25,6 +26,19 @@ const CAPTION_PX: u32 = 16;
 const LEGEND_MARGIN_PX: u32 = 16;
 const LEGEND_KEY_PX: u32 = 36;
 const OPTIMAL_RED: RGBColor = RGBColor(214, 39, 40);
+
+/// Draw `fig` into `png` and `svg`, each written atomically: the pair every figure is
+/// published as.
+pub fn render_files(fig: &Figure, png: &Path, svg: &Path) -> Result<(), PlotError> {
+    render_png(fig, png)?;
+    let svg_text = render_svg(fig, svg)?;
+    crate::files::atomic::write_atomic(svg, svg_text.as_bytes()).map_err(|source| {
+        PlotError::Write {
+            path: svg.to_path_buf(),
+            source,
+        }
+    })
+}
 
 /// Draw `fig` into a PNG file at `path`.
 pub fn render_png(fig: &Figure, path: &Path) -> Result<(), PlotError> {
@@ -74,7 +88,7 @@ fn rgb((r, g, b): Rgb) -> RGBColor {
 }
 
 /// The data ranges shown: every curve's band and the optimal line, padded by 6% so nothing touches
-/// the frame. Never empty, even for a single point.
+/// the frame, and x from 0 when the figure asks. Never empty, even for a single point.
 /// Returns beyond +-[`MAX_AXIS`] are drawn clipped at the frame: the axis must stay finite and
 /// wide enough for f64 steps, or the tick search never ends.
 fn ranges(fig: &Figure) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
@@ -89,12 +103,12 @@ fn ranges(fig: &Figure) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
         }
     };
     for p in points {
-        x0 = x0.min(p.episode as f64);
-        x1 = x1.max(p.episode as f64);
-        // An infinite band (one huge return makes the SE overflow) still shows its mean.
-        see_y(p.mean);
-        see_y(p.mean - p.se);
-        see_y(p.mean + p.se);
+        x0 = x0.min(p.x);
+        x1 = x1.max(p.x);
+        // An infinite band (one huge return makes the SE overflow) still shows its line.
+        see_y(p.y);
+        see_y(p.low);
+        see_y(p.high);
     }
     if let Some(opt) = fig.optimal {
         see_y(opt);
@@ -105,7 +119,9 @@ fn ranges(fig: &Figure) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
     if !y0.is_finite() {
         (y0, y1) = (0.0, 1.0);
     }
-    x0 = x0.min(0.0);
+    if fig.x_from_zero {
+        x0 = x0.min(0.0);
+    }
     if x1 <= x0 {
         x1 = x0 + 1.0;
     }
@@ -220,13 +236,13 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     let (x_lo, x_hi) = (xr.start, xr.end);
     chart
         .configure_mesh()
-        .x_desc("training episodes")
+        .x_desc(fig.x_label.as_str())
         .y_desc(fig.y_label.as_str())
         .axis_desc_style((FAMILY, AXIS_DESC_PX))
         .label_style((FAMILY, TICK_PX))
         .x_labels(8)
         .y_labels(8)
-        .x_label_formatter(&|x| format!("{x:.0}"))
+        .x_label_formatter(&|x| trim_number(*x))
         .y_label_formatter(&|y| trim_number(*y))
         .bold_line_style(BLACK.mix(0.10))
         .light_line_style(BLACK.mix(0.03))
@@ -234,14 +250,15 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
         .draw()
         .map_err(e)?;
 
+    // Values far off the axes are drawn at a frame's height beyond them: the drawing area clips
+    // them the same, and plotters' pixel arithmetic (i32) cannot overflow on a huge return.
+    let y_span = chart.y_range().end - chart.y_range().start;
+    let (y_lo, y_hi) = (chart.y_range().start - y_span, chart.y_range().end + y_span);
+    let on_axes = |y: f64| if y.is_nan() { y } else { y.clamp(y_lo, y_hi) };
     // Bands first, so every line is drawn on top of every band.
     for s in &fig.series {
-        let upper = s.points.iter().map(|p| (p.episode as f64, p.mean + p.se));
-        let lower = s
-            .points
-            .iter()
-            .rev()
-            .map(|p| (p.episode as f64, p.mean - p.se));
+        let upper = s.points.iter().map(|p| (p.x, on_axes(p.high)));
+        let lower = s.points.iter().rev().map(|p| (p.x, on_axes(p.low)));
         let outline: Vec<(f64, f64)> = upper.chain(lower).collect();
         chart
             .draw_series(std::iter::once(Polygon::new(
@@ -252,11 +269,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &Figure) -> Resu
     }
     for s in &fig.series {
         let colour = rgb(s.colour);
-        let line: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .map(|p| (p.episode as f64, p.mean))
-            .collect();
+        let line: Vec<(f64, f64)> = s.points.iter().map(|p| (p.x, on_axes(p.y))).collect();
         let single = line.len() < 2;
         chart
             .draw_series(LineSeries::new(line.clone(), colour.stroke_width(3)))
@@ -343,11 +356,10 @@ fn occupancy<DB: DrawingBackend>(
             .points
             .iter()
             .map(|p| {
-                let x = p.episode as f64;
-                let (x_px, mean) = px(x, p.mean);
-                let top = px(x, p.mean + p.se).1;
-                let bottom = px(x, p.mean - p.se).1;
-                (x_px, mean, top, bottom)
+                let (x_px, line) = px(p.x, p.y);
+                let top = px(p.x, p.high).1;
+                let bottom = px(p.x, p.low).1;
+                (x_px, line, top, bottom)
             })
             .collect();
         occupied.mark_band(&band);
@@ -406,18 +418,22 @@ mod tests {
                         mean: -10.0,
                         se: 2.0,
                         n: 2,
-                    },
+                    }
+                    .into(),
                     CurvePoint {
                         episode: 100,
                         mean: 40.0,
                         se: 5.0,
                         n: 2,
-                    },
+                    }
+                    .into(),
                 ],
             }],
             optimal: Some(80.0),
             partial: None,
             caption: String::new(),
+            x_label: "training episodes".into(),
+            x_from_zero: true,
             y_label: "discounted return".into(),
         };
         let (x, y) = ranges(&fig);
@@ -425,6 +441,27 @@ mod tests {
         // data span -12 .. 80 = 92, padded by 6% = 5.52 each side
         assert!((y.start - (-12.0 - 5.52)).abs() < 1e-9);
         assert!((y.end - (80.0 + 5.52)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_x_axis_starts_at_zero_only_when_the_figure_asks() {
+        let mut fig = figure_of(vec![
+            CurvePoint {
+                episode: 100,
+                mean: 1.0,
+                se: 0.0,
+                n: 1,
+            },
+            CurvePoint {
+                episode: 200,
+                mean: 2.0,
+                se: 0.0,
+                n: 1,
+            },
+        ]);
+        assert_eq!(ranges(&fig).0, 0.0..200.0);
+        fig.x_from_zero = false;
+        assert_eq!(ranges(&fig).0, 100.0..200.0);
     }
 
     #[test]
@@ -440,11 +477,13 @@ mod tests {
             series: vec![crate::plot::figure::Series {
                 label: "a".into(),
                 colour: (0, 0, 0),
-                points,
+                points: points.into_iter().map(Into::into).collect(),
             }],
             optimal: Some(80.0),
             partial: None,
             caption: String::new(),
+            x_label: "training episodes".into(),
+            x_from_zero: true,
             y_label: "discounted return".into(),
         }
     }
@@ -503,11 +542,14 @@ mod tests {
             label: label.into(),
             colour: (0, 0, 0),
             points: (0..50)
-                .map(|i| CurvePoint {
-                    episode: i * 100,
-                    mean,
-                    se: 1.0,
-                    n: 2,
+                .map(|i| {
+                    CurvePoint {
+                        episode: i * 100,
+                        mean,
+                        se: 1.0,
+                        n: 2,
+                    }
+                    .into()
                 })
                 .collect(),
         };
