@@ -121,7 +121,8 @@ fn median_spacing(episodes: &[u64]) -> Option<u64> {
 /// One evaluation point of a curve aggregated over runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CurvePoint {
-    /// Training episodes completed (the metrics' `episode` column).
+    /// Training episodes completed (the metrics' `episode` column); environment steps for a
+    /// curve drawn against them ([`aggregate_interpolated`]).
     pub episode: u64,
     /// Mean over the runs that have this point.
     pub mean: f64,
@@ -165,6 +166,70 @@ pub fn aggregate(runs: &[&[(u64, f64)]]) -> Vec<CurvePoint> {
             let (mean, se) = mean_and_se(&values)?;
             Some(CurvePoint {
                 episode,
+                mean,
+                se,
+                n: values.len(),
+            })
+        })
+        .collect()
+}
+
+/// A run's value at `at` by linear interpolation between its evaluations either side (the
+/// first evaluation at `at` itself when there is one; the end values outside the run's range,
+/// as `numpy.interp` does). `run` is `(x, value)` with x non-decreasing and not empty.
+pub fn interpolate(run: &[(f64, f64)], at: f64) -> f64 {
+    let after = run.partition_point(|p| p.0 < at);
+    if after == run.len() {
+        return run[run.len() - 1].1;
+    }
+    let (x1, y1) = run[after];
+    if after == 0 || x1 == at {
+        return y1;
+    }
+    let (x0, y0) = run[after - 1];
+    y0 + (y1 - y0) * (at - x0) / (x1 - x0)
+}
+
+/// Aggregate runs evaluated at different x (environment steps, which differ between seeds) into
+/// one curve of `points` evenly spaced integer x from the earliest first evaluation to the latest
+/// last one: at each x, the mean and standard error over the runs whose own range holds x, each
+/// linearly interpolated between its evaluations either side ([`interpolate`]). So, as in
+/// [`aggregate`], an unfinished run contributes where it has data and `n` says how many did.
+/// Each run is `(x, value)` with x non-decreasing; empty runs are ignored.
+pub fn aggregate_interpolated(runs: &[Vec<(u64, f64)>], points: usize) -> Vec<CurvePoint> {
+    let runs: Vec<Vec<(f64, f64)>> = runs
+        .iter()
+        .filter(|r| !r.is_empty())
+        .map(|r| r.iter().map(|&(x, v)| (x as f64, v)).collect())
+        .collect();
+    let (Some(lo), Some(hi)) = (
+        runs.iter().map(|r| r[0].0).reduce(f64::min),
+        runs.iter().map(|r| r[r.len() - 1].0).reduce(f64::max),
+    ) else {
+        return Vec::new();
+    };
+    let xs: Vec<u64> = match points {
+        0 => Vec::new(),
+        _ if points == 1 || hi == lo => vec![hi as u64],
+        _ => {
+            let mut xs: Vec<u64> = (0..points)
+                .map(|i| (lo + (hi - lo) * i as f64 / (points - 1) as f64).round() as u64)
+                .collect();
+            xs.dedup();
+            xs
+        }
+    };
+    xs.into_iter()
+        .filter_map(|x| {
+            let at = x as f64;
+            let values: Vec<f64> = runs
+                .iter()
+                .filter(|r| r[0].0 <= at && at <= r[r.len() - 1].0)
+                .map(|r| interpolate(r, at))
+                .collect();
+            let (mean, se) = mean_and_se(&values)?;
+            Some(CurvePoint {
+                episode: x,
                 mean,
                 se,
                 n: values.len(),
@@ -260,6 +325,44 @@ pub fn run_mean_over_training(points: &[(u64, f64)]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn runs_of_different_step_counts_are_interpolated_onto_a_shared_step_grid() {
+        // Run a: 0 at step 0, 10 at step 100. Run b: 0 at 0, 20 at 200 (it stops later).
+        let a = vec![(0, 0.0), (100, 10.0)];
+        let b = vec![(0, 0.0), (200, 20.0)];
+        let curve = aggregate_interpolated(&[a, b], 5);
+        let x: Vec<u64> = curve.iter().map(|p| p.episode).collect();
+        assert_eq!(x, [0, 50, 100, 150, 200]);
+        // Both runs give x / 10 where both have data; past step 100 only b does.
+        let means: Vec<f64> = curve.iter().map(|p| p.mean).collect();
+        assert_eq!(means, [0.0, 5.0, 10.0, 15.0, 20.0]);
+        let n: Vec<usize> = curve.iter().map(|p| p.n).collect();
+        assert_eq!(n, [2, 2, 2, 1, 1]);
+        assert!(
+            curve.iter().all(|p| p.se == 0.0),
+            "the runs agree where they overlap"
+        );
+        // Unequal runs: the mean and its standard error over the two interpolated values.
+        let c =
+            aggregate_interpolated(&[vec![(0, 0.0), (10, 10.0)], vec![(0, 0.0), (10, 30.0)]], 3);
+        assert_eq!(c[1].episode, 5);
+        assert_eq!((c[1].mean, c[1].n), (10.0, 2));
+        assert_eq!(c[1].se, mean_and_se(&[5.0, 15.0]).unwrap().1);
+        assert!(aggregate_interpolated(&[], 5).is_empty());
+        assert_eq!(aggregate_interpolated(&[vec![(7, 1.0)]], 5)[0].episode, 7);
+    }
+
+    #[test]
+    fn interpolation_holds_the_ends_and_joins_neighbours_linearly() {
+        let run = [(10.0, 1.0), (20.0, 3.0), (20.0, 5.0), (30.0, 7.0)];
+        assert_eq!(interpolate(&run, 0.0), 1.0);
+        assert_eq!(interpolate(&run, 15.0), 2.0);
+        // The first evaluation at a repeated x.
+        assert_eq!(interpolate(&run, 20.0), 3.0);
+        assert_eq!(interpolate(&run, 25.0), 6.0);
+        assert_eq!(interpolate(&run, 99.0), 7.0);
+    }
 
     fn pt(episode: u64, mean: f64) -> CurvePoint {
         CurvePoint {

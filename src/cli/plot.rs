@@ -16,6 +16,15 @@ pub(super) struct PlotArgs {
     /// method family's own such as loss or epsilon); files become <experiment>_<metric>.*.
     #[arg(long, default_value = "eval_return")]
     metric: String,
+    /// The return to draw: `discounted` (eval_return) or `undiscounted`
+    /// (eval_return_undiscounted, the summed team reward later papers report); instead of
+    /// --metric.
+    #[arg(long = "y", value_parser = crate::plot::axis::YAxis::parse, conflicts_with = "metric")]
+    y_axis: Option<crate::plot::axis::YAxis>,
+    /// What the curves are drawn against: `episode` or `env_steps` (runs interpolated between
+    /// their evaluations; files get an `_env_steps` suffix).
+    #[arg(long = "x", default_value = "episode", value_parser = crate::plot::axis::XAxis::parse)]
+    x_axis: crate::plot::axis::XAxis,
     /// Centred moving average before drawing and reading "95% of optimal first at":
     /// `auto` (half window = evaluation points / 40, at most 10: 21 points on long runs,
     /// none under 40 points), `0` (none), an odd number of evaluation points (`21`), or
@@ -30,12 +39,15 @@ pub(super) fn run(args: PlotArgs) -> Result<()> {
         results,
         out,
         metric,
+        y_axis,
+        x_axis,
         smooth,
     } = args;
     let out = out.unwrap_or_else(|| results.clone());
     let options = crate::plot::PlotOptions {
-        metric,
+        metric: y_axis.map_or(metric, |y| y.column().to_string()),
         smoothing: smooth,
+        x: x_axis,
     };
     plot(&results, &out, &options)
 }
@@ -102,6 +114,28 @@ mod tests {
             &["--smooth", "foo"],
             ErrorKind::ValueValidation,
             "`foo` is not a smoothing",
+        );
+    }
+
+    #[test]
+    fn plot_takes_an_x_axis_and_a_y_axis_but_not_y_with_metric() {
+        use crate::plot::axis::{XAxis, YAxis};
+        let args = parse(&[]);
+        assert_eq!((args.x_axis, args.y_axis), (XAxis::Episode, None));
+        let args = parse(&["--x", "env_steps", "--y", "undiscounted"]);
+        assert_eq!(args.x_axis, XAxis::EnvSteps);
+        assert_eq!(args.y_axis, Some(YAxis::Undiscounted));
+        assert_refused(
+            "plot",
+            &["--y", "undiscounted", "--metric", "loss"],
+            ErrorKind::ArgumentConflict,
+            "--metric",
+        );
+        assert_refused(
+            "plot",
+            &["--x", "steps"],
+            ErrorKind::ValueValidation,
+            "`steps` is not an x axis",
         );
     }
 }

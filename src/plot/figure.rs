@@ -2,10 +2,11 @@
 //! point), its legend with the seed count, the optimal-return line, the partial-results mark, and
 //! the summary rows. Decides everything about the figure except pixels (`render` draws it).
 
+use super::axis::{XAxis, EVAL_RETURN_UNDISCOUNTED};
 use super::discover::{CurveData, ExperimentData, RunData, EVAL_RETURN};
 use super::stats::{
-    aggregate, best_return, final_return, first_reaching, mean_and_se, mean_over_training,
-    run_mean_over_training, smooth, CurvePoint, Smoothing,
+    aggregate, aggregate_interpolated, best_return, final_return, first_reaching, mean_and_se,
+    mean_over_training, run_mean_over_training, smooth, CurvePoint, Smoothing,
 };
 use super::summary::CurveSummary;
 use crate::algos::families::{Family, Method};
@@ -99,13 +100,18 @@ const PALETTE: [Rgb; 9] = [
 
 /// Build the figure and summary of one experiment's `eval_return` curves, smoothed by default.
 pub fn build(exp: &ExperimentData) -> Built {
-    build_metric(exp, EVAL_RETURN, Smoothing::Auto)
+    build_metric(exp, EVAL_RETURN, Smoothing::Auto, XAxis::Episode)
 }
 
 /// Build the figure and summary of one experiment whose runs were read for the `metric` column
 /// ([`crate::plot::discover::discover_metric`]), each curve smoothed as `smoothing` says for its
-/// own evaluation points. Only `eval_return` has an optimal line.
-pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) -> Built {
+/// own evaluation points, against `x`. Only `eval_return` has an optimal line.
+///
+/// Against environment steps, which differ from seed to seed, each curve is the mean of its runs
+/// interpolated onto as many evenly spaced steps as it has evaluation points
+/// ([`aggregate_interpolated`]), smoothed by the same window in points; the summary (final
+/// returns, the episode reaching 95% of the optimum, the tests) is the same as against episodes.
+pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing, x: XAxis) -> Built {
     let mut notes = Vec::new();
     let (optimal, setting_text) = common_setting(exp, &mut notes);
     let optimal = optimal.filter(|_| metric == EVAL_RETURN);
@@ -124,10 +130,27 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
             optimal,
             2 * half_window + 1,
         ));
+        let drawn = match x {
+            XAxis::Episode => points,
+            XAxis::EnvSteps => {
+                let runs: Vec<Vec<(u64, f64)>> = curve
+                    .runs
+                    .iter()
+                    .map(|r| {
+                        r.env_steps
+                            .iter()
+                            .zip(&r.points)
+                            .map(|(&s, &(_, v))| (s, v))
+                            .collect()
+                    })
+                    .collect();
+                smooth(&aggregate_interpolated(&runs, mean.len()), half_window)
+            }
+        };
         series.push(Series {
             label: label(curve),
             colour,
-            points: points.into_iter().map(BandPoint::from).collect(),
+            points: drawn.into_iter().map(BandPoint::from).collect(),
         });
     }
     let partial = partial_mark(exp);
@@ -146,11 +169,17 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
             1 => measured.into_iter().next().unwrap_or_default().to_string(),
             _ => "the discounted evaluation return (greedy or sampled by method)".to_string(),
         }
+    } else if metric == EVAL_RETURN_UNDISCOUNTED {
+        "the undiscounted evaluation return (the summed team reward)".to_string()
     } else {
         format!("`{metric}`")
     };
+    let along = match x {
+        XAxis::Episode => "",
+        XAxis::EnvSteps => ", each run interpolated linearly between its evaluations' env steps",
+    };
     let mut caption = format!(
-        "Mean over seeds of {quantity}; band: standard error (ddof 1); {}.",
+        "Mean over seeds of {quantity}{along}; band: standard error (ddof 1); {}.",
         smoothing_caption(&summary)
     );
     if let Some(mix) = provenance_mix(exp) {
@@ -164,12 +193,12 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing) ->
             optimal,
             partial,
             caption,
-            x_label: "training episodes".into(),
+            x_label: x.label().into(),
             x_from_zero: true,
-            y_label: if metric == EVAL_RETURN {
-                "discounted return".into()
-            } else {
-                metric.to_string()
+            y_label: match metric {
+                EVAL_RETURN => "discounted return".into(),
+                EVAL_RETURN_UNDISCOUNTED => "undiscounted return".into(),
+                _ => metric.to_string(),
             },
         },
         summary,

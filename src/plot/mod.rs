@@ -4,6 +4,7 @@
 //! `figure` decides what is drawn, `render` draws it (PNG and SVG; `legend` finds its place), `summary` tabulates the final
 //! returns. [`plot_results`] runs the whole pipeline for `macdec plot`.
 
+pub mod axis;
 pub mod discover;
 pub mod error;
 pub mod figure;
@@ -71,6 +72,9 @@ pub struct PlotOptions {
     pub metric: String,
     /// The moving average applied to each curve before it is drawn and read.
     pub smoothing: stats::Smoothing,
+    /// What the curves are drawn against; figures against environment steps are named
+    /// `<experiment>[_<metric>]_env_steps.*`.
+    pub x: axis::XAxis,
 }
 
 impl Default for PlotOptions {
@@ -79,6 +83,7 @@ impl Default for PlotOptions {
         PlotOptions {
             metric: discover::EVAL_RETURN.to_string(),
             smoothing: stats::Smoothing::Auto,
+            x: axis::XAxis::Episode,
         }
     }
 }
@@ -107,13 +112,16 @@ pub fn plot_results_with(
     })?;
     let mut plots = Vec::new();
     for exp in &found.experiments {
-        let built = figure::build_metric(exp, metric, options.smoothing);
+        let built = figure::build_metric(exp, metric, options.smoothing, options.x);
         notes.extend(built.notes);
-        let stem = if metric == discover::EVAL_RETURN {
+        let mut stem = if metric == discover::EVAL_RETURN {
             exp.name.clone()
         } else {
             format!("{}_{metric}", exp.name)
         };
+        if options.x == axis::XAxis::EnvSteps {
+            stem.push_str("_env_steps");
+        }
         let png = out.join(format!("{stem}.png"));
         let svg = out.join(format!("{stem}.svg"));
         let summary_csv = out.join(format!("{stem}_summary.csv"));
@@ -273,6 +281,51 @@ mod tests {
         }
         let err = plot_results_with(&res, &out, &metric("q_loss")).unwrap_err();
         assert!(err.to_string().contains("no runs found"), "{err}");
+    }
+
+    #[test]
+    fn against_env_steps_runs_of_different_speeds_share_one_curve_and_the_summary_stays() {
+        let t = tempfile::tempdir().unwrap();
+        let res = t.path().join("results");
+        let bp10 = crate::envs::box_pushing::paper_spec(10);
+        let pts: Vec<(u64, f64)> = (0..5).map(|i| (i * 100, i as f64)).collect();
+        write_run(&res, "e", "our1", 0, &pts, bp10.clone(), true);
+        write_run(&res, "e", "our1", 1, &pts, bp10, true);
+        let mut found = discover::discover(&res).unwrap();
+        // Seed 1 takes twice the steps per episode: 0, 10000, ..., 40000 against 0, ..., 20000.
+        let runs = &mut found.experiments[0].curves[0].runs;
+        runs[1].env_steps = runs[1].env_steps.iter().map(|s| s * 2).collect();
+        let exp = &found.experiments[0];
+        let smoothing = stats::Smoothing::Points(1);
+        let by_episode = figure::build_metric(exp, "eval_return", smoothing, axis::XAxis::Episode);
+        let by_steps = figure::build_metric(exp, "eval_return", smoothing, axis::XAxis::EnvSteps);
+        assert_eq!(by_steps.summary, by_episode.summary);
+        assert_eq!(by_steps.figure.x_label, "environment steps");
+        let drawn = &by_steps.figure.series[0].points;
+        let x: Vec<f64> = drawn.iter().map(|p| p.x).collect();
+        assert_eq!(x, [0.0, 10000.0, 20000.0, 30000.0, 40000.0]);
+        // At step 20000 seed 0 ends at 4 and seed 1 is at 2: mean 3; beyond, seed 1 alone.
+        let y: Vec<f64> = drawn.iter().map(|p| p.y).collect();
+        assert_eq!(y, [0.0, 1.5, 3.0, 3.0, 4.0]);
+        assert!(by_steps.figure.caption.contains("interpolated linearly"));
+        // Through the files: their own names, beside the episode figure.
+        let out = t.path().join("plots");
+        let options = PlotOptions {
+            x: axis::XAxis::EnvSteps,
+            metric: axis::YAxis::Undiscounted.column().to_string(),
+            ..PlotOptions::default()
+        };
+        let plotted = plot_results_with(&res, &out, &options).unwrap();
+        assert_eq!(
+            plotted.plots[0].svg,
+            out.join("e_eval_return_undiscounted_env_steps.svg")
+        );
+        let svg = std::fs::read_to_string(&plotted.plots[0].svg).unwrap();
+        assert!(svg.contains("undiscounted return") && svg.contains("environment steps"));
+        assert_eq!(
+            plotted.plots[0].summary[0].optimal, None,
+            "the optimum is discounted"
+        );
     }
 
     fn metric(name: &str) -> PlotOptions {

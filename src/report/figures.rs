@@ -4,7 +4,8 @@
 
 use super::block::Block;
 use super::profile::{profile, taus};
-use super::sample_efficiency::{iqm_curve, XAxis};
+use super::sample_efficiency::iqm_curve;
+use crate::plot::axis::XAxis;
 use crate::plot::figure::{BandPoint, Figure, Series};
 
 /// What both figures' captions say about their bands.

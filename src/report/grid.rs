@@ -2,6 +2,8 @@
 //! point by point (the sample-efficiency curves) and every run exports the same steps
 //! (marl-eval needs as many logged steps in every run).
 
+use crate::curve_stats::interpolate;
+
 /// The most points a curve is drawn with: enough for a smooth line, and a bound on the
 /// bootstrap's work per curve (resamples x points x runs).
 pub const CURVE_POINTS: usize = 101;
@@ -82,22 +84,6 @@ pub fn common_grid(runs: &[Vec<(f64, f64)>]) -> Option<Grid> {
     })
 }
 
-/// The run's value at `at` by linear interpolation between the evaluations either side (the
-/// first evaluation at `at` itself when there is one; the end values outside the run's range,
-/// as `numpy.interp` does).
-fn interpolate(run: &[(f64, f64)], at: f64) -> f64 {
-    let after = run.partition_point(|p| p.0 < at);
-    if after == run.len() {
-        return run[run.len() - 1].1;
-    }
-    let (x1, y1) = run[after];
-    if after == 0 || x1 == at {
-        return y1;
-    }
-    let (x0, y0) = run[after - 1];
-    y0 + (y1 - y0) * (at - x0) / (x1 - x0)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,15 +146,5 @@ mod tests {
         assert_eq!(common_grid(&[a.clone(), b]), None);
         assert_eq!(common_grid(&[a, Vec::new()]), None);
         assert_eq!(common_grid(&[]), None);
-    }
-
-    #[test]
-    fn interpolation_holds_the_ends_and_takes_the_first_of_repeated_x() {
-        let run = [(10.0, 1.0), (20.0, 3.0), (20.0, 9.0), (30.0, 5.0)];
-        assert_eq!(interpolate(&run, 0.0), 1.0);
-        assert_eq!(interpolate(&run, 15.0), 2.0);
-        assert_eq!(interpolate(&run, 20.0), 3.0);
-        assert_eq!(interpolate(&run, 25.0), 7.0);
-        assert_eq!(interpolate(&run, 99.0), 5.0);
     }
 }

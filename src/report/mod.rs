@@ -23,8 +23,8 @@ pub mod profile;
 pub mod sample_efficiency;
 pub mod scores;
 
+pub use crate::plot::axis::XAxis;
 pub use error::ReportError;
-pub use sample_efficiency::XAxis;
 
 use crate::plot::discover::{discover, ExperimentData};
 use crate::plot::summary::{format_number, write_csv};

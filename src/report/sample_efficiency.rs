@@ -6,61 +6,9 @@
 use super::bootstrap::{percentile_intervals, stream};
 use super::grid::{common_grid, Grid};
 use super::scores::iqm;
+use crate::plot::axis::XAxis;
 use crate::plot::discover::RunData;
 use crate::plot::figure::BandPoint;
-
-/// What the sample-efficiency curves are drawn against (`--x`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum XAxis {
-    /// Training episodes (the metrics' `episode` column), as `macdec plot` draws.
-    #[default]
-    Episode,
-    /// Environment steps (`env_steps`), which differ between methods that spend a different
-    /// number of steps per episode.
-    EnvSteps,
-}
-
-impl XAxis {
-    /// Parse `--x`: `episode` or `env_steps`.
-    pub fn parse(text: &str) -> Result<XAxis, String> {
-        match text.trim() {
-            "episode" => Ok(XAxis::Episode),
-            "env_steps" => Ok(XAxis::EnvSteps),
-            other => Err(format!(
-                "`{other}` is not an x axis: give `episode` or `env_steps`"
-            )),
-        }
-    }
-
-    /// The axis label of the figure.
-    pub fn label(self) -> &'static str {
-        match self {
-            XAxis::Episode => "training episodes",
-            XAxis::EnvSteps => "environment steps",
-        }
-    }
-
-    /// The name `--x` takes, also in stream keys.
-    pub fn name(self) -> &'static str {
-        match self {
-            XAxis::Episode => "episode",
-            XAxis::EnvSteps => "env_steps",
-        }
-    }
-
-    /// A run's `(x, evaluation return)` points along this axis.
-    pub fn points(self, run: &RunData) -> Vec<(f64, f64)> {
-        match self {
-            XAxis::Episode => run.points.iter().map(|&(e, v)| (e as f64, v)).collect(),
-            XAxis::EnvSteps => run
-                .env_steps
-                .iter()
-                .zip(&run.points)
-                .map(|(&s, &(_, v))| (s as f64, v))
-                .collect(),
-        }
-    }
-}
 
 /// A method's curve: the IQM across `runs` at each shared x ([`common_grid`]) and its 95%
 /// interval over resampled runs (stream `sample_efficiency/<block>/<method>/<axis>`), plus
@@ -152,15 +100,6 @@ mod tests {
         );
         // A resample can hold the outlier twice or more: the band reaches far above.
         assert!(curve[1].high > 3.0, "{:?}", curve[1]);
-    }
-
-    #[test]
-    fn the_axis_parses_from_its_names_only() {
-        for axis in [XAxis::Episode, XAxis::EnvSteps] {
-            assert_eq!(XAxis::parse(axis.name()), Ok(axis));
-        }
-        let e = XAxis::parse("steps").unwrap_err();
-        assert!(e.contains("`steps` is not an x axis"), "{e}");
     }
 
     #[test]
