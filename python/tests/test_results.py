@@ -76,6 +76,20 @@ def test_it_reads_what_macdec_results_writes(tmp_path, run_cli):
         ), c
 
 
+def test_the_readmes_pandas_recipe_for_macdec_results_keeps_every_curve(tmp_path, run_cli):
+    """README "Results as a table": the recipe's lines as printed, on `macdec results --out`."""
+    write_tree(tmp_path / "tree")
+    run_cli("results", "--results", tmp_path / "tree", "--out", tmp_path / "runs.csv")
+    runs = pd.read_csv(tmp_path / "runs.csv")
+    means = runs.groupby(["experiment", "method", "variant"], dropna=False).eval_return.mean()
+    assert len(means) == 2
+    by_curve = {(e, m, "" if pd.isna(v) else v): x for (e, m, v), x in means.items()}
+    assert by_curve[("group/ac", "mac-iac", "lr=0.01")] == 7.75
+    assert by_curve[("fig", "our1", "")] == pytest.approx((1.5 + 2.25 - 3.0) / 3)
+    # Why the recipe says dropna=False: pandas reads the empty variant as NaN and drops it.
+    assert len(runs.groupby(["experiment", "method", "variant"]).eval_return.mean()) == 1
+
+
 def test_a_missing_or_empty_tree_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="nowhere"):
         macdec.load_results(tmp_path / "nowhere")
