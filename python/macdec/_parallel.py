@@ -12,6 +12,21 @@ from pettingzoo import ParallelEnv
 from . import _macdec
 
 
+
+def _action_index(agent: str, action, n_actions: int) -> int:
+    """One agent's macro-action as an int: a Python or NumPy integer (a 0-d integer array too),
+    never a float, bool or string, which would be truncated or parsed into another action."""
+    a = np.asarray(action) if not isinstance(action, int) or isinstance(action, bool) else None
+    if a is not None and (a.ndim != 0 or a.dtype.kind not in "iu"):
+        raise ValueError(
+            f"{agent}: an action is one macro-action index, an integer in 0..{n_actions}, got {action!r}"
+        )
+    value = int(action) if a is None else int(a)
+    # Out-of-range values of a free agent are refused in Rust; ones no int64 holds, here.
+    if not -(2**63) <= value < 2**63:
+        raise ValueError(f"{agent}: the macro-action must be in 0..{n_actions}, got {value}")
+    return value
+
 class MacroParallelEnv(ParallelEnv):
     """A macdec domain as a PettingZoo ``ParallelEnv``; make one with :func:`macdec.parallel_env`.
 
@@ -88,12 +103,7 @@ class MacroParallelEnv(ParallelEnv):
         row = [-1] * len(self.possible_agents)
         for agent, action in actions.items():
             i = self._agent_index(agent)
-            try:
-                row[i] = int(np.asarray(action).item())
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"{agent}: an action is one macro-action index, got {action!r}"
-                ) from None
+            row[i] = _action_index(agent, action, self.action_space(agent).n)
         mac_done = self._env.mac_done()
         missing = [a for a, i in self._index.items() if mac_done[i] and a not in actions]
         if missing:

@@ -21,7 +21,9 @@ def load_results(root: Union[str, os.PathLike] = "results", as_dict: bool = Fals
     eval_return_undiscounted`` (NaN for runs trained before it was recorded), the method
     families' own columns, NaN where a run's family has none, ``wall_seconds``).
     Reads ``metrics.csv`` or ``metrics.csv.gz``, the same rows and values as
-    ``macdec results``. Returns a pandas DataFrame when pandas is installed (the three name
+    ``macdec results``; a metrics column named like another column (``seed``, ``episode``, a
+    second ``loss``) is refused with a ``ValueError`` naming the file. ``seed`` is int64, or
+    uint64 when a seed needs all 64 bits. Returns a pandas DataFrame when pandas is installed (the three name
     columns categorical), else (or with ``as_dict=True``) a dict of NumPy arrays.
     """
     raw = _macdec.read_results(os.fspath(root))
@@ -34,9 +36,12 @@ def load_results(root: Union[str, os.PathLike] = "results", as_dict: bool = Fals
         at = {v: i for i, v in enumerate(uniques)}
         codes = np.array([at[v] for v in values], dtype=np.int64)
         names[col] = (uniques, codes[index] if len(index) else np.zeros(0, dtype=np.int64))
-    seeds = np.array([r[3] for r in runs], dtype=np.int64)
-    seed = seeds[index] if len(index) else np.zeros(0, dtype=np.int64)
+    # int64 like the other counts, unless a seed needs all 64 bits (seed-<k> takes any u64).
+    seed_type = np.uint64 if any(r[3] > np.iinfo(np.int64).max for r in runs) else np.int64
+    seeds = np.array([r[3] for r in runs], dtype=seed_type)
+    seed = seeds[index] if len(index) else np.zeros(0, dtype=seed_type)
     columns = raw["columns"]
+    values = raw["values"]
     if not as_dict:
         try:
             import pandas as pd
@@ -48,7 +53,7 @@ def load_results(root: Union[str, os.PathLike] = "results", as_dict: bool = Fals
             out[col] = np.array(uniques, dtype=object)[codes]
         out["seed"] = seed
         for c in columns:
-            out[c] = raw[c]
+            out[c] = values[c]
         return out
     data = {
         col: pd.Categorical.from_codes(codes, categories=uniques)
@@ -56,5 +61,5 @@ def load_results(root: Union[str, os.PathLike] = "results", as_dict: bool = Fals
     }
     data["seed"] = seed
     for c in columns:
-        data[c] = raw[c]
+        data[c] = values[c]
     return pd.DataFrame(data)

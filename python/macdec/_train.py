@@ -3,24 +3,45 @@
 from __future__ import annotations
 
 import json
+import numbers
+import operator
 import os
 from pathlib import Path
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
+
+import numpy as np
 
 from . import _macdec
 
 
 def _toml_value(key: str, value: Any) -> str:
     """A ``--set`` value in TOML: strings quoted, bools lower case, lists bracketed."""
-    if isinstance(value, bool):
+    # NumPy scalars count as the Python values they stand for (np.int64 is no int, and
+    # repr(np.float64(0.5)) is "np.float64(0.5)", which is no TOML).
+    if isinstance(value, (bool, np.bool_)):
         return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
+    if isinstance(value, numbers.Integral):
+        return str(operator.index(value))
+    if isinstance(value, numbers.Real):
+        return repr(float(value))
     if isinstance(value, str):
         return json.dumps(value)
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_toml_value(key, v) for v in value) + "]"
     raise ValueError(f"override `{key}`: {type(value).__name__} is not a config value")
+
+
+def _json_scalar(value: Any) -> Any:
+    """A NumPy scalar or array in a config dict as the Python value it stands for."""
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, numbers.Integral):
+        return operator.index(value)
+    if isinstance(value, numbers.Real):
+        return float(value)
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a config value")
 
 
 def train(
@@ -51,7 +72,7 @@ def train(
     RuntimeError naming it. Returns the run directories, in the experiment's run order.
     """
     if isinstance(config, Mapping):
-        text, is_path = json.dumps(dict(config)), False
+        text, is_path = json.dumps(dict(config), default=_json_scalar), False
     else:
         text, is_path = os.fspath(config), True
         if not os.path.isfile(text):
@@ -61,7 +82,13 @@ def train(
     elif methods is not None:
         methods = [str(m) for m in methods]
     if seeds is not None and not isinstance(seeds, str):
-        seeds = str(seeds) if isinstance(seeds, int) else ",".join(str(int(s)) for s in seeds)
+        try:
+            if isinstance(seeds, numbers.Integral):
+                seeds = str(operator.index(seeds))
+            else:
+                seeds = ",".join(str(operator.index(s)) for s in seeds)
+        except TypeError:
+            raise ValueError(f"seeds must be integers, got {seeds!r}") from None
     if overrides is None:
         sets: List[str] = []
     elif isinstance(overrides, Mapping):

@@ -45,8 +45,10 @@ class VectorEnv:
 
     def step(self, actions) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, Dict[str, np.ndarray]]:
         """One primitive step of every copy: ``(obs, rewards [N] float64, terminations [N] bool,
-        truncations [N] bool, infos)``; ``infos`` holds ``mac_done`` and ``executed``
-        ``[N, n_agents]``, ``action_mask`` and ``final_obs``."""
+        truncations [N] bool, infos)``; ``infos`` holds ``mac_done`` (who chooses at the next
+        step: every agent of a copy that ended and was reset), ``final_mac_done`` (the step's own
+        flags, before any reset) and ``executed`` ``[N, n_agents]``, ``action_mask`` and
+        ``final_obs``."""
         a = np.asarray(actions)
         if a.dtype.kind not in "iu":
             raise ValueError(f"actions must be integers, got dtype {a.dtype}")

@@ -323,7 +323,10 @@ struct Outputs {
     rewards: Vec<f64>,
     terminated: Vec<bool>,
     truncated: Vec<bool>,
+    /// Who chooses at the next step: the step's flags, or every agent of a copy just reset.
     mac_done: Vec<bool>,
+    /// The step's own flags, also for a copy that ended and was reset.
+    final_mac_done: Vec<bool>,
     executed: Vec<i64>,
     mask: Vec<bool>,
 }
@@ -437,9 +440,11 @@ impl VectorEnv {
 
     /// One primitive step of every copy. `actions`: int64 [N, n_agents], a busy agent's entry
     /// ignored (pass -1). Returns `(obs, rewards [N] float64, terminations [N] bool,
-    /// truncations [N] bool, infos)` where `infos` holds `mac_done` [N, n_agents] bool,
-    /// `executed` [N, n_agents] int64, `action_mask` and `final_obs` (the observations at the
-    /// end of this step, before an ended copy was reset).
+    /// truncations [N] bool, infos)` where `infos` holds `mac_done` [N, n_agents] bool (who
+    /// chooses at the next step: all agents of a copy that ended and was reset),
+    /// `final_mac_done` (the step's own flags, before any reset), `executed` [N, n_agents]
+    /// int64, `action_mask` and `final_obs` (the observations at the end of this step, before
+    /// an ended copy was reset).
     #[allow(clippy::type_complexity)]
     fn step<'py>(
         &mut self,
@@ -476,6 +481,7 @@ impl VectorEnv {
             terminated: vec![false; n],
             truncated: vec![false; n],
             mac_done: vec![false; n * a],
+            final_mac_done: vec![false; n * a],
             executed: vec![0; n * a],
             mask: vec![false; n * a * m],
         };
@@ -485,6 +491,7 @@ impl VectorEnv {
         py.allow_threads(|| step_all(envs, rngs, scratch, &flat, (a, w, m), &mut out))?;
         let infos = PyDict::new_bound(py);
         infos.set_item("mac_done", array2(py, out.mac_done, (n, a)))?;
+        infos.set_item("final_mac_done", array2(py, out.final_mac_done, (n, a)))?;
         infos.set_item("executed", array2(py, out.executed, (n, a)))?;
         infos.set_item("action_mask", array3(py, out.mask, (n, a, m)))?;
         infos.set_item("final_obs", array3(py, out.final_obs, (n, a, w)))?;
@@ -534,7 +541,7 @@ fn step_all(
         out.terminated[k] = terminated;
         out.truncated[k] = truncated;
         for agent in 0..a {
-            out.mac_done[k * a + agent] = env.mac_done()[agent];
+            out.final_mac_done[k * a + agent] = env.mac_done()[agent];
             out.executed[k * a + agent] = env.executed()[agent] as i64;
         }
         let rows = k * a * w..(k + 1) * a * w;
@@ -544,6 +551,11 @@ fn step_all(
             write_obs(env, w, &mut out.obs[rows]);
         } else {
             out.obs[rows.clone()].copy_from_slice(&out.final_obs[rows]);
+        }
+        // After a reset every agent of the new episode chooses; a learner acting for the
+        // `mac_done` agents must not see the terminal step's flags here (`final_mac_done`).
+        for agent in 0..a {
+            out.mac_done[k * a + agent] = env.mac_done()[agent];
         }
         write_mask(env, m, &mut out.mask[k * a * m..(k + 1) * a * m]);
     }

@@ -16,6 +16,9 @@ fn to_toml(key: &str, value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::
     if value.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(value.extract()?));
     }
+    if is_numpy_bool(value) {
+        return Ok(toml::Value::Boolean(value.is_truthy()?));
+    }
     if value.is_instance_of::<PyString>() {
         return Ok(toml::Value::String(value.extract()?));
     }
@@ -51,6 +54,19 @@ fn to_toml(key: &str, value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::
         "parameter `{key}`: {} is not a parameter value (expected a bool, int, float, str, or a list or dict of them)",
         value.get_type().name()?
     )))
+}
+
+/// NumPy's bool scalar (`np.True_`): no Python bool (nor int), yet it must read as a bool, not
+/// as the float 1.0 its `__float__` gives. (NumPy's ints and floats convert through
+/// `__index__` and `__float__` as Python's do.)
+fn is_numpy_bool(value: &Bound<'_, PyAny>) -> bool {
+    let t = value.get_type();
+    let module = t
+        .getattr("__module__")
+        .and_then(|m| m.extract::<String>())
+        .unwrap_or_default();
+    let name = t.name().map(|n| n.to_string()).unwrap_or_default();
+    module == "numpy" && (name == "bool" || name == "bool_")
 }
 
 /// A dict of parameters as a TOML table; keys must be strings.

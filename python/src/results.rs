@@ -82,8 +82,9 @@ fn read_all(root: &std::path::Path) -> Result<Columns, TidyError> {
 }
 
 /// Read every run below `root`: a dict with `runs` (a list of `(experiment, method, variant,
-/// seed)`), `run_index` (each row's run, int64) and one NumPy array per metrics column
-/// (`columns` lists their names in table order; empty cells are NaN).
+/// seed)`), `run_index` (each row's run, int64), `values` (one NumPy array per metrics column,
+/// by name, so no column name can collide with these keys) and `columns` (their names in table
+/// order; empty cells are NaN).
 #[pyfunction]
 pub fn read_results<'py>(py: Python<'py>, root: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     if !root.is_dir() {
@@ -98,22 +99,24 @@ pub fn read_results<'py>(py: Python<'py>, root: PathBuf) -> PyResult<Bound<'py, 
     let out = PyDict::new_bound(py);
     out.set_item("runs", PyList::new_bound(py, c.runs))?;
     out.set_item("run_index", c.run_index.into_pyarray_bound(py))?;
+    let values = PyDict::new_bound(py);
     let mut names: Vec<String> = LEADING_COLUMNS.iter().map(|s| s.to_string()).collect();
-    out.set_item("episode", c.episode.into_pyarray_bound(py))?;
-    out.set_item("env_steps", c.env_steps.into_pyarray_bound(py))?;
-    out.set_item("updates", c.updates.into_pyarray_bound(py))?;
-    out.set_item("eval_return", c.eval_return.into_pyarray_bound(py))?;
-    out.set_item(
+    values.set_item("episode", c.episode.into_pyarray_bound(py))?;
+    values.set_item("env_steps", c.env_steps.into_pyarray_bound(py))?;
+    values.set_item("updates", c.updates.into_pyarray_bound(py))?;
+    values.set_item("eval_return", c.eval_return.into_pyarray_bound(py))?;
+    values.set_item(
         EVAL_RETURN_UNDISCOUNTED,
         c.eval_return_undiscounted.into_pyarray_bound(py),
     )?;
     names.push(EVAL_RETURN_UNDISCOUNTED.to_string());
     for (name, col) in c.family {
-        out.set_item(&name, col.into_pyarray_bound(py))?;
+        values.set_item(&name, col.into_pyarray_bound(py))?;
         names.push(name);
     }
-    out.set_item(WALL_SECONDS, c.wall_seconds.into_pyarray_bound(py))?;
+    values.set_item(WALL_SECONDS, c.wall_seconds.into_pyarray_bound(py))?;
     names.push(WALL_SECONDS.to_string());
+    out.set_item("values", values)?;
     out.set_item("columns", names)?;
     Ok(out)
 }

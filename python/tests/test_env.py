@@ -121,6 +121,13 @@ def test_bad_input_raises_errors_naming_the_problem():
         env.step({"agent_0": 8, "agent_1": 0})
     with pytest.raises(ValueError, match="agent_1 may choose now"):
         env.step({"agent_0": 0})
+    # Not truncated or parsed into another action: floats, strings, bools, arrays refused.
+    for bad in (2.7, 2.0, "3", True, np.array([1, 2]), np.float64(1.0)):
+        with pytest.raises(ValueError, match=r"agent_0: an action is one macro-action index, an integer in 0..8"):
+            env.step({"agent_0": bad, "agent_1": 0})
+    with pytest.raises(ValueError, match=r"agent_0: the macro-action must be in 0..8, got 1267650600228229401496703205376"):
+        env.step({"agent_0": 2**100, "agent_1": 0})
+    env.step({"agent_0": np.int64(1), "agent_1": np.array(0, dtype=np.uint8)})
     with pytest.raises(ValueError, match="unknown agent 'agent_7'"):
         env.step({"agent_0": 0, "agent_1": 0, "agent_7": 0})
     with pytest.raises(ValueError, match="num_envs"):
@@ -175,7 +182,7 @@ def test_vector_env_equals_n_single_envs(env_id, params):
             for i, a in enumerate(s.possible_agents):
                 size = venv.obs_sizes[i]
                 assert np.array_equal(vinfo["final_obs"][k, i, :size], o[a])
-                assert vinfo["mac_done"][k, i] == inf[a]["mac_done"]
+                assert vinfo["final_mac_done"][k, i] == inf[a]["mac_done"]
                 assert vinfo["executed"][k, i] == inf[a]["executed"]
             a0 = s.possible_agents[0]
             assert (vrew[k], vterm[k], vtrunc[k]) == (r[a0], te[a0], tr[a0])
@@ -186,6 +193,10 @@ def test_vector_env_equals_n_single_envs(env_id, params):
                 size = venv.obs_sizes[i]
                 assert np.array_equal(vobs[k, i, :size], o[a])
                 assert not vobs[k, i, size:].any()
+                # Who chooses next: after an auto-reset, every agent of the new episode.
+                assert vinfo["mac_done"][k, i] == inf[a]["mac_done"]
+                if te[a0] or tr[a0]:
+                    assert vinfo["mac_done"][k, i]
                 m = vinfo["action_mask"][k, i]
                 assert m[: venv.n_actions[i]].astype(np.int8).tolist() == inf[a]["action_mask"].tolist()
     assert ends > 0, "no episode ended: the auto-reset was not tested"

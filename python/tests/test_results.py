@@ -5,6 +5,7 @@ import gzip
 import io
 import math
 import re
+import subprocess
 import sys
 
 import numpy as np
@@ -88,6 +89,31 @@ def test_the_readmes_pandas_recipe_for_macdec_results_keeps_every_curve(tmp_path
     assert by_curve[("fig", "our1", "")] == pytest.approx((1.5 + 2.25 - 3.0) / 3)
     # Why the recipe says dropna=False: pandas reads the empty variant as NaN and drops it.
     assert len(runs.groupby(["experiment", "method", "variant"]).eval_return.mean()) == 1
+
+
+def test_hostile_column_names_and_huge_seeds(tmp_path, macdec_bin):
+    """A family column may be called `runs` or `columns`; one named like a run column is refused
+    by both readers; a seed needing all 64 bits keeps its value."""
+    run = tmp_path / "ok" / "e" / "m" / "seed-18446744073709551615"
+    run.mkdir(parents=True)
+    (run / "metrics.csv").write_text(
+        "episode,env_steps,updates,eval_return,runs,columns,wall_seconds\n0,0,0,1.5,8,9,0.1\n"
+    )
+    df = macdec.load_results(tmp_path / "ok")
+    assert df["runs"].tolist() == [8.0] and df["columns"].tolist() == [9.0]
+    assert df["seed"].tolist() == [2**64 - 1] and df["eval_return"].tolist() == [1.5]
+    for name in ["seed", "experiment", "episode", "eval_return"]:
+        bad = tmp_path / name / "e" / "m" / "seed-0"
+        bad.mkdir(parents=True)
+        (bad / "metrics.csv").write_text(
+            f"episode,env_steps,updates,eval_return,{name},wall_seconds\n0,0,0,1.5,7,0.1\n"
+        )
+        with pytest.raises(ValueError, match=f"`{name}`") as e:
+            macdec.load_results(tmp_path / name)
+        assert "metrics.csv" in str(e.value)
+        p = subprocess.run([str(macdec_bin), "results", "--results", str(tmp_path / name)],
+                           capture_output=True, text=True)
+        assert p.returncode != 0 and f"`{name}`" in p.stderr
 
 
 def test_a_missing_or_empty_tree_is_named(tmp_path):

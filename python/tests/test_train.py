@@ -50,6 +50,29 @@ def test_a_dict_config_with_methods_seeds_and_overrides(tmp_path, run_cli):
     assert len(metrics_without_time(tmp_path / "py" / rel)) == 1 + 30 // 5 + 1
 
 
+def test_numpy_scalars_work_wherever_python_numbers_do(tmp_path, run_cli):
+    """np.int64 / np.float64 / np.bool_ in overrides, seeds and a config dict give the run that
+    the same Python numbers give (numpy's own reprs are no TOML; np.bool_ is no bool)."""
+    import numpy as np
+
+    as_dict = tomllib.loads(TINY)
+    plain = macdec.train(as_dict, methods="our1", seeds=[1], out=tmp_path / "plain",
+                         overrides={"total_epi": 30, "our1.l_rate": 0.002})
+    as_dict["params"]["grid_dim"] = np.int64(8)
+    as_dict["params"]["eval_freq"] = np.int32(5)
+    scalars = macdec.train(as_dict, methods="our1", seeds=np.array([1])[0], out=tmp_path / "np",
+                           overrides={"total_epi": np.int64(30), "our1.l_rate": np.float64(0.002)})
+    rel = "tiny/our1/seed-1/metrics.csv"
+    assert [d.relative_to(tmp_path / "np").as_posix() for d in scalars] == ["tiny/our1/seed-1"]
+    assert metrics_without_time(tmp_path / "np" / rel) == metrics_without_time(plain[0] / "metrics.csv")
+    with pytest.raises(ValueError, match="seeds must be integers"):
+        macdec.train(as_dict, seeds=[0.5], out=tmp_path / "bad")
+    # A NumPy bool reads as a bool, not as the number 1.0 (a bool key refuses a number).
+    env = macdec.parallel_env("OSD-D-v7", obs_human_wait=np.True_, TB_move_noisy=np.float32(0.5))
+    assert env.params["obs_human_wait"] is True
+    assert env.params["TB_move_noisy"] == 0.5
+
+
 def test_bad_configs_are_named(tmp_path):
     with pytest.raises(ValueError, match="gird_dim"):
         macdec.train({"methods": ["our1"], "params": {"env_name": "BP_MA", "gird_dim": 8}}, out=tmp_path)

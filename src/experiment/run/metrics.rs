@@ -209,6 +209,19 @@ pub fn read(path: &Path) -> Result<MetricsTable, MetricsError> {
     let has_undiscounted = header[LEADING_COLUMNS.len()] == EVAL_RETURN_UNDISCOUNTED;
     let first_family = LEADING_COLUMNS.len() + usize::from(has_undiscounted);
     let family_columns = header[first_family..n - 1].to_vec();
+    // Readers index columns by name (`plot --metric`, `macdec results`, `load_results`): a name
+    // given twice would make one column silently replace the other.
+    for (k, name) in family_columns.iter().enumerate() {
+        let reserved = LEADING_COLUMNS.contains(&name.as_str())
+            || name == EVAL_RETURN_UNDISCOUNTED
+            || name == WALL_SECONDS;
+        if reserved || family_columns[..k].contains(name) || name.is_empty() {
+            return Err(layout(format!(
+                "the column name `{name}` is empty or appears twice in the header `{}`",
+                header.join(",")
+            )));
+        }
+    }
     let mut rows = Vec::new();
     for (i, record) in r.records().enumerate() {
         let record = record.map_err(csv_err)?;
@@ -402,5 +415,39 @@ mod tests {
         .unwrap();
         let e = read(&p).unwrap_err().to_string();
         assert!(e.contains("`episode` is not a count"), "{e}");
+    }
+
+    #[test]
+    fn a_column_name_given_twice_is_refused_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("metrics.csv");
+        for (family, name) in [
+            ("loss,loss", "loss"),
+            ("eval_return", "eval_return"),
+            ("wall_seconds", "wall_seconds"),
+            ("episode", "episode"),
+            ("eps,eval_return_undiscounted", "eval_return_undiscounted"),
+        ] {
+            let cells = vec!["1"; family.split(',').count()].join(",");
+            std::fs::write(
+                &p,
+                format!(
+                    "episode,env_steps,updates,eval_return,{family},wall_seconds\n0,0,0,1.5,{cells},0.1\n"
+                ),
+            )
+            .unwrap();
+            let e = read(&p).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("`{name}` is empty or appears twice")),
+                "{e}"
+            );
+        }
+        // The undiscounted return in its own place is no family column.
+        std::fs::write(
+            &p,
+            "episode,env_steps,updates,eval_return,eval_return_undiscounted,loss,wall_seconds\n0,0,0,1.5,2,3,0.1\n",
+        )
+        .unwrap();
+        assert_eq!(read(&p).unwrap().family_columns, ["loss"]);
     }
 }

@@ -40,6 +40,17 @@ pub enum TidyError {
     /// A metrics file could not be read.
     #[error(transparent)]
     Metrics(#[from] MetricsError),
+    /// A metrics column is named like one of the table's run columns.
+    #[error(
+        "{path}: a metrics column is named `{name}`, which the table uses for the run's own \
+         {name}; rename the column"
+    )]
+    RunColumnName {
+        /// The metrics file.
+        path: PathBuf,
+        /// The column's name.
+        name: String,
+    },
     /// The table could not be written.
     #[error("{path}: {source}")]
     Write {
@@ -192,7 +203,18 @@ pub fn read_run(run: &TidyRun) -> Result<MetricsTable, TidyError> {
     let path = metrics::locate(&run.dir).ok_or_else(|| TidyError::NoRuns {
         path: run.dir.clone(),
     })?;
-    Ok(metrics::read(&path)?)
+    let table = metrics::read(&path)?;
+    if let Some(name) = table
+        .family_columns
+        .iter()
+        .find(|c| RUN_COLUMNS.contains(&c.as_str()))
+    {
+        return Err(TidyError::RunColumnName {
+            path,
+            name: name.clone(),
+        });
+    }
+    Ok(table)
 }
 
 /// One cell, written as `metrics.csv` writes its type (floats by `ryu`, `None` empty).
@@ -318,5 +340,29 @@ mod tests {
             1,
             "no temp file left"
         );
+    }
+
+    #[test]
+    fn a_metrics_column_named_like_a_run_column_is_refused_naming_the_file() {
+        for name in RUN_COLUMNS {
+            let t = tempfile::tempdir().unwrap();
+            let dir = t.path().join("e/our1/seed-0");
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(
+                dir.join(metrics::METRICS_FILE),
+                format!(
+                    "episode,env_steps,updates,eval_return,{name},wall_seconds\n0,0,0,1,7,0.1\n"
+                ),
+            )
+            .unwrap();
+            let err = write_tidy_table(t.path(), &mut Vec::new())
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains(&format!("a metrics column is named `{name}`")),
+                "{err}"
+            );
+            assert!(err.contains("metrics.csv"), "{err}");
+        }
     }
 }
