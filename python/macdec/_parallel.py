@@ -16,12 +16,15 @@ from . import _macdec
 def _action_index(agent: str, action, n_actions: int) -> int:
     """One agent's macro-action as an int: a Python or NumPy integer (a 0-d integer array too),
     never a float, bool or string, which would be truncated or parsed into another action."""
-    a = np.asarray(action) if not isinstance(action, int) or isinstance(action, bool) else None
-    if a is not None and (a.ndim != 0 or a.dtype.kind not in "iu"):
-        raise ValueError(
-            f"{agent}: an action is one macro-action index, an integer in 0..{n_actions}, got {action!r}"
-        )
-    value = int(action) if a is None else int(a)
+    if isinstance(action, int) and not isinstance(action, bool):
+        value = action
+    else:
+        a = np.asarray(action)
+        if a.ndim != 0 or a.dtype.kind not in "iu":
+            raise ValueError(
+                f"{agent}: an action is one macro-action index, an integer in 0..{n_actions}, got {action!r}"
+            )
+        value = int(a)
     # Out-of-range values of a free agent are refused in Rust; ones no int64 holds, here.
     if not -(2**63) <= value < 2**63:
         raise ValueError(f"{agent}: the macro-action must be in 0..{n_actions}, got {value}")
