@@ -1,0 +1,333 @@
+//! MacroMARL's value-based team as the training loop drives it (`algs/value_based/mac_dec_q.py:
+//! learn`, `mac_cen_q.py: learn`; `docs/MACROMARL.md` §8.2): every main-loop step (counted from 1)
+//! steps each of the `n_env` lanes once; when the step is a multiple of `train_freq` and
+//! `start_train` episodes are done, the hysteresis is set from the episodes since `start_train`,
+//! `n_env` updates run, and then epsilon is set from the same count; targets are copied every
+//! `target_update_freq` steps. One greedy episode is evaluated before training and whenever the
+//! episode count reaches a multiple of `eval_freq`.
+
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::acting::{act_cen, act_dec, Explore};
+use super::config::MacValueConfig;
+use super::episode::Recorder;
+use super::memory::Memory;
+use super::method::{MacValueMethod, QNets};
+use super::update::{update_cen, update_dec, Dims, QNet};
+use crate::algos::learner::{
+    EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+};
+use crate::algos::train_error::TrainError;
+use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use crate::nn::{GruActorConfig, GruActorState, Params};
+
+/// The family's `metrics.csv` columns.
+pub const METRIC_COLUMNS: [&str; 3] = ["epsilon", "hysteresis", "loss"];
+
+/// One training lane: the runner's accumulators and the nets' recurrent states.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Lane {
+    recorder: Recorder,
+    states: Vec<GruActorState>,
+}
+
+/// A MacDec-Q or MacCen-Q run's learner.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MacValueLearner {
+    method: MacValueMethod,
+    seed: u64,
+    config: MacValueConfig,
+    dims: Dims,
+    /// One per agent (MacDec-Q) or the team's one (MacCen-Q).
+    nets: Vec<QNet>,
+    memory: Memory,
+    explore: ChaCha8Rng,
+    replay: ChaCha8Rng,
+    epsilon: f64,
+    hysteresis: f64,
+    loss_sum: f64,
+    loss_count: u64,
+    episodes: u64,
+}
+
+impl MacValueLearner {
+    /// The Q-nets (one per agent, or the team's one).
+    pub fn nets(&self) -> &[QNet] {
+        &self.nets
+    }
+
+    /// The replay memory.
+    pub fn memory(&self) -> &Memory {
+        &self.memory
+    }
+
+    fn zero_states(&self) -> Vec<GruActorState> {
+        self.nets.iter().map(|q| q.net.zero_state()).collect()
+    }
+
+    /// Pick the free agents' macro-actions from `states`, exploring with `explore`.
+    fn choose<E: MacroEnv>(
+        &self,
+        states: &mut [GruActorState],
+        env: &E,
+        explore: Option<Explore<'_>>,
+        actions: &mut [usize],
+    ) {
+        match self.method.nets() {
+            QNets::Decentralized => act_dec(&self.nets, states, env, &self.dims, explore, actions),
+            QNets::Centralized => act_cen(
+                &self.nets[0],
+                &mut states[0],
+                env,
+                &self.dims,
+                explore,
+                actions,
+            ),
+        }
+    }
+}
+
+impl Learner for MacValueLearner {
+    type Lane = Lane;
+    type Method = MacValueMethod;
+    type Config = MacValueConfig;
+
+    fn new<E: MacroEnv>(
+        config: &MacValueConfig,
+        method: MacValueMethod,
+        seed: u64,
+        env: &E,
+        mut rngs: LearnerRngs,
+    ) -> Result<Self, TrainError> {
+        let dims = Dims {
+            obs_sizes: env.obs_sizes().to_vec(),
+            n_actions: env.n_actions().to_vec(),
+        };
+        let mlp = [config.mlp_layer_size[0], config.mlp_layer_size[1]];
+        let layers = |input, output| GruActorConfig {
+            input,
+            mlp,
+            hidden: config.rnn_h_size,
+            output,
+        };
+        let shapes = match method.nets() {
+            QNets::Decentralized => (0..env.n_agents())
+                .map(|i| layers(dims.obs_sizes[i], dims.n_actions[i]))
+                .collect(),
+            QNets::Centralized => vec![layers(dims.obs_sizes.iter().sum(), dims.n_joint())],
+        };
+        let nets = shapes
+            .into_iter()
+            .map(|cfg: GruActorConfig| QNet::new(cfg, config.l_rate, &mut rngs.init))
+            .collect();
+        Ok(MacValueLearner {
+            method,
+            seed,
+            config: config.clone(),
+            dims,
+            nets,
+            memory: Memory::new(
+                config.sample_epi,
+                config.trace_len,
+                config.replay_buffer_size,
+            ),
+            explore: rngs.explore,
+            replay: rngs.replay,
+            // `EPS_START`, and the hysteresis's initial value (`Team.__init__`).
+            epsilon: 1.0,
+            hysteresis: config.init_h,
+            loss_sum: 0.0,
+            loss_count: 0,
+            episodes: 0,
+        })
+    }
+
+    fn method(&self) -> MacValueMethod {
+        self.method
+    }
+
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    fn config(&self) -> &MacValueConfig {
+        &self.config
+    }
+
+    fn schedule(&self) -> Schedule {
+        Schedule::EveryStep {
+            train_freq: self.config.train_freq as u64,
+            start_train: self.config.start_train as u64,
+            target_update_freq: self.config.target_update_freq as u64,
+            eval_freq: self.config.eval_freq as u64,
+            first_step: 1,
+        }
+    }
+
+    fn lanes(&self) -> Vec<LanePlan> {
+        vec![
+            LanePlan {
+                counts_episodes: true
+            };
+            self.config.n_env
+        ]
+    }
+
+    fn begin_lane<E: MacroEnv>(&self, _lane: usize, env: &E) -> Result<Lane, TrainError> {
+        Ok(Lane {
+            recorder: Recorder::new(env, self.config.discount),
+            states: self.zero_states(),
+        })
+    }
+
+    fn act<E: MacroEnv>(&mut self, lane: &mut Lane, env: &E, actions: &mut [usize]) {
+        if !self.config.h_explore {
+            // The reference's runner keeps the reset state (None) for every decision.
+            lane.states.iter_mut().for_each(GruActorState::reset);
+        }
+        let mut rng = std::mem::replace(&mut self.explore, rand::SeedableRng::seed_from_u64(0));
+        let explore = Explore {
+            epsilon: self.epsilon,
+            rng: &mut rng,
+        };
+        self.choose(&mut lane.states, env, Some(explore), actions);
+        self.explore = rng;
+    }
+
+    fn record<E: MacroEnv>(
+        &mut self,
+        lane: &mut Lane,
+        env: &E,
+        outcome: StepOutcome,
+    ) -> Result<bool, TrainError> {
+        match lane.recorder.record(env, outcome) {
+            Some(episode) => {
+                self.memory.push(episode);
+                self.episodes += 1;
+                Ok(true)
+            }
+            None => Ok(false),
+        }
+    }
+
+    fn begin_episode<E: MacroEnv>(&self, lane: &mut Lane, env: &E) -> Result<(), TrainError> {
+        lane.recorder = Recorder::new(env, self.config.discount);
+        lane.states.iter_mut().for_each(GruActorState::reset);
+        Ok(())
+    }
+
+    fn train_iteration(&mut self, _lanes: &[&Lane], episodes: u64) -> Result<(), TrainError> {
+        let c = &self.config;
+        let since = episodes.saturating_sub(c.start_train as u64);
+        self.hysteresis = c.hysteresis_at(since, self.epsilon);
+        for _ in 0..c.n_env {
+            let batch = self
+                .memory
+                .sample(c.batch_size, &mut self.replay)
+                .map_err(|e| TrainError::Family(Box::new(e)))?;
+            let losses: Vec<f32> = match self.method.nets() {
+                QNets::Decentralized => update_dec(
+                    &mut self.nets,
+                    &batch,
+                    &self.dims,
+                    self.hysteresis,
+                    c.discount,
+                    c.sub_trace_len,
+                )
+                .map(|t| t.iter().map(|t| t.loss).collect())
+                .unwrap_or_default(),
+                QNets::Centralized => update_cen(
+                    &mut self.nets[0],
+                    &batch,
+                    &self.dims,
+                    self.hysteresis,
+                    c.discount,
+                    c.sub_trace_len,
+                )
+                .map(|t| vec![t.loss])
+                .unwrap_or_default(),
+            };
+            for loss in losses {
+                if !loss.is_finite() {
+                    return Err(TrainError::NonFinite {
+                        method: self.method.name(),
+                        seed: self.seed,
+                        what: "loss",
+                        episode: episodes,
+                    });
+                }
+                self.loss_sum += f64::from(loss);
+                self.loss_count += 1;
+            }
+        }
+        self.epsilon = c.epsilon_at(since);
+        Ok(())
+    }
+
+    fn sync_targets(&mut self) {
+        for q in &mut self.nets {
+            q.target.copy_values_from(&q.net);
+        }
+    }
+
+    /// One greedy episode (`evaluate(n_episode=1)`), the nets' states carried through it; the
+    /// return is the sum of discount^t x the agents' mean reward.
+    fn evaluate<E: MacroEnv>(
+        &self,
+        env: &mut E,
+        rng: &mut EnvRng,
+    ) -> Result<EvalReturns, EnvError> {
+        env.reset(rng);
+        let mut states = self.zero_states();
+        let mut actions = vec![0; env.n_agents()];
+        let (mut discounted, mut undiscounted, mut scale) = (0.0, 0.0, 1.0);
+        loop {
+            self.choose(&mut states, env, None, &mut actions);
+            let outcome = env.step(&actions, rng)?;
+            discounted += scale * outcome.reward;
+            undiscounted += outcome.reward;
+            scale *= self.config.discount;
+            if outcome.done {
+                return Ok(EvalReturns {
+                    discounted,
+                    undiscounted,
+                });
+            }
+        }
+    }
+
+    fn metric_columns(&self) -> &'static [&'static str] {
+        &METRIC_COLUMNS
+    }
+
+    fn metric_values(&mut self) -> Vec<Option<f64>> {
+        let loss = (self.loss_count > 0).then(|| self.loss_sum / self.loss_count as f64);
+        self.loss_sum = 0.0;
+        self.loss_count = 0;
+        vec![Some(self.epsilon), Some(self.hysteresis), loss]
+    }
+
+    fn progress(&self) -> String {
+        format!("eps {:.3} h {:.3}", self.epsilon, self.hysteresis)
+    }
+
+    fn saved_nets(&self) -> SavedNets<'_> {
+        use crate::nn::ActingNetRef;
+        use crate::policy_files::SavedNet;
+        // The policy files' net kinds are Q-nets (the ICRA LSTM) and actors (MacroMARL's GRU
+        // layers); these Q-nets have the actor's layers, so they are saved as that kind: the
+        // greedy macro-action (argmax of the scores) is the same, log_softmax being monotonic.
+        self.nets
+            .iter()
+            .enumerate()
+            .map(|(i, q)| {
+                let net = ActingNetRef::Actor(&q.net);
+                match self.method.nets() {
+                    QNets::Decentralized => SavedNet::agent(i, net, true),
+                    QNets::Centralized => SavedNet::team(net, true),
+                }
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,52 @@
+//! MacroMARL's value-based methods as a small value naming what differs between them: whose
+//! Q-nets learn and act (`docs/MACROMARL.md` §8).
+
+use crate::algos::learner::MethodName;
+use serde::{Deserialize, Serialize};
+
+/// One of MacroMARL's value-based methods, by its command-line name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MacValueMethod {
+    /// MacDec-Q: a hysteretic double DRQN per agent on its own squeezed experience (`MacDecQ`).
+    MacDecQ,
+    /// MacCen-Q: one DRQN on the joint observation over joint macro-actions, squeezed where any
+    /// agent finished, with the conditional argmax (`MacCenQ`).
+    MacCenQ,
+}
+
+impl MethodName for MacValueMethod {
+    fn name(self) -> &'static str {
+        match self {
+            MacValueMethod::MacDecQ => "mac-dec-q",
+            MacValueMethod::MacCenQ => "mac-cen-q",
+        }
+    }
+}
+
+/// Who learns and acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QNets {
+    /// One Q-net per agent on its own observation history.
+    Decentralized,
+    /// One Q-net on the joint observation history over joint macro-actions.
+    Centralized,
+}
+
+impl MacValueMethod {
+    /// The method's nets: the one place the methods differ.
+    pub fn nets(self) -> QNets {
+        match self {
+            MacValueMethod::MacDecQ => QNets::Decentralized,
+            MacValueMethod::MacCenQ => QNets::Centralized,
+        }
+    }
+
+    /// The reference's `--alg`, which keys its published settings.
+    pub fn reference_alg(self) -> &'static str {
+        match self {
+            MacValueMethod::MacDecQ => "MacDecQ",
+            MacValueMethod::MacCenQ => "MacCenQ",
+        }
+    }
+}
