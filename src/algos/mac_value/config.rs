@@ -268,15 +268,15 @@ pub fn check(
         .chain([c.rnn_h_size])
         .max()
         .unwrap_or(1) as u128;
-    // One update unrolls batch_size sequences of at most the horizon (a window is shorter),
-    // twice (the history and its continuation) through the net and its target.
+    // One update's taped pass unrolls batch_size sequences of at most the horizon (a window is
+    // shorter); the continuation (one longer) runs untaped through the net and its target.
     let seq = if c.sample_epi {
         shape.horizon
     } else {
         c.trace_len.min(shape.horizon)
     };
     check_batch_activations(
-        ("batch_size", c.batch_size.saturating_mul(3)),
+        ("batch_size", c.batch_size),
         ("env_terminate_step", seq + 1),
         NetWidths {
             hidden: widest,
