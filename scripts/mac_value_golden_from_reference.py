@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """Golden fixtures of MacroMARL's value-based methods from the reference's own code.
 
-Runs, for MacDecQ and MacCenQ, the reference's runner worker (`envs_runner.py: worker`,
+Runs, for MacDecQ, MacCenQ and MacDecDDRQN, the reference's runner worker (`envs_runner.py: worker`,
 `envs_runner_cen_condi.py: worker`) over a scripted environment with random observations,
 rewards, availability masks and macro-action ends (one episode ending in a terminal state, the
 others cut by the horizon); pushes the recorded episodes into the reference's memory
 (`ReplayMemory_rand` windows with FIFO eviction, or `ReplayMemory_epi`); samples batches with
 `np.random.choice(..., replace=False)` as its `sample` does; separates them with the team's own
-`sep_joint_exps`; and runs the reference learner (`QLearn_squ`, `QLearn_squ_cen_condi_0`) on
+`sep_joint_exps` (MacDecDDRQN: `cen_sep_joint_exps`, `dec_sep_joint_exps`); and runs the reference
+learner (`QLearn_squ`, `QLearn_squ_cen_condi_0`, `QLearn_squ_dec_cen_0`) on
 its `DDRQN` nets and Adam three times, with a hard target copy before the third. Everything is
 written to tests/golden_mac_value/<case>.json: the scripted environment, every record the
 runner produced, the sampled indices, the hysteresis of each update, the initial weights and
@@ -44,6 +45,15 @@ from macro_marl.cores.value_based.mac_cen_q.model_cen_condi import DDRQN as CenD
 from macro_marl.cores.value_based.mac_cen_q.team_cen_condi import Team_RNN as CenTeam  # noqa: E402
 from macro_marl.cores.value_based.mac_cen_q.utils.Cen_ctrl import Cen_Controller  # noqa: E402
 from macro_marl.cores.value_based.mac_cen_q.utils import memory_cen_condi as cen_memory  # noqa: E402
+from macro_marl.cores.value_based.mac_dec_ddrqn import envs_runner as ddrqn_runner  # noqa: E402
+from macro_marl.cores.value_based.mac_dec_ddrqn.learning_methods import (  # noqa: E402
+    QLearn_squ_dec_cen_0,
+)
+from macro_marl.cores.value_based.mac_dec_ddrqn.model import DDRQN as DdrqnDec, Cen_DDRQN  # noqa: E402
+from macro_marl.cores.value_based.mac_dec_ddrqn.team import Team_RNN as DdrqnTeam  # noqa: E402
+from macro_marl.cores.value_based.mac_dec_ddrqn.utils.Agent import Agent as DdrqnAgent  # noqa: E402
+from macro_marl.cores.value_based.mac_dec_ddrqn.utils.Cen_ctrl import Cen_Controller as DdrqnCen  # noqa: E402
+from macro_marl.cores.value_based.mac_dec_ddrqn.utils import memory as ddrqn_memory  # noqa: E402
 
 OBS_SIZES = [3, 2]
 N_ACTIONS = [3, 2]
@@ -133,8 +143,9 @@ def run_worker(worker, episode, horizon):
         parent.send(("step", [0] * len(N_ACTIONS)))
         exp = parent.recv()
         sent.append((last_avail, exp))
-        last_avail = exp[-4] if worker is cen_runner.worker else exp[5]
-        if exp[7 if worker is cen_runner.worker else 6] or t + 1 == horizon:
+        avail_at, terminate_at = {cen_runner.worker: (6, 7), ddrqn_runner.worker: (7, 8)}.get(worker, (5, 6))
+        last_avail = exp[avail_at]
+        if exp[terminate_at] or t + 1 == horizon:
             break
     parent.send(("close", None))
     th.join()
@@ -183,6 +194,40 @@ def cen_records(sent):
     return out
 
 
+def ddrqn_records(sent):
+    """The MacDecDDRQN runner's `exp_to_tensor` layout: (last_obs, last_avail, a, id_r, joint_r,
+    id_gamma, joint_gamma, obs, avail, t, id_v, joint_v)."""
+    out = []
+    for last_avail, e in sent:
+        out.append(
+            (
+                [torch.from_numpy(o).float() for o in e[0]],
+                [torch.FloatTensor(a).view(1, -1) for a in last_avail],
+                [torch.tensor(a).view(1, -1) for a in e[1]],
+                [torch.tensor(r).float().view(1, -1) for r in e[2]],
+                torch.tensor(e[3]).float().view(1, -1),
+                [torch.tensor(g).float().view(1, -1) for g in e[4]],
+                torch.tensor(e[5]).float().view(1, -1),
+                [torch.from_numpy(o).float() for o in e[6]],
+                [torch.FloatTensor(a).view(1, -1) for a in e[7]],
+                torch.tensor(e[8]).float().view(1, -1),
+                [torch.tensor(v, dtype=torch.bool).view(1, -1) for v in e[9]],
+                torch.tensor(e[10], dtype=torch.bool).view(1, -1),
+            )
+        )
+    return out
+
+
+def check_ddrqn_record(rec, d, c):
+    """MacDecDDRQN's runner keeps both runners' accumulators: its per-agent ones must be MacDec-Q's
+    and its joint ones MacCen-Q's (so one recorder serves all three)."""
+    for a, b in zip(rec[3], d[3]):
+        assert abs(a.item() - b.item()) < 1e-6
+    for a, b in zip(rec[5], d[4]):
+        assert abs(a.item() - b.item()) < 1e-6
+    assert abs(rec[4].item() - c[4].item()) < 1e-6 and abs(rec[6].item() - c[5].item()) < 1e-6
+
+
 def record_json(dec, cen):
     """One record as the Rust `Step` holds it, from both runners' outputs of the same step."""
     return {
@@ -213,13 +258,17 @@ def make_case(alg, sample_epi, seed):
     rng = np.random.default_rng(seed)
     horizon = 9
     scripted = [script_episode(rng, int(rng.integers(4, 10)), k == 1) for k in range(6)]
-    episodes_dec, episodes_cen, records = [], [], []
+    episodes_dec, episodes_cen, episodes_ddrqn, records = [], [], [], []
     for ep in scripted:
         d = dec_records(run_worker(dec_runner.worker, ep, horizon))
         c = cen_records(run_worker(cen_runner.worker, ep, horizon))
-        assert len(d) == len(c)
+        dd = ddrqn_records(run_worker(ddrqn_runner.worker, ep, horizon))
+        assert len(d) == len(c) == len(dd)
+        for a, b, e in zip(dd, d, c):
+            check_ddrqn_record(a, b, e)
         episodes_dec.append(d)
         episodes_cen.append(c)
+        episodes_ddrqn.append(dd)
         records.append([record_json(a, b) for a, b in zip(d, c)])
 
     trace_len, capacity, batch_size = 4, 30, 5
@@ -248,6 +297,33 @@ def make_case(alg, sample_epi, seed):
         nets = lambda: [weights(a.policy_net) for a in agents]  # noqa: E731
         team = SimpleNamespace(n_agent=2)
         sep = lambda b: DecTeam.sep_joint_exps(team, b)  # noqa: E731
+    elif alg == "MacDecDDRQN":
+        mem = (ddrqn_memory.ReplayMemory_epi(2, OBS_SIZES, N_ACTIONS, batch_size, size=capacity)
+               if sample_epi else
+               ddrqn_memory.ReplayMemory_rand(2, OBS_SIZES, N_ACTIONS, trace_len, batch_size, size=capacity))
+        for ep in episodes_ddrqn:
+            mem.scenario_cache += ep
+            mem.flush_scenario_cache()
+        sizes = dict(dec_mlp_layer_size=mlp, dec_rnn_h_size=rnn_h, cen_mlp_layer_size=[7, 6],
+                     cen_rnn_h_size=5)
+        agents = []
+        for i in range(2):
+            a = DdrqnAgent()
+            a.idx = i
+            a.policy_net = DdrqnDec(OBS_SIZES[i], N_ACTIONS[i], **sizes)
+            a.target_net = DdrqnDec(OBS_SIZES[i], N_ACTIONS[i], **sizes)
+            a.target_net.load_state_dict(a.policy_net.state_dict())
+            a.optimizer = torch.optim.Adam(a.policy_net.parameters(), lr=lr)
+            agents.append(a)
+        ctrl = DdrqnCen()
+        n_joint = int(np.prod(N_ACTIONS))
+        ctrl.policy_net = Cen_DDRQN(sum(OBS_SIZES), n_joint, **sizes)
+        ctrl.target_net = Cen_DDRQN(sum(OBS_SIZES), n_joint, **sizes)
+        ctrl.target_net.load_state_dict(ctrl.policy_net.state_dict())
+        ctrl.optimizer = torch.optim.Adam(ctrl.policy_net.parameters(), lr=lr)
+        nets = lambda: [weights(a.policy_net) for a in agents] + [weights(ctrl.policy_net)]  # noqa: E731
+        team = SimpleNamespace(n_agent=2, env=SimpleNamespace(n_action=N_ACTIONS))
+        sep = lambda b: (DdrqnTeam.cen_sep_joint_exps(team, b), DdrqnTeam.dec_sep_joint_exps(team, b))  # noqa: E731
     else:
         mem = (cen_memory.ReplayMemory_epi(2, OBS_SIZES, N_ACTIONS, batch_size, size=capacity)
                if sample_epi else
@@ -269,10 +345,10 @@ def make_case(alg, sample_epi, seed):
     for k, h in enumerate(hysteresis):
         sync = k == 2
         if sync:
-            if alg == "MacDecQ":
+            if alg != "MacCenQ":
                 for a in agents:
                     a.target_net.load_state_dict(a.policy_net.state_dict())
-            else:
+            if alg != "MacDecQ":
                 ctrl.target_net.load_state_dict(ctrl.policy_net.state_dict())
         # The memory's own `sample`, with its indices kept.
         indices = np.random.choice(len(mem.buf), batch_size, replace=False)
@@ -285,6 +361,8 @@ def make_case(alg, sample_epi, seed):
         params = dict(trace_len=length, sub_trace_len=1, batch_size=batch_size)
         if alg == "MacDecQ":
             QLearn_squ(agents, batch, h, DISCOUNT, **params)
+        elif alg == "MacDecDDRQN":
+            QLearn_squ_dec_cen_0(SimpleNamespace(n_action=N_ACTIONS), agents, ctrl, batch, h, DISCOUNT, **params)
         else:
             QLearn_squ_cen_condi_0(SimpleNamespace(n_action=N_ACTIONS), ctrl, batch, h, DISCOUNT, **params)
         updates.append({"indices": [int(i) for i in indices], "hysteresis": h,
@@ -301,6 +379,8 @@ def make_case(alg, sample_epi, seed):
                    "batch_size": batch_size, "held": len(mem.buf)},
         "mlp_layer_size": mlp,
         "rnn_h_size": rnn_h,
+        "cen_mlp_layer_size": [7, 6],
+        "cen_rnn_h_size": 5,
         "l_rate": lr,
         "init_weights": init,
         "updates": updates,
@@ -311,7 +391,9 @@ def main():
     torch.set_num_threads(1)
     os.makedirs(OUT, exist_ok=True)
     cases = [("mac_dec_q_windows", "MacDecQ", False, 1), ("mac_dec_q_episodes", "MacDecQ", True, 2),
-             ("mac_cen_q_windows", "MacCenQ", False, 3), ("mac_cen_q_episodes", "MacCenQ", True, 4)]
+             ("mac_cen_q_windows", "MacCenQ", False, 3), ("mac_cen_q_episodes", "MacCenQ", True, 4),
+             ("mac_dec_ddrqn_windows", "MacDecDDRQN", False, 5),
+             ("mac_dec_ddrqn_episodes", "MacDecDDRQN", True, 6)]
     for name, alg, epi, seed in cases:
         case = make_case(alg, epi, seed)
         with open(os.path.join(OUT, name + ".json"), "w") as f:

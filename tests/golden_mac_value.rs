@@ -1,4 +1,4 @@
-//! Differential tests of MacroMARL's value-based methods (MacDec-Q, MacCen-Q) against the
+//! Differential tests of MacroMARL's value-based methods (MacDec-Q, MacCen-Q, MacDec-DDRQN) against the
 //! reference's own code (`docs/MACROMARL.md` §8).
 //!
 //! Each `tests/golden_mac_value/<case>.json` was written by
@@ -6,7 +6,8 @@
 //! (`envs_runner.py: worker`, `envs_runner_cen_condi.py: worker`) replaying scripted episodes with
 //! random rewards, macro-action ends and availability masks; its memory (`ReplayMemory_rand`
 //! windows with FIFO eviction, or `ReplayMemory_epi`) and the indices its `sample` drew; the
-//! team's `sep_joint_exps`; and its learner (`QLearn_squ`, `QLearn_squ_cen_condi_0`) on its
+//! team's `sep_joint_exps`; and its learner (`QLearn_squ`, `QLearn_squ_cen_condi_0`,
+//! `QLearn_squ_dec_cen_0`: the centralized net then the agents' nets) on its
 //! `DDRQN` nets and Adam, three updates with hysteresis 0.3, 0.55 and 1 and a hard target copy
 //! before the third.
 //!
@@ -20,7 +21,7 @@ use std::path::Path;
 
 use macdec::algos::mac_value::episode::{Episode, Recorder, Step, StepParts};
 use macdec::algos::mac_value::memory::Memory;
-use macdec::algos::mac_value::update::{update_cen, update_dec, Dims, QNet};
+use macdec::algos::mac_value::update::{update_cen, update_dec, update_dec_cen, Dims, QNet};
 use macdec::envs::StepOutcome;
 use macdec::nn::{GruActor, GruActorConfig, Params};
 use serde_json::Value;
@@ -206,14 +207,24 @@ fn run_case(name: &str) {
         hidden: case["rnn_h_size"].as_u64().unwrap() as usize,
         output,
     };
-    let centralized = case["alg"] == "MacCenQ";
-    let shapes: Vec<GruActorConfig> = if centralized {
-        vec![layers(dims.obs_sizes.iter().sum(), dims.n_joint())]
+    let alg = case["alg"].as_str().unwrap();
+    let joint_input: usize = dims.obs_sizes.iter().sum();
+    let mut shapes: Vec<GruActorConfig> = if alg == "MacCenQ" {
+        vec![layers(joint_input, dims.n_joint())]
     } else {
         (0..2)
             .map(|i| layers(dims.obs_sizes[i], dims.n_actions[i]))
             .collect()
     };
+    if alg == "MacDecDDRQN" {
+        let cen_mlp = counts(&case["cen_mlp_layer_size"]);
+        shapes.push(GruActorConfig {
+            input: joint_input,
+            mlp: [cen_mlp[0], cen_mlp[1]],
+            hidden: case["cen_rnn_h_size"].as_u64().unwrap() as usize,
+            output: dims.n_joint(),
+        });
+    }
     let lr = case["l_rate"].as_f64().unwrap();
     let mut nets: Vec<QNet> = shapes
         .iter()
@@ -232,10 +243,14 @@ fn run_case(name: &str) {
             .map(|i| memory.entry(i))
             .collect();
         let h = u["hysteresis"].as_f64().unwrap();
-        let updated = if centralized {
-            update_cen(&mut nets[0], &batch, &dims, h, discount, 1).is_some()
-        } else {
-            update_dec(&mut nets, &batch, &dims, h, discount, 1).is_some()
+        let updated = match alg {
+            "MacCenQ" => update_cen(&mut nets[0], &batch, &dims, h, discount, 1).is_some(),
+            "MacDecQ" => update_dec(&mut nets, &batch, &dims, h, discount, 1).is_some(),
+            _ => {
+                let (decs, cen) = nets.split_at_mut(2);
+                update_dec_cen(&mut cen[0], decs, &batch, &dims, h, discount, 1)
+                    .is_some_and(|(_, decs)| decs.len() == 2)
+            }
         };
         assert!(updated, "{name}: update {k} kept records");
         for (i, (q, want)) in nets
@@ -266,4 +281,14 @@ fn mac_cen_q_on_windows_matches_the_reference() {
 #[test]
 fn mac_cen_q_on_whole_episodes_matches_the_reference() {
     run_case("mac_cen_q_episodes");
+}
+
+#[test]
+fn mac_dec_ddrqn_on_windows_matches_the_reference() {
+    run_case("mac_dec_ddrqn_windows");
+}
+
+#[test]
+fn mac_dec_ddrqn_on_whole_episodes_matches_the_reference() {
+    run_case("mac_dec_ddrqn_episodes");
 }

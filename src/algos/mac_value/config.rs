@@ -64,6 +64,14 @@ pub struct MacValueConfig {
     pub mlp_layer_size: Vec<usize>,
     /// The GRU's width.
     pub rnn_h_size: usize,
+    /// MacDec-DDRQN: [m0, m1] of the decentralized nets (`mlp_layer_size` is not read).
+    pub dec_mlp_layer_size: Vec<usize>,
+    /// MacDec-DDRQN: [m0, m1] of the centralized net.
+    pub cen_mlp_layer_size: Vec<usize>,
+    /// MacDec-DDRQN: the decentralized nets' GRU width.
+    pub dec_rnn_h_size: usize,
+    /// MacDec-DDRQN: the centralized net's GRU width.
+    pub cen_rnn_h_size: usize,
     /// Evaluate one greedy episode before training and every `eval_freq` training episodes.
     pub eval_freq: usize,
     /// Training episodes between checkpoints (ours).
@@ -71,7 +79,7 @@ pub struct MacValueConfig {
 }
 
 /// The keys whose value is a list by nature.
-pub const LIST_KEYS: [&str; 1] = ["mlp_layer_size"];
+pub const LIST_KEYS: [&str; 3] = ["mlp_layer_size", "dec_mlp_layer_size", "cen_mlp_layer_size"];
 
 /// Replay capacity, in windows or episodes (published: at most 100 000 windows).
 pub const MAX_REPLAY: usize = 10_000_000;
@@ -108,6 +116,10 @@ impl MacValueConfig {
             batch_size: 16,
             mlp_layer_size: vec![32, 32],
             rnn_h_size: 32,
+            dec_mlp_layer_size: vec![32, 32],
+            cen_mlp_layer_size: vec![32, 32],
+            dec_rnn_h_size: 32,
+            cen_rnn_h_size: 64,
             eval_freq: 100,
             checkpoint_freq: 2000,
         }
@@ -210,19 +222,28 @@ pub fn check(
         ("rnn_h_size", c.rnn_h_size, MAX_NET_WIDTH),
         ("batch_size", c.batch_size, c.replay_buffer_size),
     ])?;
-    if c.mlp_layer_size.len() != 2
-        || c.mlp_layer_size
-            .iter()
-            .any(|&s| s == 0 || s > MAX_NET_WIDTH)
-    {
-        return Err((
-            "mlp_layer_size",
-            format!(
-                "must be two widths [before, after] the GRU, each 1..={MAX_NET_WIDTH}, got {:?}",
-                c.mlp_layer_size
-            ),
-        ));
+    for (key, sizes) in [
+        ("mlp_layer_size", &c.mlp_layer_size),
+        ("dec_mlp_layer_size", &c.dec_mlp_layer_size),
+        ("cen_mlp_layer_size", &c.cen_mlp_layer_size),
+    ] {
+        if sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH) {
+            return Err((
+                key,
+                format!(
+                    "must be two widths [before, after] the GRU, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
+                ),
+            ));
+        }
     }
+    check_positive(&[
+        ("dec_rnn_h_size", c.dec_rnn_h_size),
+        ("cen_rnn_h_size", c.cen_rnn_h_size),
+    ])?;
+    check_at_most(&[
+        ("dec_rnn_h_size", c.dec_rnn_h_size, MAX_NET_WIDTH),
+        ("cen_rnn_h_size", c.cen_rnn_h_size, MAX_NET_WIDTH),
+    ])?;
     if c.start_train >= c.total_epi {
         return Err((
             "start_train",
@@ -253,7 +274,7 @@ pub fn check(
     }
     let (input, output) = match method.nets() {
         QNets::Decentralized => (shape.widest_obs(), shape.widest_actions()),
-        QNets::Centralized => (shape.joint_obs_size(), shape.n_joint_actions()),
+        QNets::Centralized | QNets::DecWithCen => (shape.joint_obs_size(), shape.n_joint_actions()),
     };
     if output > MAX_JOINT_ACTIONS {
         return Err((
@@ -264,8 +285,10 @@ pub fn check(
     let widest = c
         .mlp_layer_size
         .iter()
+        .chain(&c.dec_mlp_layer_size)
+        .chain(&c.cen_mlp_layer_size)
         .copied()
-        .chain([c.rnn_h_size])
+        .chain([c.rnn_h_size, c.dec_rnn_h_size, c.cen_rnn_h_size])
         .max()
         .unwrap_or(1) as u128;
     // One update's taped pass unrolls batch_size sequences of at most the horizon (a window is

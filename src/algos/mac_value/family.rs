@@ -17,12 +17,17 @@ impl FamilyMethod for MacValueMethod {
         list_keys: &config::LIST_KEYS,
         evaluated_return: "the greedy discounted return",
     };
-    const ALL: &'static [MacValueMethod] = &[MacValueMethod::MacDecQ, MacValueMethod::MacCenQ];
+    const ALL: &'static [MacValueMethod] = &[
+        MacValueMethod::MacDecQ,
+        MacValueMethod::MacCenQ,
+        MacValueMethod::MacDecDdrqn,
+    ];
 
     fn legend(self) -> &'static str {
         match self {
             MacValueMethod::MacDecQ => "MacDec-Q",
             MacValueMethod::MacCenQ => "MacCen-Q",
+            MacValueMethod::MacDecDdrqn => "MacDec-DDRQN",
         }
     }
 

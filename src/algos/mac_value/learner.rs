@@ -14,7 +14,7 @@ use super::config::MacValueConfig;
 use super::episode::Recorder;
 use super::memory::Memory;
 use super::method::{MacValueMethod, QNets};
-use super::update::{update_cen, update_dec, Dims, QNet};
+use super::update::{update_cen, update_dec, update_dec_cen, Dims, QNet};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
@@ -76,6 +76,18 @@ impl MacValueLearner {
     ) {
         match self.method.nets() {
             QNets::Decentralized => act_dec(&self.nets, states, env, &self.dims, explore, actions),
+            // The decentralized nets act (the reference's default, without `cen_explore`).
+            QNets::DecWithCen => {
+                let n = self.nets.len() - 1;
+                act_dec(
+                    &self.nets[..n],
+                    &mut states[..n],
+                    env,
+                    &self.dims,
+                    explore,
+                    actions,
+                )
+            }
             QNets::Centralized => act_cen(
                 &self.nets[0],
                 &mut states[0],
@@ -104,18 +116,34 @@ impl Learner for MacValueLearner {
             obs_sizes: env.obs_sizes().to_vec(),
             n_actions: env.n_actions().to_vec(),
         };
-        let mlp = [config.mlp_layer_size[0], config.mlp_layer_size[1]];
-        let layers = |input, output| GruActorConfig {
+        let layers = |mlp: &[usize], hidden, input, output| GruActorConfig {
             input,
-            mlp,
-            hidden: config.rnn_h_size,
+            mlp: [mlp[0], mlp[1]],
+            hidden,
             output,
         };
+        let joint_input = dims.obs_sizes.iter().sum();
+        let (mlp, h) = (&config.mlp_layer_size, config.rnn_h_size);
+        let (dec_mlp, dec_h) = (&config.dec_mlp_layer_size, config.dec_rnn_h_size);
+        let agents = |mlp, h| -> Vec<GruActorConfig> {
+            (0..env.n_agents())
+                .map(|i| layers(mlp, h, dims.obs_sizes[i], dims.n_actions[i]))
+                .collect()
+        };
         let shapes = match method.nets() {
-            QNets::Decentralized => (0..env.n_agents())
-                .map(|i| layers(dims.obs_sizes[i], dims.n_actions[i]))
-                .collect(),
-            QNets::Centralized => vec![layers(dims.obs_sizes.iter().sum(), dims.n_joint())],
+            QNets::Decentralized => agents(mlp, h),
+            QNets::Centralized => vec![layers(mlp, h, joint_input, dims.n_joint())],
+            // The agents' nets, then the centralized one (`create_agents`, then the controller).
+            QNets::DecWithCen => {
+                let mut s = agents(dec_mlp, dec_h);
+                s.push(layers(
+                    &config.cen_mlp_layer_size,
+                    config.cen_rnn_h_size,
+                    joint_input,
+                    dims.n_joint(),
+                ));
+                s
+            }
         };
         let nets = shapes
             .into_iter()
@@ -247,6 +275,25 @@ impl Learner for MacValueLearner {
                 )
                 .map(|t| vec![t.loss])
                 .unwrap_or_default(),
+                QNets::DecWithCen => {
+                    let n_dec = self.nets.len() - 1;
+                    let (decs, cen) = self.nets.split_at_mut(n_dec);
+                    update_dec_cen(
+                        &mut cen[0],
+                        decs,
+                        &batch,
+                        &self.dims,
+                        self.hysteresis,
+                        c.discount,
+                        c.sub_trace_len,
+                    )
+                    .map(|(cen, decs)| {
+                        std::iter::once(cen.loss)
+                            .chain(decs.iter().map(|t| t.loss))
+                            .collect()
+                    })
+                    .unwrap_or_default()
+                }
             };
             for loss in losses {
                 if !loss.is_finite() {
@@ -318,14 +365,22 @@ impl Learner for MacValueLearner {
         // The policy files' net kinds are Q-nets (the ICRA LSTM) and actors (MacroMARL's GRU
         // layers); these Q-nets have the actor's layers, so they are saved as that kind: the
         // greedy macro-action (argmax of the scores) is the same, log_softmax being monotonic.
+        let n_dec = match self.method.nets() {
+            QNets::Decentralized => self.nets.len(),
+            QNets::Centralized => 0,
+            QNets::DecWithCen => self.nets.len() - 1,
+        };
+        let central = self.method.nets() == QNets::Centralized;
         self.nets
             .iter()
             .enumerate()
             .map(|(i, q)| {
                 let net = ActingNetRef::Actor(&q.net);
-                match self.method.nets() {
-                    QNets::Decentralized => SavedNet::agent(i, net, true),
-                    QNets::Centralized => SavedNet::team(net, true),
+                if i < n_dec {
+                    SavedNet::agent(i, net, true)
+                } else {
+                    // MacCen-Q acts with it; MacDec-DDRQN's centralized net only trains.
+                    SavedNet::team(net, central)
                 }
             })
             .collect()

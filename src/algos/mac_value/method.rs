@@ -13,6 +13,10 @@ pub enum MacValueMethod {
     /// MacCen-Q: one DRQN on the joint observation over joint macro-actions, squeezed where any
     /// agent finished, with the conditional argmax (`MacCenQ`).
     MacCenQ,
+    /// MacDec-DDRQN (ICRA 2020's MacDec-MADDRQN as MacroMARL ships it, `MacDecDDRQN`): MacDec-Q's
+    /// decentralized nets, whose double-Q targets take a' from a centralized net trained beside
+    /// them as MacCen-Q (without hysteresis). No published script.
+    MacDecDdrqn,
 }
 
 impl MethodName for MacValueMethod {
@@ -20,6 +24,7 @@ impl MethodName for MacValueMethod {
         match self {
             MacValueMethod::MacDecQ => "mac-dec-q",
             MacValueMethod::MacCenQ => "mac-cen-q",
+            MacValueMethod::MacDecDdrqn => "mac-dec-ddrqn",
         }
     }
 }
@@ -31,6 +36,8 @@ pub enum QNets {
     Decentralized,
     /// One Q-net on the joint observation history over joint macro-actions.
     Centralized,
+    /// One Q-net per agent, which act, and a centralized one that picks their targets' actions.
+    DecWithCen,
 }
 
 impl MacValueMethod {
@@ -39,6 +46,7 @@ impl MacValueMethod {
         match self {
             MacValueMethod::MacDecQ => QNets::Decentralized,
             MacValueMethod::MacCenQ => QNets::Centralized,
+            MacValueMethod::MacDecDdrqn => QNets::DecWithCen,
         }
     }
 
@@ -47,6 +55,7 @@ impl MacValueMethod {
         match self {
             MacValueMethod::MacDecQ => "MacDecQ",
             MacValueMethod::MacCenQ => "MacCenQ",
+            MacValueMethod::MacDecDdrqn => "MacDecDDRQN",
         }
     }
 }

@@ -14,6 +14,12 @@
 //!
 //! MacDec-Q updates no agent when any agent's squeeze is empty (the reference returns from the
 //! learner before any optimizer step).
+//!
+//! MacDec-DDRQN (`mac_dec_ddrqn/learning_methods.py: QLearn_squ_dec_cen_0`, ICRA 2020's
+//! MacDec-MADDRQN) first takes MacCen-Q's step on its centralized net **without hysteresis**, then
+//! lets the updated centralized net choose every agent's a': agent i's component of the
+//! conditional argmax at the joint records where i finished; the decentralized nets then take
+//! MacDec-Q's hysteretic step with those actions.
 
 use ndarray::ArrayView1;
 use serde::{Deserialize, Serialize};
@@ -360,6 +366,84 @@ pub fn update_cen(
         hysteresis,
         discount,
     ))
+}
+
+/// MacDec-DDRQN's iteration: the centralized net `cen`, then every agent's net in `decs` with
+/// the centralized net's choices. `None` when the joint squeeze kept nothing; the decentralized
+/// traces are empty when some agent's squeeze kept nothing (the reference returns before their
+/// optimizer steps, after the centralized one).
+pub fn update_dec_cen(
+    cen: &mut QNet,
+    decs: &mut [QNet],
+    batch: &[&[Step]],
+    dims: &Dims,
+    hysteresis: f64,
+    discount: f64,
+    sub_trace_len: usize,
+) -> Option<(TdTrace, Vec<TdTrace>)> {
+    let width = dims.obs_sizes.iter().sum();
+    let (s, kept) = Squeezed::of(
+        batch,
+        sub_trace_len,
+        width,
+        Step::any_valid,
+        |o| o,
+        |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+    );
+    if s.lengths.is_empty() {
+        return None;
+    }
+    let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+    let choose = |k: usize, row: &[f32]| {
+        let r = records[k];
+        let running: Vec<Option<usize>> = r
+            .valid
+            .iter()
+            .zip(&r.actions)
+            .map(|(&v, &a)| (!v).then_some(a))
+            .collect();
+        conditional_argmax(row, &running, &r.next_avail, dims)
+    };
+    // The centralized step is plain double Q (no hysteresis in `QLearn_squ_dec_cen_0`).
+    let cen_trace = td_step(cen, &s, choose, 1.0, discount);
+    let joint_next: Vec<usize> = next_values(&cen.net, &s)
+        .iter()
+        .enumerate()
+        .map(|(k, row)| choose(k, row))
+        .collect();
+    let squeezed: Vec<_> = (0..decs.len())
+        .map(|i| {
+            let obs = dims.obs_range(i);
+            Squeezed::of(
+                batch,
+                sub_trace_len,
+                obs.len(),
+                |r| r.valid[i],
+                |o| &o[obs.clone()],
+                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+            )
+            .0
+        })
+        .collect();
+    if squeezed.iter().any(|s| s.lengths.is_empty()) {
+        return Some((cen_trace, Vec::new()));
+    }
+    let dec_traces = decs
+        .iter_mut()
+        .zip(&squeezed)
+        .enumerate()
+        .map(|(i, (q, s))| {
+            // Agent i's records are the joint records where it finished, in the same order.
+            let a_next: Vec<usize> = records
+                .iter()
+                .zip(&joint_next)
+                .filter(|(r, _)| r.valid[i])
+                .map(|(_, &j)| dims.unravel(j)[i])
+                .collect();
+            td_step(q, s, |k, _| a_next[k], hysteresis, discount)
+        })
+        .collect();
+    Some((cen_trace, dec_traces))
 }
 
 #[cfg(test)]
