@@ -54,6 +54,18 @@ from macro_marl.cores.value_based.mac_dec_ddrqn.team import Team_RNN as DdrqnTea
 from macro_marl.cores.value_based.mac_dec_ddrqn.utils.Agent import Agent as DdrqnAgent  # noqa: E402
 from macro_marl.cores.value_based.mac_dec_ddrqn.utils.Cen_ctrl import Cen_Controller as DdrqnCen  # noqa: E402
 from macro_marl.cores.value_based.mac_dec_ddrqn.utils import memory as ddrqn_memory  # noqa: E402
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn import envs_runner as par_runner  # noqa: E402
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn.learning_methods import (  # noqa: E402
+    QLearn_squ_dec_cen_0 as ParQLearn,
+)
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn.model import (  # noqa: E402
+    DDRQN as ParDec,
+    Cen_DDRQN as ParCen,
+)
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn.team import Team_RNN as ParTeam  # noqa: E402
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn.utils.Agent import Agent as ParAgent  # noqa: E402
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn.utils.Cen_ctrl import Cen_Controller as ParCtrl  # noqa: E402
+from macro_marl.cores.value_based.parallel_mac_dec_ddrqn.utils import memory as par_memory  # noqa: E402
 
 OBS_SIZES = [3, 2]
 N_ACTIONS = [3, 2]
@@ -143,7 +155,8 @@ def run_worker(worker, episode, horizon):
         parent.send(("step", [0] * len(N_ACTIONS)))
         exp = parent.recv()
         sent.append((last_avail, exp))
-        avail_at, terminate_at = {cen_runner.worker: (6, 7), ddrqn_runner.worker: (7, 8)}.get(worker, (5, 6))
+        avail_at, terminate_at = {cen_runner.worker: (6, 7), ddrqn_runner.worker: (7, 8),
+                                  par_runner.worker: (7, 8)}.get(worker, (5, 6))
         last_avail = exp[avail_at]
         if exp[terminate_at] or t + 1 == horizon:
             break
@@ -257,12 +270,14 @@ def weights(net):
 def make_case(alg, sample_epi, seed):
     rng = np.random.default_rng(seed)
     horizon = 9
-    scripted = [script_episode(rng, int(rng.integers(4, 10)), k == 1) for k in range(6)]
+    parallel = alg == "ParallelMacDecDDRQN"
+    n_episodes = 10 if parallel else 6
+    scripted = [script_episode(rng, int(rng.integers(4, 10)), k == 1) for k in range(n_episodes)]
     episodes_dec, episodes_cen, episodes_ddrqn, records = [], [], [], []
     for ep in scripted:
         d = dec_records(run_worker(dec_runner.worker, ep, horizon))
         c = cen_records(run_worker(cen_runner.worker, ep, horizon))
-        dd = ddrqn_records(run_worker(ddrqn_runner.worker, ep, horizon))
+        dd = ddrqn_records(run_worker(par_runner.worker if parallel else ddrqn_runner.worker, ep, horizon))
         assert len(d) == len(c) == len(dd)
         for a, b, e in zip(dd, d, c):
             check_ddrqn_record(a, b, e)
@@ -324,6 +339,39 @@ def make_case(alg, sample_epi, seed):
         nets = lambda: [weights(a.policy_net) for a in agents] + [weights(ctrl.policy_net)]  # noqa: E731
         team = SimpleNamespace(n_agent=2, env=SimpleNamespace(n_action=N_ACTIONS))
         sep = lambda b: (DdrqnTeam.cen_sep_joint_exps(team, b), DdrqnTeam.dec_sep_joint_exps(team, b))  # noqa: E731
+    elif parallel:
+        def memory():
+            return (par_memory.ReplayMemory_epi(2, OBS_SIZES, N_ACTIONS, batch_size, size=capacity)
+                    if sample_epi else
+                    par_memory.ReplayMemory_rand(2, OBS_SIZES, N_ACTIONS, trace_len, batch_size, size=capacity))
+        # The centralized runner's episodes (the first half) and the agents' (the second).
+        mem_cen, mem = memory(), memory()
+        half = n_episodes // 2
+        for k, ep in enumerate(episodes_ddrqn):
+            m = mem_cen if k < half else mem
+            m.scenario_cache += ep
+            m.flush_scenario_cache()
+        sizes = dict(dec_mlp_layer_size=mlp, dec_rnn_h_size=rnn_h, cen_mlp_layer_size=[7, 6],
+                     cen_rnn_h_size=5)
+        agents = []
+        for i in range(2):
+            a = ParAgent()
+            a.idx = i
+            a.policy_net = ParDec(OBS_SIZES[i], N_ACTIONS[i], **sizes)
+            a.target_net = ParDec(OBS_SIZES[i], N_ACTIONS[i], **sizes)
+            a.target_net.load_state_dict(a.policy_net.state_dict())
+            a.optimizer = torch.optim.Adam(a.policy_net.parameters(), lr=lr)
+            agents.append(a)
+        ctrl = ParCtrl()
+        n_joint = int(np.prod(N_ACTIONS))
+        ctrl.policy_net = ParCen(sum(OBS_SIZES), n_joint, **sizes)
+        ctrl.target_net = ParCen(sum(OBS_SIZES), n_joint, **sizes)
+        ctrl.target_net.load_state_dict(ctrl.policy_net.state_dict())
+        ctrl.optimizer = torch.optim.Adam(ctrl.policy_net.parameters(), lr=lr)
+        nets = lambda: [weights(a.policy_net) for a in agents] + [weights(ctrl.policy_net)]  # noqa: E731
+        team = SimpleNamespace(n_agent=2, env=SimpleNamespace(n_action=N_ACTIONS),
+                               env_dec=SimpleNamespace(n_action=N_ACTIONS),
+                               env_cen=SimpleNamespace(n_action=N_ACTIONS))
     else:
         mem = (cen_memory.ReplayMemory_epi(2, OBS_SIZES, N_ACTIONS, batch_size, size=capacity)
                if sample_epi else
@@ -351,21 +399,36 @@ def make_case(alg, sample_epi, seed):
             if alg != "MacDecQ":
                 ctrl.target_net.load_state_dict(ctrl.policy_net.state_dict())
         # The memory's own `sample`, with its indices kept.
-        indices = np.random.choice(len(mem.buf), batch_size, replace=False)
-        batch = [mem.buf[i] for i in indices]
-        if sample_epi:
-            batch, length = mem.padding_batches(batch)
+        def sample(m):
+            indices = np.random.choice(len(m.buf), batch_size, replace=False)
+            batch = [m.buf[i] for i in indices]
+            if sample_epi:
+                batch, length = m.padding_batches(batch)
+            else:
+                length = trace_len
+            return indices, batch, length
+        cen_indices = []
+        if parallel:
+            # `Team_RNN.train`: the centralized memory is sampled first.
+            cen_indices, batch_cen, len_cen = sample(mem_cen)
+        indices, batch, length = sample(mem)
+        if parallel:
+            batch = (ParTeam.cen_sep_joint_exps(team, batch_cen), ParTeam.cen_sep_joint_exps(team, batch),
+                     ParTeam.dec_sep_joint_exps(team, batch))
+            params = dict(trace_lens=(len_cen, length), sub_trace_len=1, batch_size=batch_size)
         else:
-            length = trace_len
-        batch = sep(batch)
-        params = dict(trace_len=length, sub_trace_len=1, batch_size=batch_size)
-        if alg == "MacDecQ":
+            batch = sep(batch)
+            params = dict(trace_len=length, sub_trace_len=1, batch_size=batch_size)
+        if parallel:
+            ParQLearn(SimpleNamespace(n_action=N_ACTIONS), agents, ctrl, batch, h, DISCOUNT, **params)
+        elif alg == "MacDecQ":
             QLearn_squ(agents, batch, h, DISCOUNT, **params)
         elif alg == "MacDecDDRQN":
             QLearn_squ_dec_cen_0(SimpleNamespace(n_action=N_ACTIONS), agents, ctrl, batch, h, DISCOUNT, **params)
         else:
             QLearn_squ_cen_condi_0(SimpleNamespace(n_action=N_ACTIONS), ctrl, batch, h, DISCOUNT, **params)
-        updates.append({"indices": [int(i) for i in indices], "hysteresis": h,
+        updates.append({"indices": [int(i) for i in indices], "cen_indices": [int(i) for i in cen_indices],
+                        "hysteresis": h,
                         "sync_before": sync, "weights_after": nets()})
     return {
         "alg": alg,
@@ -376,7 +439,8 @@ def make_case(alg, sample_epi, seed):
         "scripted": scripted,
         "episodes": records,
         "memory": {"sample_epi": sample_epi, "trace_len": trace_len, "capacity": capacity,
-                   "batch_size": batch_size, "held": len(mem.buf)},
+                   "batch_size": batch_size, "held": len(mem.buf),
+                   "cen_held": len(mem_cen.buf) if parallel else 0},
         "mlp_layer_size": mlp,
         "rnn_h_size": rnn_h,
         "cen_mlp_layer_size": [7, 6],
@@ -393,7 +457,9 @@ def main():
     cases = [("mac_dec_q_windows", "MacDecQ", False, 1), ("mac_dec_q_episodes", "MacDecQ", True, 2),
              ("mac_cen_q_windows", "MacCenQ", False, 3), ("mac_cen_q_episodes", "MacCenQ", True, 4),
              ("mac_dec_ddrqn_windows", "MacDecDDRQN", False, 5),
-             ("mac_dec_ddrqn_episodes", "MacDecDDRQN", True, 6)]
+             ("mac_dec_ddrqn_episodes", "MacDecDDRQN", True, 6),
+             ("parallel_mac_dec_ddrqn_windows", "ParallelMacDecDDRQN", False, 7),
+             ("parallel_mac_dec_ddrqn_episodes", "ParallelMacDecDDRQN", True, 8)]
     for name, alg, epi, seed in cases:
         case = make_case(alg, epi, seed)
         with open(os.path.join(OUT, name + ".json"), "w") as f:

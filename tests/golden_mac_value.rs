@@ -1,4 +1,5 @@
-//! Differential tests of MacroMARL's value-based methods (MacDec-Q, MacCen-Q, MacDec-DDRQN) against the
+//! Differential tests of MacroMARL's value-based methods (MacDec-Q, MacCen-Q, MacDec-DDRQN,
+//! Parallel-MacDec-DDRQN: its two memories, the centralized net's batch from one) against the
 //! reference's own code (`docs/MACROMARL.md` §8).
 //!
 //! Each `tests/golden_mac_value/<case>.json` was written by
@@ -183,18 +184,34 @@ fn run_case(name: &str) {
     let case = load(name);
     let episodes = recorded(&case);
     let m = &case["memory"];
-    let mut memory = Memory::new(
-        m["sample_epi"].as_bool().unwrap(),
-        m["trace_len"].as_u64().unwrap() as usize,
-        m["capacity"].as_u64().unwrap() as usize,
-    );
-    for e in episodes {
-        memory.push(e);
+    let new_memory = || {
+        Memory::new(
+            m["sample_epi"].as_bool().unwrap(),
+            m["trace_len"].as_u64().unwrap() as usize,
+            m["capacity"].as_u64().unwrap() as usize,
+        )
+    };
+    let alg = case["alg"].as_str().unwrap();
+    let parallel = alg == "ParallelMacDecDDRQN";
+    // Parallel-MacDec-DDRQN: the first half of the episodes came from the centralized runner.
+    let (mut memory, mut cen_memory) = (new_memory(), new_memory());
+    let half = episodes.len() / 2;
+    for (k, e) in episodes.into_iter().enumerate() {
+        if parallel && k < half {
+            cen_memory.push(e);
+        } else {
+            memory.push(e);
+        }
     }
     assert_eq!(
         memory.len() as u64,
         m["held"].as_u64().unwrap(),
         "{name}: entries held"
+    );
+    assert_eq!(
+        cen_memory.len() as u64,
+        m["cen_held"].as_u64().unwrap(),
+        "{name}: centralized entries held"
     );
     let dims = Dims {
         obs_sizes: counts(&case["obs_sizes"]),
@@ -207,7 +224,6 @@ fn run_case(name: &str) {
         hidden: case["rnn_h_size"].as_u64().unwrap() as usize,
         output,
     };
-    let alg = case["alg"].as_str().unwrap();
     let joint_input: usize = dims.obs_sizes.iter().sum();
     let mut shapes: Vec<GruActorConfig> = if alg == "MacCenQ" {
         vec![layers(joint_input, dims.n_joint())]
@@ -216,7 +232,7 @@ fn run_case(name: &str) {
             .map(|i| layers(dims.obs_sizes[i], dims.n_actions[i]))
             .collect()
     };
-    if alg == "MacDecDDRQN" {
+    if alg.contains("DDRQN") {
         let cen_mlp = counts(&case["cen_mlp_layer_size"]);
         shapes.push(GruActorConfig {
             input: joint_input,
@@ -242,13 +258,18 @@ fn run_case(name: &str) {
             .into_iter()
             .map(|i| memory.entry(i))
             .collect();
+        let cen_batch: Vec<&[Step]> = counts(&u["cen_indices"])
+            .into_iter()
+            .map(|i| cen_memory.entry(i))
+            .collect();
         let h = u["hysteresis"].as_f64().unwrap();
         let updated = match alg {
             "MacCenQ" => update_cen(&mut nets[0], &batch, &dims, h, discount, 1).is_some(),
             "MacDecQ" => update_dec(&mut nets, &batch, &dims, h, discount, 1).is_some(),
             _ => {
                 let (decs, cen) = nets.split_at_mut(2);
-                update_dec_cen(&mut cen[0], decs, &batch, &dims, h, discount, 1)
+                let cen_batch = if parallel { &cen_batch } else { &batch };
+                update_dec_cen(&mut cen[0], decs, cen_batch, &batch, &dims, h, discount, 1)
                     .is_some_and(|(_, decs)| decs.len() == 2)
             }
         };
@@ -291,4 +312,14 @@ fn mac_dec_ddrqn_on_windows_matches_the_reference() {
 #[test]
 fn mac_dec_ddrqn_on_whole_episodes_matches_the_reference() {
     run_case("mac_dec_ddrqn_episodes");
+}
+
+#[test]
+fn parallel_mac_dec_ddrqn_on_windows_matches_the_reference() {
+    run_case("parallel_mac_dec_ddrqn_windows");
+}
+
+#[test]
+fn parallel_mac_dec_ddrqn_on_whole_episodes_matches_the_reference() {
+    run_case("parallel_mac_dec_ddrqn_episodes");
 }

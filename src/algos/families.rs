@@ -413,7 +413,7 @@ mod tests {
     #[test]
     fn names_round_trip_through_from_str_and_serde() {
         let all = Method::all();
-        assert_eq!(all.len(), 14);
+        assert_eq!(all.len(), 15);
         for m in all {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
             let json = serde_json::to_string(&m).unwrap();

@@ -216,7 +216,12 @@ pub fn check(
     check_at_most(&[
         ("env_terminate_step", shape.horizon, MAX_HORIZON),
         ("total_epi", c.total_epi, MAX_TOTAL_EPI),
-        ("n_env", c.n_env, crate::algos::training_loop::MAX_LANES),
+        // Parallel-MacDec-DDRQN steps n_env environments per runner, two runners.
+        (
+            "n_env",
+            c.n_env,
+            crate::algos::training_loop::MAX_LANES / if method.parallel() { 2 } else { 1 },
+        ),
         ("replay_buffer_size", c.replay_buffer_size, MAX_REPLAY),
         ("trace_len", c.trace_len, MAX_HORIZON),
         ("rnn_h_size", c.rnn_h_size, MAX_NET_WIDTH),
@@ -263,12 +268,15 @@ pub fn check(
     check_rates(&[("l_rate", c.l_rate)])?;
     // Replay holds whole episodes: capacity x the horizon records at most (a window's episode
     // stays while any of its windows does, so windows count one episode each at worst).
-    let records = (c.replay_buffer_size as u128).saturating_mul(shape.horizon as u128);
+    let memories = if method.parallel() { 2 } else { 1 };
+    let records = (c.replay_buffer_size as u128)
+        .saturating_mul(shape.horizon as u128)
+        .saturating_mul(memories);
     if records > MAX_REPLAY_RECORDS {
         return Err((
             "replay_buffer_size",
             format!(
-                "replay_buffer_size x env_terminate_step = {records} records, at most {MAX_REPLAY_RECORDS}"
+                "replay_buffer_size x env_terminate_step x memories ({memories}) = {records} records, at most {MAX_REPLAY_RECORDS}"
             ),
         ));
     }

@@ -21,6 +21,7 @@ impl FamilyMethod for MacValueMethod {
         MacValueMethod::MacDecQ,
         MacValueMethod::MacCenQ,
         MacValueMethod::MacDecDdrqn,
+        MacValueMethod::ParallelMacDecDdrqn,
     ];
 
     fn legend(self) -> &'static str {
@@ -28,6 +29,7 @@ impl FamilyMethod for MacValueMethod {
             MacValueMethod::MacDecQ => "MacDec-Q",
             MacValueMethod::MacCenQ => "MacCen-Q",
             MacValueMethod::MacDecDdrqn => "MacDec-DDRQN",
+            MacValueMethod::ParallelMacDecDdrqn => "Parallel-MacDec-DDRQN",
         }
     }
 

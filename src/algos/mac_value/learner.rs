@@ -30,9 +30,12 @@ pub const METRIC_COLUMNS: [&str; 3] = ["epsilon", "hysteresis", "loss"];
 pub struct Lane {
     recorder: Recorder,
     states: Vec<GruActorState>,
+    /// Parallel-MacDec-DDRQN's centralized lanes: the centralized net explores, the episodes go
+    /// to its memory and do not count as training episodes.
+    explores_centrally: bool,
 }
 
-/// A MacDec-Q or MacCen-Q run's learner.
+/// A run's learner (any of the family's methods).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MacValueLearner {
     method: MacValueMethod,
@@ -42,6 +45,8 @@ pub struct MacValueLearner {
     /// One per agent (MacDec-Q) or the team's one (MacCen-Q).
     nets: Vec<QNet>,
     memory: Memory,
+    /// Parallel-MacDec-DDRQN's second memory, filled by the centralized net's exploration.
+    cen_memory: Option<Memory>,
     explore: ChaCha8Rng,
     replay: ChaCha8Rng,
     epsilon: f64,
@@ -160,6 +165,13 @@ impl Learner for MacValueLearner {
                 config.trace_len,
                 config.replay_buffer_size,
             ),
+            cen_memory: method.parallel().then(|| {
+                Memory::new(
+                    config.sample_epi,
+                    config.trace_len,
+                    config.replay_buffer_size,
+                )
+            }),
             explore: rngs.explore,
             replay: rngs.replay,
             // `EPS_START`, and the hysteresis's initial value (`Team.__init__`).
@@ -194,18 +206,22 @@ impl Learner for MacValueLearner {
     }
 
     fn lanes(&self) -> Vec<LanePlan> {
-        vec![
-            LanePlan {
-                counts_episodes: true
-            };
-            self.config.n_env
-        ]
+        // Parallel-MacDec-DDRQN: the agents' runner's environments step first, then the
+        // centralized runner's (`Team_RNN.step`), whose episodes do not count.
+        let n = self.config.n_env;
+        let central = if self.method.parallel() { n } else { 0 };
+        (0..n + central)
+            .map(|k| LanePlan {
+                counts_episodes: k < n,
+            })
+            .collect()
     }
 
-    fn begin_lane<E: MacroEnv>(&self, _lane: usize, env: &E) -> Result<Lane, TrainError> {
+    fn begin_lane<E: MacroEnv>(&self, lane: usize, env: &E) -> Result<Lane, TrainError> {
         Ok(Lane {
             recorder: Recorder::new(env, self.config.discount),
             states: self.zero_states(),
+            explores_centrally: self.method.parallel() && lane >= self.config.n_env,
         })
     }
 
@@ -219,7 +235,20 @@ impl Learner for MacValueLearner {
             epsilon: self.epsilon,
             rng: &mut rng,
         };
-        self.choose(&mut lane.states, env, Some(explore), actions);
+        if lane.explores_centrally {
+            let cen = self.nets.len() - 1;
+            let q = &self.nets[cen];
+            act_cen(
+                q,
+                &mut lane.states[cen],
+                env,
+                &self.dims,
+                Some(explore),
+                actions,
+            );
+        } else {
+            self.choose(&mut lane.states, env, Some(explore), actions);
+        }
         self.explore = rng;
     }
 
@@ -231,8 +260,13 @@ impl Learner for MacValueLearner {
     ) -> Result<bool, TrainError> {
         match lane.recorder.record(env, outcome) {
             Some(episode) => {
-                self.memory.push(episode);
-                self.episodes += 1;
+                match (&mut self.cen_memory, lane.explores_centrally) {
+                    (Some(cen_memory), true) => cen_memory.push(episode),
+                    _ => {
+                        self.memory.push(episode);
+                        self.episodes += 1;
+                    }
+                }
                 Ok(true)
             }
             None => Ok(false),
@@ -249,11 +283,17 @@ impl Learner for MacValueLearner {
         let c = &self.config;
         let since = episodes.saturating_sub(c.start_train as u64);
         self.hysteresis = c.hysteresis_at(since, self.epsilon);
+        let sampling = |e| TrainError::Family(Box::new(e));
         for _ in 0..c.n_env {
+            // Parallel-MacDec-DDRQN samples the centralized memory first (`Team_RNN.train`).
+            let cen_batch = match &self.cen_memory {
+                Some(m) => Some(m.sample(c.batch_size, &mut self.replay).map_err(sampling)?),
+                None => None,
+            };
             let batch = self
                 .memory
                 .sample(c.batch_size, &mut self.replay)
-                .map_err(|e| TrainError::Family(Box::new(e)))?;
+                .map_err(sampling)?;
             let losses: Vec<f32> = match self.method.nets() {
                 QNets::Decentralized => update_dec(
                     &mut self.nets,
@@ -281,6 +321,7 @@ impl Learner for MacValueLearner {
                     update_dec_cen(
                         &mut cen[0],
                         decs,
+                        cen_batch.as_deref().unwrap_or(&batch),
                         &batch,
                         &self.dims,
                         self.hysteresis,

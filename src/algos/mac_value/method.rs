@@ -17,6 +17,10 @@ pub enum MacValueMethod {
     /// decentralized nets, whose double-Q targets take a' from a centralized net trained beside
     /// them as MacCen-Q (without hysteresis). No published script.
     MacDecDdrqn,
+    /// Parallel-MacDec-DDRQN (`ParallelMacDecDDRQN`): MacDec-DDRQN with two sets of environments
+    /// and two memories, one explored by the centralized net (trains it) and one by the agents'
+    /// nets (trains them, counts the episodes). No published script.
+    ParallelMacDecDdrqn,
 }
 
 impl MethodName for MacValueMethod {
@@ -25,6 +29,7 @@ impl MethodName for MacValueMethod {
             MacValueMethod::MacDecQ => "mac-dec-q",
             MacValueMethod::MacCenQ => "mac-cen-q",
             MacValueMethod::MacDecDdrqn => "mac-dec-ddrqn",
+            MacValueMethod::ParallelMacDecDdrqn => "parallel-mac-dec-ddrqn",
         }
     }
 }
@@ -46,7 +51,7 @@ impl MacValueMethod {
         match self {
             MacValueMethod::MacDecQ => QNets::Decentralized,
             MacValueMethod::MacCenQ => QNets::Centralized,
-            MacValueMethod::MacDecDdrqn => QNets::DecWithCen,
+            MacValueMethod::MacDecDdrqn | MacValueMethod::ParallelMacDecDdrqn => QNets::DecWithCen,
         }
     }
 
@@ -56,6 +61,12 @@ impl MacValueMethod {
             MacValueMethod::MacDecQ => "MacDecQ",
             MacValueMethod::MacCenQ => "MacCenQ",
             MacValueMethod::MacDecDdrqn => "MacDecDDRQN",
+            MacValueMethod::ParallelMacDecDdrqn => "ParallelMacDecDDRQN",
         }
+    }
+
+    /// Whether the centralized net explores environments of its own into a memory of its own.
+    pub fn parallel(self) -> bool {
+        self == MacValueMethod::ParallelMacDecDdrqn
     }
 }

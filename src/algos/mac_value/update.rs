@@ -19,7 +19,10 @@
 //! MacDec-MADDRQN) first takes MacCen-Q's step on its centralized net **without hysteresis**, then
 //! lets the updated centralized net choose every agent's a': agent i's component of the
 //! conditional argmax at the joint records where i finished; the decentralized nets then take
-//! MacDec-Q's hysteretic step with those actions.
+//! MacDec-Q's hysteretic step with those actions. Parallel-MacDec-DDRQN
+//! (`parallel_mac_dec_ddrqn/learning_methods.py: QLearn_squ_dec_cen_0`) does the same with the
+//! centralized net's batch from the memory its own exploration filled and the agents' batch from
+//! the memory the agents' exploration filled.
 
 use ndarray::ArrayView1;
 use serde::{Deserialize, Serialize};
@@ -368,34 +371,38 @@ pub fn update_cen(
     ))
 }
 
-/// MacDec-DDRQN's iteration: the centralized net `cen`, then every agent's net in `decs` with
-/// the centralized net's choices. `None` when the joint squeeze kept nothing; the decentralized
-/// traces are empty when some agent's squeeze kept nothing (the reference returns before their
-/// optimizer steps, after the centralized one).
+/// MacDec-DDRQN's iteration (`mac_dec_ddrqn`: `cen_batch` and `dec_batch` the same sample;
+/// `parallel_mac_dec_ddrqn`: one from each memory): the centralized net `cen` steps on
+/// `cen_batch`, then every agent's net in `decs` steps on `dec_batch` with the centralized net's
+/// choices there. `None` when `cen_batch`'s joint squeeze kept nothing; the decentralized traces
+/// are empty when `dec_batch`'s joint squeeze or some agent's squeeze kept nothing (the reference
+/// returns before their optimizer steps, after the centralized one).
+#[allow(clippy::too_many_arguments)]
 pub fn update_dec_cen(
     cen: &mut QNet,
     decs: &mut [QNet],
-    batch: &[&[Step]],
+    cen_batch: &[&[Step]],
+    dec_batch: &[&[Step]],
     dims: &Dims,
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
 ) -> Option<(TdTrace, Vec<TdTrace>)> {
     let width = dims.obs_sizes.iter().sum();
-    let (s, kept) = Squeezed::of(
-        batch,
-        sub_trace_len,
-        width,
-        Step::any_valid,
-        |o| o,
-        |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-    );
-    if s.lengths.is_empty() {
-        return None;
-    }
-    let records: Vec<&Step> = kept.iter().flatten().copied().collect();
-    let choose = |k: usize, row: &[f32]| {
-        let r = records[k];
+    let joint = |batch: &[&'_ [Step]]| {
+        let (s, kept) = Squeezed::of(
+            batch,
+            sub_trace_len,
+            width,
+            Step::any_valid,
+            |o| o,
+            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+        );
+        let records: Vec<Step> = kept.iter().flatten().map(|&r| r.clone()).collect();
+        (s, records)
+    };
+    let choose = |records: &[Step], k: usize, row: &[f32]| {
+        let r = &records[k];
         let running: Vec<Option<usize>> = r
             .valid
             .iter()
@@ -404,18 +411,26 @@ pub fn update_dec_cen(
             .collect();
         conditional_argmax(row, &running, &r.next_avail, dims)
     };
+    let (s, records) = joint(cen_batch);
+    if s.lengths.is_empty() {
+        return None;
+    }
     // The centralized step is plain double Q (no hysteresis in `QLearn_squ_dec_cen_0`).
-    let cen_trace = td_step(cen, &s, choose, 1.0, discount);
+    let cen_trace = td_step(cen, &s, |k, row| choose(&records, k, row), 1.0, discount);
+    let (s, records) = joint(dec_batch);
+    if s.lengths.is_empty() {
+        return Some((cen_trace, Vec::new()));
+    }
     let joint_next: Vec<usize> = next_values(&cen.net, &s)
         .iter()
         .enumerate()
-        .map(|(k, row)| choose(k, row))
+        .map(|(k, row)| choose(&records, k, row))
         .collect();
     let squeezed: Vec<_> = (0..decs.len())
         .map(|i| {
             let obs = dims.obs_range(i);
             Squeezed::of(
-                batch,
+                dec_batch,
                 sub_trace_len,
                 obs.len(),
                 |r| r.valid[i],
