@@ -427,3 +427,95 @@ impl Learner for MacValueLearner {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::family::FamilyMethod;
+    use crate::algos::training_loop::{Advance, TrainingLoop};
+    use crate::experiment::run::train_run::run_rngs;
+
+    /// A few episodes of Box Pushing 8x8 (horizon 30) with updates from the third episode on.
+    fn short_run(
+        method: MacValueMethod,
+        seed: u64,
+    ) -> TrainingLoop<MacValueLearner, crate::envs::AnyEnv> {
+        let spec = crate::envs::bp_ma_v0::spec(8, 30);
+        let mut c = method.defaults(&spec);
+        (c.total_epi, c.start_train, c.eval_freq) = (6, 2, 2);
+        (c.batch_size, c.train_freq, c.target_update_freq) = (4, 5, 20);
+        (c.mlp_layer_size, c.rnn_h_size) = (vec![8, 8], 8);
+        (c.init_h, c.end_h, c.h_stable_at) = (0.2, 0.4, 4);
+        TrainingLoop::new(&c, method, seed, run_rngs(seed), || spec.build()).unwrap()
+    }
+
+    fn finish(l: &mut TrainingLoop<MacValueLearner, crate::envs::AnyEnv>) {
+        while let Advance::Episode { .. } = l.advance().unwrap() {}
+    }
+
+    fn weights(l: &TrainingLoop<MacValueLearner, crate::envs::AnyEnv>) -> Vec<Vec<f32>> {
+        l.learner()
+            .nets()
+            .iter()
+            .flat_map(|q| [&q.net, &q.target])
+            .map(|n| n.slices().concat())
+            .collect()
+    }
+
+    #[test]
+    fn every_method_trains_the_same_numbers_from_the_same_seed_and_from_a_checkpoint() {
+        for &method in MacValueMethod::ALL {
+            let mut a = short_run(method, 3);
+            finish(&mut a);
+            assert!(a.updates() > 0, "{method:?} never updated");
+            let mut b = short_run(method, 3);
+            // Stop halfway, round-trip through a checkpoint's serialization, finish.
+            for _ in 0..3 {
+                b.advance().unwrap();
+            }
+            let json = serde_json::to_string(&b).unwrap();
+            let mut b: TrainingLoop<MacValueLearner, crate::envs::AnyEnv> =
+                serde_json::from_str(&json).unwrap();
+            finish(&mut b);
+            assert_eq!(a.evals().len(), b.evals().len(), "{method:?}");
+            for (x, y) in a.evals().iter().zip(b.evals()) {
+                assert_eq!(
+                    (x.eval_return, &x.family, x.env_steps, x.updates),
+                    (y.eval_return, &y.family, y.env_steps, y.updates),
+                    "{method:?}"
+                );
+            }
+            assert_eq!(weights(&a), weights(&b), "{method:?}");
+            let mut c = short_run(method, 4);
+            finish(&mut c);
+            assert_ne!(weights(&a), weights(&c), "{method:?}: another seed");
+        }
+    }
+
+    #[test]
+    fn epsilon_stays_at_one_until_the_first_update_and_hysteresis_rises_after_start_train() {
+        let mut l = short_run(MacValueMethod::MacDecQ, 0);
+        finish(&mut l);
+        let first = &l.evals()[0];
+        assert_eq!(first.family[0], Some(1.0));
+        // After the last update, epsilon is the linear decay at episodes - start_train.
+        let last = l.evals().last().unwrap();
+        let c = l.config();
+        let eps = last.family[0].unwrap();
+        assert!(eps < 1.0 && eps >= c.eps_end, "{eps}");
+        let h = last.family[1].unwrap();
+        assert!(h > c.init_h && h <= c.end_h, "{h}");
+    }
+
+    #[test]
+    fn parallel_runs_count_only_the_agents_episodes_and_fill_both_memories() {
+        let mut l = short_run(MacValueMethod::ParallelMacDecDdrqn, 1);
+        finish(&mut l);
+        let learner = l.learner();
+        assert_eq!(learner.episodes, 6);
+        let cen = learner.cen_memory.as_ref().unwrap();
+        assert!(!cen.is_empty() && !learner.memory().is_empty());
+        // Two lanes stepped in lockstep: twice the primitive steps of the main loop.
+        assert_eq!(l.env_steps() % 2, 0);
+    }
+}
