@@ -363,4 +363,27 @@ mod tests {
         assert_eq!(bad(&|c| c.train_freq = 0), "train_freq");
         assert_eq!(bad(&|c| c.trace_len = 1 << 40), "trace_len");
     }
+
+    #[test]
+    fn mac_cen_q_on_three_cooks_is_refused_and_the_published_two_cooks_fit() {
+        // docs/MACROMARL.md 8.4 bug 4: the published runs trained 2 cooks; with 3, MacCen-Q's
+        // joint output (15^3 on map B) over 64 whole episodes exceeds the activation bound.
+        for (cooks, fits) in [(2, true), (3, false)] {
+            let keys = toml::toml! { map_type = "B" n_agent = cooks };
+            let spec = crate::envs::EnvSpec::new("Overcooked-MA-v1", &keys).unwrap();
+            let shape = EnvShape::of(&spec).unwrap();
+            let c = published_defaults(&spec, MacValueMethod::MacCenQ);
+            let result = check(&c, MacValueMethod::MacCenQ, &shape);
+            assert_eq!(result.is_ok(), fits, "{cooks} cooks: {result:?}");
+            if let Err((key, why)) = result {
+                assert_eq!(key, "batch_size");
+                assert!(why.contains("widest output 3375"), "{why}");
+            }
+            let dec = published_defaults(&spec, MacValueMethod::MacDecQ);
+            assert!(
+                check(&dec, MacValueMethod::MacDecQ, &shape).is_ok(),
+                "{cooks} cooks"
+            );
+        }
+    }
 }
