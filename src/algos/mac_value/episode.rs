@@ -3,7 +3,7 @@
 //! with each agent's macro-reward discounted **inside** its macro-action and the discount its
 //! bootstrap needs, and the same for the joint macro-action (restarted after any agent finished).
 
-use crate::envs::{MacroEnv, StepOutcome};
+use crate::envs::{FirstRecordObs, MacroEnv, StepOutcome};
 use serde::{Deserialize, Serialize};
 
 /// One primitive step of one environment.
@@ -99,7 +99,8 @@ impl Recorder {
     /// Record the step `env` just took; returns the episode when it ended (then call
     /// [`Recorder::new`] again after the reset).
     pub fn record<E: MacroEnv>(&mut self, env: &E, outcome: StepOutcome) -> Option<Episode> {
-        self.record_parts(
+        let first = self.steps.is_empty();
+        let mut ended = self.record_parts(
             StepParts {
                 next_obs: joint_obs(env),
                 executed: env.executed(),
@@ -107,7 +108,25 @@ impl Recorder {
                 next_avail: all_available(env),
             },
             outcome,
-        )
+        );
+        // Quirk Q20 (`MacroEnv::first_record_obs`): the runner's first record holds the list
+        // `env.reset()` returned, which the first step overwrote for the agents that finished in
+        // it (the Warehouse domains; `last_obs = env.reset()` in the value runners too).
+        if first && env.first_record_obs() == FirstRecordObs::OverwrittenByFirstStep {
+            let step = match ended.as_mut() {
+                Some(episode) => &mut episode[0],
+                None => &mut self.steps[0],
+            };
+            let mut at = 0;
+            for i in 0..env.n_agents() {
+                let len = env.obs(i).len();
+                if env.mac_done()[i] {
+                    step.obs[at..at + len].copy_from_slice(env.obs(i));
+                }
+                at += len;
+            }
+        }
+        ended
     }
 
     /// [`Recorder::record`] from the step's parts (what the reference's worker reads off
@@ -169,4 +188,58 @@ pub struct StepParts<'a> {
     pub mac_done: &'a [bool],
     /// Every agent's availability mask after the step, concatenated.
     pub next_avail: Vec<f32>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::value::recorder::tests::{script, FakeEnv};
+    use crate::envs::EnvRng;
+    use rand::SeedableRng;
+
+    #[test]
+    fn the_first_record_shows_the_first_steps_observation_only_under_quirk_q20() {
+        let mut s = script();
+        s[0].2 = [true, false]; // agent 0 finishes at step 1: its observation becomes 10
+        let first_obs = |first: FirstRecordObs| {
+            let mut rng = EnvRng::seed_from_u64(0);
+            let mut env = FakeEnv::new(s.clone());
+            env.first = first;
+            env.reset(&mut rng);
+            let mut rec = Recorder::new(&env, 0.9);
+            for _ in 0..2 {
+                let o = env.step(&[0, 0], &mut rng).unwrap();
+                rec.record(&env, o);
+            }
+            (rec.steps[0].obs.clone(), rec.steps[1].obs.clone())
+        };
+        let faithful = first_obs(FirstRecordObs::OverwrittenByFirstStep);
+        let fixed = first_obs(FirstRecordObs::Reset);
+        assert_eq!(faithful.0, [10.0, -2.0]);
+        assert_eq!(fixed.0, [-1.0, -2.0]);
+        assert_eq!(faithful.1, fixed.1);
+    }
+
+    #[test]
+    fn macro_rewards_are_discounted_inside_the_macro_action() {
+        // Agent 0 runs one 3-step macro-action, agent 1 finishes every step; reward 1 per step.
+        let mut rec = Recorder::starting(vec![0.0, 0.0], 2, 0.5);
+        let mut last = None;
+        for (t, done0) in [false, false, true].into_iter().enumerate() {
+            let parts = StepParts {
+                next_obs: vec![t as f32, t as f32],
+                executed: &[3, 1],
+                mac_done: &[done0, true],
+                next_avail: vec![1.0; 4],
+            };
+            last = rec.record_parts(parts, StepOutcome::running(1.0));
+        }
+        assert!(last.is_none());
+        let third = &rec.steps[2];
+        // 1 + 0.5 + 0.25, gamma_b = 0.5^2: the bootstrap is 0.5 x 0.25 = 0.5^3.
+        assert_eq!((third.rewards[0], third.gammas[0]), (1.75, 0.25));
+        assert_eq!((third.rewards[1], third.gammas[1]), (1.0, 1.0));
+        // The joint macro-action restarts after any agent finished: every step here.
+        assert_eq!((third.joint_reward, third.joint_gamma), (1.0, 1.0));
+    }
 }
