@@ -21,6 +21,7 @@ pub mod domain;
 pub mod macromarl;
 pub mod osd;
 pub mod overcooked;
+pub mod overcooked_acac;
 pub mod registry;
 pub mod replay;
 pub mod shape;
