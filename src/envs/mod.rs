@@ -12,6 +12,7 @@
 
 use rand_chacha::ChaCha8Rng;
 
+pub mod acac;
 pub mod bench;
 pub mod box_pushing;
 pub mod bp_ma_v0;
