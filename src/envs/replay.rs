@@ -533,6 +533,40 @@ mod tests {
     }
 
     #[test]
+    fn bad_acac_forms_name_the_problem() {
+        let ovc = |extra: &str, params: &str| {
+            format!(
+                r#"{{"source": "acac", "env": "Overcooked-MA-v1", "params": {{{params}}}{extra}, "steps": [[0, 0, 0]]}}"#
+            )
+        };
+        let e = error_of(&ovc("", ""));
+        assert!(e.contains("missing `np_seed`"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": -3"#, ""));
+        assert!(e.contains("`np_seed` must be numpy's seed"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1, "start_map": [[1]]"#, ""));
+        assert!(e.contains("`start_map` is for random starts only"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""rand_start": true"#));
+        assert!(e.contains("missing `start_map`"), "{e}");
+        let e = error_of(&ovc(
+            r#", "np_seed": 1, "start_map": [[1, 1], [1, 1]]"#,
+            r#""rand_start": true"#,
+        ));
+        assert!(e.contains("`start_map`: must be 7 rows of 7 cells"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""n_agent": 6"#));
+        assert!(e.contains("`n_agent`"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1, "seed": 2"#, ""));
+        assert!(e.contains("unknown field `seed`"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, "").replace("acac", "pymarl"));
+        assert!(e.contains("`source` must be"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, "").replace("MA-v1", "MA-v7"));
+        assert!(e.contains("not an ACAC environment"), "{e}");
+        // ACAC's fixed start is fine with np_seed alone; macdec's own form keeps refusing it.
+        assert!(parse_replay(&ovc(r#", "np_seed": 1"#, "")).is_ok());
+        let e = error_of(r#"{"env": "BP-MA-v0", "np_seed": 1, "params": {}, "steps": []}"#);
+        assert!(e.contains("unknown field `np_seed`"), "{e}");
+    }
+
+    #[test]
     fn busy_agents_may_hold_any_integer() {
         let file = parse_replay(&bp10("[[2, 7], [-1, 7], [99, 7]]")).unwrap();
         let replay = run_replay(&file, false).unwrap();

@@ -178,6 +178,30 @@ mod tests {
         assert_eq!(Domain::short_name(&d, &r), "acac-overcooked-b-r");
     }
 
+    /// Training draws random starts from the run's environment stream: the same seed gives the
+    /// same starts, another seed others, and successive resets differ.
+    #[test]
+    fn training_starts_come_from_the_runs_stream() {
+        use crate::envs::EnvRng;
+        use rand::SeedableRng;
+        let d = OvercookedAcacDomain;
+        let keys = Domain::keys(&d, &toml::toml! { rand_start = true }).unwrap();
+        let starts = |seed: u64| {
+            let mut env = Domain::build(&d, &keys).unwrap();
+            let mut rng = EnvRng::seed_from_u64(seed);
+            (0..4)
+                .map(|_| {
+                    env.reset(&mut rng);
+                    env.render_ascii()
+                })
+                .collect::<Vec<_>>()
+        };
+        let a = starts(1);
+        assert_eq!(a, starts(1));
+        assert_ne!(a, starts(2));
+        assert_ne!(a[0], a[1]);
+    }
+
     #[test]
     fn bad_keys_are_named() {
         let d = OvercookedAcacDomain;
