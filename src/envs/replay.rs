@@ -12,7 +12,13 @@
 //! horizon takes it from its params), `done` is the env's own terminal flag, and each line also
 //! has `rewards` (the per-agent list the reference returns) and, for a domain with a global state,
 //! `state` (the reference's `get_state()`), so the output diffs against the reference's trace
-//! (`scripts/macromarl_traces.py`).
+//! (`scripts/macromarl_traces.py`). `"source": "macromarl"` may name that origin.
+//!
+//! ACAC's form adds `"source": "acac"`: `env` is ACAC's gym id (its macdec domain from
+//! [`super::acac::GYM_IDS`]), `np_seed` (required) what `np.random.seed` got before the reset, and
+//! for random starts (`params.rand_start`) `start_map`, the grid that reset produced; both become
+//! the domain's replay keys, which check the grid against numpy's re-derived draws
+//! (`docs/ACAC.md`, `scripts/acac_traces.py`).
 
 use rand::SeedableRng;
 use serde::Serialize;
