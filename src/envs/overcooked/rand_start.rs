@@ -160,8 +160,8 @@ mod tests {
                 .flat_map(|x| (0..7).filter(move |&y| m[x][y] == 2))
                 .collect();
             assert!(agents.iter().any(|&y| y < 3) && agents.iter().any(|&y| y >= 3));
-            for x in 1..6 {
-                assert_eq!(m[x][3], 1, "the divider stays");
+            for row in &m[1..6] {
+                assert_eq!(row[3], 1, "the divider stays");
             }
         }
     }
