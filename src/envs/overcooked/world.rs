@@ -438,6 +438,23 @@ mod tests {
         assert_eq!(w.n_items(), 11);
     }
 
+    /// ACAC's `_createItems` scans column by column (spec acac_envs.md item 1).
+    #[test]
+    fn acac_numbers_agents_and_plates_column_by_column() {
+        let w = World::from_map(
+            start_map(7, MapType::A, 3).unwrap(),
+            7,
+            Numbering::ColumnMajor,
+        )
+        .unwrap();
+        let cooks: Vec<Cell> = w.cooks.iter().map(|c| c.at).collect();
+        assert_eq!(cooks, [Cell::new(1, 2), Cell::new(5, 2), Cell::new(1, 4)]);
+        assert_eq!(w.plates[0].at, Cell::new(6, 5));
+        assert_eq!(w.plates[1].at, Cell::new(5, 6));
+        assert_eq!(w.knives[0].at, Cell::new(1, 0));
+        assert_eq!(w.foods[0].at, Cell::new(0, 5));
+    }
+
     #[test]
     fn a_plate_carries_its_foods() {
         let mut w =
