@@ -36,8 +36,9 @@ pub enum Tile {
 }
 
 impl Tile {
-    /// The tile of the reference's index `i` (maps are written with these numbers).
-    const fn of(i: u8) -> Tile {
+    /// The tile of the reference's index `i` (maps are written with these numbers; above 8,
+    /// the onion).
+    pub const fn of(i: u8) -> Tile {
         match i {
             0 => Tile::Space,
             1 => Tile::Counter,
