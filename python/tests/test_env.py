@@ -2,6 +2,7 @@
 macro-action semantics, errors; vector_env equals N single environments."""
 
 import json
+import subprocess
 import warnings
 
 import numpy as np
@@ -200,3 +201,24 @@ def test_vector_env_equals_n_single_envs(env_id, params):
                 m = vinfo["action_mask"][k, i]
                 assert m[: venv.n_actions[i]].astype(np.int8).tolist() == inf[a]["action_mask"].tolist()
     assert ends > 0, "no episode ended: the auto-reset was not tested"
+
+
+def test_a_key_the_domain_does_not_read_is_refused_never_dropped(macdec_bin, tmp_path):
+    # Box Pushing has no noise: 0.5 was kept as 0.0 and the episode ran noiseless.
+    with pytest.raises(ValueError, match=r"`tb_m_noisy`.*leave it out"):
+        macdec.parallel_env("BP_MA", tb_m_noisy=0.5)
+    with pytest.raises(ValueError, match=r"`tb_m_noisy`"):
+        macdec.vector_env("BP_MA", 2, tb_m_noisy=0.5)
+    assert macdec.parallel_env("BP_MA", tb_m_noisy=0).params["tb_m_noisy"] == 0.0
+    # MacroMARL's script passes these to every env; Box Pushing and the Warehouses do not read them.
+    with pytest.raises(ValueError, match=r"`TB_move_speed`.*does not read it"):
+        macdec.parallel_env("BP-MA-v0", TB_move_speed=0.6)
+    with pytest.raises(ValueError, match=r"`n_agent`"):
+        macdec.vector_env("OSD-D-v7", 2, n_agent=3)
+    # `train` refuses the same keys, through the same check.
+    cfg = tmp_path / "bp.toml"
+    cfg.write_text('name = "bp"\nmethods = ["mac-iac"]\n[params]\nenv_name = "BP-MA-v0"\nTB_move_speed = 0.6\n')
+    out = subprocess.run([str(macdec_bin), "train", "--config", str(cfg), "--out", str(tmp_path / "out")], capture_output=True, text=True)
+    assert out.returncode != 0 and "`TB_move_speed`" in out.stderr, out.stderr
+    with pytest.raises(ValueError, match="`TB_move_speed`"):
+        macdec.train(config=str(cfg), out=str(tmp_path / "out2"))

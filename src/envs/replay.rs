@@ -12,7 +12,10 @@
 //! horizon takes it from its params), `done` is the env's own terminal flag, and each line also
 //! has `rewards` (the per-agent list the reference returns) and, for a domain with a global state,
 //! `state` (the reference's `get_state()`), so the output diffs against the reference's trace
-//! (`scripts/macromarl_traces.py`). `"source": "macromarl"` may name that origin.
+//! (`scripts/macromarl_traces.py`). `"source": "macromarl"` may name that origin. `params` records
+//! the reference's `gym.make` call, so the kwargs MacroMARL's script passes to every environment
+//! and this one does not read are left out, as the reference left them unread; any other key the
+//! domain does not have is refused.
 //!
 //! ACAC's form adds `"source": "acac"`: `env` is ACAC's gym id (its macdec domain from
 //! [`super::acac::GYM_IDS`]), `np_seed` (required) what `np.random.seed` got before the reset, and
@@ -190,7 +193,14 @@ fn reference_spec(
     given
         .entry(super::domain::HORIZON_KEY)
         .or_insert_with(|| (n_steps.max(1) as i64).into());
-    EnvSpec::new(env, &given).map_err(ReplayFileError::BadParams)
+    // `params` records the reference's gym.make call: the shared kwargs its env did not read
+    // mean nothing here either (anything else unknown is refused by the domain).
+    let domain = super::registry::lookup(env).map_err(|e| ReplayFileError::BadParams(e.into()))?;
+    let own = domain
+        .keys(&toml::Table::new())
+        .expect("a domain's defaults are valid");
+    let given = super::macromarl::kwargs_read(&given, &own);
+    EnvSpec::of(domain, &given).map_err(ReplayFileError::BadParams)
 }
 
 /// The ACAC form's `np_seed` (required) and `start_map` (random starts only) as the domain's

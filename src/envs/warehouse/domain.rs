@@ -5,8 +5,8 @@
 
 use super::{Warehouse, WarehouseParams};
 use crate::envs::domain::{
-    fill_keys, key_f64, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain,
-    KeyError, HORIZON_KEY,
+    fill_keys, fixed_key, key_f64, key_table, key_usize, refuse_unknown_fields, tagged_count,
+    Domain, KeyError, HORIZON_KEY,
 };
 use crate::envs::EnvError;
 
@@ -65,7 +65,12 @@ impl Domain for WarehouseDomain {
                 ("tb_m_noisy", p.tb_move_noisy.into()),
             ]),
         )?;
-        keys.insert("grid_dim".into(), RECORDED_GRID_DIM.into());
+        fixed_key(
+            &mut keys,
+            "grid_dim",
+            RECORDED_GRID_DIM.into(),
+            "the ICRA Warehouse",
+        )?;
         params(&keys)?.validate().map_err(key_of)?;
         Ok(keys)
     }
