@@ -48,6 +48,7 @@ fn imported_actors_evaluate_exactly_as_deployed_on_robot_processes() {
     // A kwarg MacroMARL's script passes to every env but Box Pushing does not read is refused by
     // name, as `train` refuses it, and so is --tb-m-noisy, which BP-MA-v0 has no key for.
     std::fs::write(&params, r#"{"grid_dim": [6, 6], "TB_move_speed": 0.8}"#).unwrap();
+    let agent_list = list(&agents);
     let import = |extra: &[&str]| {
         let args = [
             &[
@@ -59,7 +60,7 @@ fn imported_actors_evaluate_exactly_as_deployed_on_robot_processes() {
                 "--params",
                 params.to_str().unwrap(),
                 "--agents",
-                &list(&agents),
+                &agent_list,
                 "--out",
                 policy.to_str().unwrap(),
             ][..],

@@ -427,6 +427,7 @@ impl VectorEnv {
     /// Reset every copy; copy k restarts its stream at `seed + k` (`None`: fresh OS seeds).
     /// Returns `(obs [N, n_agents, max_obs] float32, action_mask [N, n_agents, max_actions] bool)`.
     #[pyo3(signature = (seed=None))]
+    #[allow(clippy::type_complexity)]
     fn reset<'py>(
         &mut self,
         py: Python<'py>,

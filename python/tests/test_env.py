@@ -145,8 +145,13 @@ def test_bad_input_raises_errors_naming_the_problem():
         macdec.vector_env("BP_MA", 2, grid_dim=deep)
     venv = macdec.vector_env("BP_MA", 2)
     venv.reset(seed=0)
-    with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\)"):
-        venv.step(np.zeros((2, 3), dtype=np.int64))
+    for shape in [(2, 3), (4,), (2, 2, 1), ()]:
+        with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\), got shape"):
+            venv.step(np.zeros(shape, dtype=np.int64))
+    with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\), got a ragged"):
+        venv.step([[0, 0], [0]])
+    with pytest.raises(ValueError, match=r"env 1, agent 0: the macro-action must be in 0..8, got 18446744073709551615"):
+        venv.step(np.array([[0, 0], [2**64 - 1, 0]], dtype=np.uint64))
     with pytest.raises(ValueError, match="env 1, agent 0"):
         venv.step(np.array([[0, 0], [9, 0]]))
     with pytest.raises(ValueError, match="integers"):

@@ -141,8 +141,12 @@ mod tests {
         }
         assert_eq!(spec(150, 0.3).horizon(), 150);
         assert_eq!(paper_spec().paper_discount(), Some(1.0));
-        // The unused grid is recorded as the reference's default whatever a file says.
-        let keys = Domain::keys(&d, &key_table([("grid_dim", 30.into())])).unwrap();
+        // The unused grid is recorded as the reference's default; another value is refused,
+        // not dropped.
+        let keys = Domain::keys(&d, &key_table([("grid_dim", 10.into())])).unwrap();
         assert_eq!(keys["grid_dim"].as_integer(), Some(10));
+        let err = Domain::keys(&d, &key_table([("grid_dim", 30.into())])).unwrap_err();
+        assert_eq!(err.key, "grid_dim");
+        assert!(err.message.contains("does not read this key"), "{err:?}");
     }
 }
