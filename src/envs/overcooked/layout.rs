@@ -10,6 +10,9 @@ use serde::{Deserialize, Serialize};
 
 /// Largest grid side the reference has maps for (9 x 9).
 pub const MAX_SIDE: usize = 9;
+/// Most agents a kitchen holds (ACAC's Large kitchen has 6): the capacity of the agents' buffers
+/// and of a random start's draws.
+pub const MAX_AGENTS: usize = 6;
 
 /// What a cell of a map holds, as the reference's `ITEMNAME` / `ITEMIDX` number it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

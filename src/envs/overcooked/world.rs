@@ -191,7 +191,7 @@ impl World {
             }; 2],
             knives: [station; 2],
             delivery: station,
-            cooks: Vec::with_capacity(super::rand_start::MAX_AGENTS),
+            cooks: Vec::with_capacity(super::layout::MAX_AGENTS),
         };
         w.restart_from(map, numbering)?;
         Ok(w)

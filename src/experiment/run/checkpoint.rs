@@ -313,8 +313,9 @@ mod tests {
         assert!(e.to_string().contains("older macdec"), "{e}");
         assert!(e.to_string().contains("delete it"), "{e}");
         // Versions 1 (the value-based trainer before the learner seam), 2 (before the
-        // undiscounted return) and 3 (before the one list of families), and any future version.
-        for found in [1, 2, 3, 5] {
+        // undiscounted return), 3 (before the one list of families) and 4 (before ACAC's
+        // Overcooked), and any future version.
+        for found in [1, 2, 3, 4, 6] {
             let mut other = encode(&tiny().0, &t).unwrap();
             other[8] = found as u8;
             assert_eq!(
