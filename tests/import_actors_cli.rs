@@ -175,6 +175,19 @@ fn bad_actor_files_and_arguments_are_refused_and_nothing_is_written() {
         e.contains("fc1.weight") && e.contains("5 observation values"),
         "{e}"
     );
+    // Agents whose actors have different widths: named as such, not as an unreadable file.
+    let narrow_dir = dir.path().join("narrow");
+    std::fs::create_dir(&narrow_dir).unwrap();
+    let narrow = write_actors(&narrow_dir, &env, [6, 8], 4);
+    let n1 = narrow[1].to_str().unwrap();
+    let e = import(&["--env", "BP-MA-v0", "--agents", &format!("{a0},{n1}")]);
+    assert!(
+        e.contains("widths [6, 8]")
+            && e.contains("[8, 8]")
+            && e.contains("share one architecture")
+            && !e.contains("not a safetensors file"),
+        "{e}"
+    );
     let e = import(&["--env", "Pong-v0", "--agents", a0]);
     assert!(e.contains("unknown domain `Pong-v0`"), "{e}");
     let e = import(&["--env", "BP-MA-v0", "--grid", "10", "--agents", a0]);
