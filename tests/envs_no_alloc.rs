@@ -75,6 +75,13 @@ fn stepping_and_resetting_allocate_nothing() {
             specs.push(EnvSpec::new("Overcooked-MA-v1", &keys).unwrap());
         }
     }
+    // ACAC's copy, fixed and random starts (drawn from the run's stream at every reset).
+    for rand_start in [false, true] {
+        let keys = toml::toml! { map_type = "B" };
+        let mut keys = keys.clone();
+        keys.insert("rand_start".into(), rand_start.into());
+        specs.push(EnvSpec::new("ACAC-Overcooked-MA-v1", &keys).unwrap());
+    }
     for spec in specs {
         let mut env = spec.build().unwrap();
         let mut policy_rng = ChaCha8Rng::seed_from_u64(3);

@@ -2,6 +2,7 @@
 
 use macdec::algos::actor_critic::method::AcMethod;
 use macdec::algos::families::Method;
+use macdec::algos::mac_value::method::MacValueMethod;
 use macdec::algos::value::method::ValueMethod;
 use macdec::experiment::definition::config::{Experiment, Overrides};
 use std::path::Path;
@@ -214,4 +215,92 @@ fn a_shared_curve_must_name_a_method_and_a_plain_experiment() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("expected an experiment name"), "{err}");
+}
+
+#[test]
+fn macromarl_value_blocks_have_twenty_seeds_both_methods_and_their_scripts_rows() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/macromarl_value");
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let e = Experiment::load(&path, &Overrides::default())
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(e.seeds, (0..20).collect::<Vec<u64>>(), "{}", e.name);
+        assert_eq!(
+            e.methods,
+            [
+                Method::MacValue(MacValueMethod::MacDecQ),
+                Method::MacValue(MacValueMethod::MacCenQ)
+            ],
+            "{}",
+            e.name
+        );
+        for run in e.runs().unwrap().iter().filter(|r| r.seed == 0) {
+            let c = run
+                .config
+                .of::<MacValueMethod>()
+                .expect("a value-based config");
+            // Every published block decays epsilon to 0.05 and moves off the argparse lr.
+            assert_eq!(c.eps_end, 0.05, "{} {}", e.name, run.method);
+            assert_ne!(c.l_rate, 0.0006, "{} {}", e.name, run.method);
+            assert_eq!(c.h_stable_at, c.eps_l_d_steps, "{} {}", e.name, run.method);
+        }
+        names.push(e.name);
+    }
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "bp10",
+            "bp12",
+            "bp20",
+            "bp30",
+            "bp8",
+            "overcooked_a",
+            "overcooked_b",
+            "wh_a",
+            "wh_b",
+            "wh_c"
+        ]
+    );
+    // Spot checks against docs/MACROMARL.md 8.3.
+    let of = |file: &str, m: MacValueMethod| {
+        load(file)
+            .runs()
+            .unwrap()
+            .into_iter()
+            .find(|r| r.method == Method::MacValue(m))
+            .unwrap()
+            .config
+            .of::<MacValueMethod>()
+            .unwrap()
+            .clone()
+    };
+    let dec = of("macromarl_value/bp30.toml", MacValueMethod::MacDecQ);
+    assert_eq!((dec.l_rate, dec.trace_len, dec.batch_size), (5e-4, 45, 32));
+    assert_eq!((dec.init_h, dec.end_h, dec.sample_epi), (0.2, 0.4, false));
+    let cen = of("macromarl_value/bp10.toml", MacValueMethod::MacCenQ);
+    assert_eq!((cen.batch_size, cen.rnn_h_size, cen.init_h), (128, 64, 1.0));
+    let cen = of("macromarl_value/wh_c.toml", MacValueMethod::MacCenQ);
+    assert_eq!(
+        (cen.train_freq, cen.init_h, cen.total_epi),
+        (64, 0.2, 80_000)
+    );
+    let cen = of("macromarl_value/wh_b.toml", MacValueMethod::MacCenQ);
+    assert_eq!((cen.l_rate, cen.init_h), (1e-4, 1.0));
+    let dec = of("macromarl_value/wh_b.toml", MacValueMethod::MacDecQ);
+    assert_eq!(
+        (dec.l_rate, dec.sample_epi, dec.replay_buffer_size),
+        (5e-5, true, 2000)
+    );
+    let cen = of("macromarl_value/overcooked_b.toml", MacValueMethod::MacCenQ);
+    assert_eq!(
+        (cen.start_train, cen.mlp_layer_size.clone(), cen.h_explore),
+        (500, vec![128, 64], true)
+    );
+    let dec = of("macromarl_value/overcooked_a.toml", MacValueMethod::MacDecQ);
+    assert_eq!(
+        (dec.l_rate, dec.init_h, dec.total_epi),
+        (5e-4, 1.0, 100_000)
+    );
 }

@@ -1,7 +1,10 @@
-//! MacroMARL's domains replay the reference step for step (issue 27).
+//! MacroMARL's domains (issue 27) and ACAC's environment copies (issue 41 item 3) replay the
+//! reference step for step.
 //!
 //! Each fixture in `tests/fixtures/macromarl/` is a pair written by `scripts/macromarl_traces.py`
-//! from the reference code itself (`scripts/macromarl_fixtures.sh` regenerates them all): the
+//! from the reference code itself (`scripts/macromarl_fixtures.sh` regenerates them all), each in
+//! `tests/fixtures/acac/` one written by `scripts/acac_traces.py` from ACAC's code
+//! (`scripts/acac_fixtures.sh`, which also records numpy's seed and the random start): the
 //! actions in the reference form of `macdec replay` (`NAME.actions.json`) and what the reference
 //! printed for them (`NAME.trace.jsonl.gz`). The replay of the actions must give the same lines:
 //! the same number of steps, the same executed macro-actions, `mac_done` and `done` flags, and
@@ -13,9 +16,10 @@ use std::path::PathBuf;
 use macdec::envs::replay::{parse_replay, run_replay};
 use serde_json::Value;
 
+/// `tests/fixtures/NAME.EXT`; `name` starts with its folder (`macromarl/`, `acac/`).
 fn fixture(name: &str, ext: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/macromarl")
+        .join("tests/fixtures")
         .join(format!("{name}.{ext}"))
 }
 
@@ -82,9 +86,14 @@ fn replays_like_the_reference(name: &str) {
     }
 }
 
+/// Replay the fixtures `names` of MacroMARL's folder.
 fn all(names: &[&str]) {
+    in_folder("macromarl", names);
+}
+
+fn in_folder(folder: &str, names: &[&str]) {
     for name in names {
-        replays_like_the_reference(name);
+        replays_like_the_reference(&format!("{folder}/{name}"));
     }
 }
 
@@ -106,6 +115,8 @@ fn bp_ma_v0_replays_the_reference() {
         .map(String::from),
     );
     all(&names.iter().map(String::as_str).collect::<Vec<_>>());
+    // ACAC's runner passes `terminate_step` and an integer `big_box_reward`; the env is the same.
+    in_folder("acac", &["bp6_random7"]);
 }
 
 #[test]
@@ -162,4 +173,27 @@ fn overcooked_ma_v1_replays_the_reference() {
         "overcooked_a_n3_actors",
         "overcooked_b_n3_actors",
     ]);
+}
+
+#[test]
+fn acac_overcooked_ma_v1_replays_acacs_code() {
+    // Fixed starts: ACAC numbers agents and plates column by column.
+    in_folder(
+        "acac",
+        &["ovc_a7_random0", "ovc_b7_random1", "ovc_c7_random2"],
+    );
+}
+
+#[test]
+fn acac_random_starts_replay_numpys_draws() {
+    // Each file's `start_map` is checked against the port of numpy's draws from its `np_seed`.
+    in_folder(
+        "acac",
+        &[
+            "ovc_ar7_np3_random3",
+            "ovc_br7_np4_random4",
+            "ovc_cr7_np5_random5",
+            "ovc_br7_np123456789_random6",
+        ],
+    );
 }

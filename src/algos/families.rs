@@ -24,6 +24,7 @@ macro_rules! method_families {
         $then! {
             Value(crate::algos::value::method::ValueMethod),
             ActorCritic(crate::algos::actor_critic::method::AcMethod),
+            MacValue(crate::algos::mac_value::method::MacValueMethod),
         }
     };
 }
@@ -416,7 +417,7 @@ mod tests {
     #[test]
     fn names_round_trip_through_from_str_and_serde() {
         let all = Method::all();
-        assert_eq!(all.len(), 11);
+        assert_eq!(all.len(), 15);
         for m in all {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
             let json = serde_json::to_string(&m).unwrap();

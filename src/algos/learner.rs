@@ -32,6 +32,9 @@ pub enum Schedule {
         target_update_freq: u64,
         /// Evaluate before training and every `eval_freq` training episodes.
         eval_freq: u64,
+        /// The number of the first main-loop step in the train and target-sync checks: 0 for
+        /// the ICRA loop, 1 for MacroMARL's value-based `learn()` (`step += 1` comes first).
+        first_step: u64,
     },
     /// MacroMARL's collection (`docs/MACROMARL.md` §2.3): every update first resets every lane,
     /// steps them in lockstep until at least `train_freq` episodes have completed (the

@@ -18,6 +18,7 @@ pub mod config_checks;
 pub mod families;
 pub mod family;
 pub mod learner;
+pub mod mac_value;
 pub mod train_error;
 pub mod training_loop;
 pub mod value;

@@ -258,11 +258,10 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
                     start_train,
                     target_update_freq,
                     eval_freq,
+                    first_step,
                 } => self.main_loop_iteration(
-                    train_freq,
-                    start_train,
-                    target_update_freq,
-                    eval_freq,
+                    [train_freq, start_train, target_update_freq, eval_freq],
+                    first_step,
                 )?,
                 Schedule::EpisodeBatches {
                     train_freq,
@@ -322,10 +321,8 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
     /// whether a training episode finished.
     fn main_loop_iteration(
         &mut self,
-        train_freq: u64,
-        start_train: u64,
-        target_update_freq: u64,
-        eval_freq: u64,
+        [train_freq, start_train, target_update_freq, eval_freq]: [u64; 4],
+        first_step: u64,
     ) -> Result<bool, TrainError> {
         if !self.evaluated_once {
             self.evaluated_once = true;
@@ -342,12 +339,13 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
                 self.evaluate()?;
             }
         }
-        if self.step.is_multiple_of(train_freq) && self.episodes >= start_train {
+        let counted = self.step + first_step;
+        if counted.is_multiple_of(train_freq) && self.episodes >= start_train {
             let lanes: Vec<&L::Lane> = self.lanes.iter().map(|l| &l.state).collect();
             self.learner.train_iteration(&lanes, self.episodes)?;
             self.updates += 1;
         }
-        if self.step.is_multiple_of(target_update_freq) {
+        if counted.is_multiple_of(target_update_freq) {
             self.learner.sync_targets();
         }
         self.step += 1;
@@ -450,6 +448,7 @@ mod tests {
                 start_train: 1,
                 target_update_freq: 5,
                 eval_freq: 2,
+                first_step: 0,
             }
         }
         fn lanes(&self) -> Vec<LanePlan> {

@@ -12,6 +12,7 @@
 
 use rand_chacha::ChaCha8Rng;
 
+pub mod acac;
 pub mod bench;
 pub mod box_pushing;
 pub mod bp_ma_v0;
@@ -21,6 +22,7 @@ pub mod domain;
 pub mod macromarl;
 pub mod osd;
 pub mod overcooked;
+pub mod overcooked_acac;
 pub mod registry;
 pub mod replay;
 pub mod shape;

@@ -12,7 +12,16 @@
 //! horizon takes it from its params), `done` is the env's own terminal flag, and each line also
 //! has `rewards` (the per-agent list the reference returns) and, for a domain with a global state,
 //! `state` (the reference's `get_state()`), so the output diffs against the reference's trace
-//! (`scripts/macromarl_traces.py`).
+//! (`scripts/macromarl_traces.py`). `"source": "macromarl"` may name that origin. `params` records
+//! the reference's `gym.make` call, so the kwargs MacroMARL's script passes to every environment
+//! and this one does not read are left out, as the reference left them unread; any other key the
+//! domain does not have is refused.
+//!
+//! ACAC's form adds `"source": "acac"`: `env` is ACAC's gym id (its macdec domain from
+//! [`super::acac::GYM_IDS`]), `np_seed` (required) what `np.random.seed` got before the reset, and
+//! for random starts (`params.rand_start`) `start_map`, the grid that reset produced; both become
+//! the domain's replay keys, which check the grid against numpy's re-derived draws
+//! (`docs/ACAC.md`, `scripts/acac_traces.py`).
 
 use rand::SeedableRng;
 use serde::Serialize;
@@ -139,10 +148,27 @@ fn reference_spec(
     let Some(Value::String(env)) = map.get("env") else {
         return Err(ReplayFileError::MissingEnv);
     };
-    if let Some(other) = map.keys().find(|k| *k != "env") {
-        return Err(ReplayFileError::BadSpec(serde::de::Error::custom(format!(
-            "unknown field `{other}` beside `params` (the reference form has `env`, `params` and `steps`)"
-        ))));
+    let custom = |m: String| ReplayFileError::BadSpec(serde::de::Error::custom(m));
+    let acac = match map.get("source") {
+        None => false,
+        Some(Value::String(s)) if s == "macromarl" => false,
+        Some(Value::String(s)) if s == "acac" => true,
+        Some(other) => {
+            return Err(custom(format!(
+                "`source` must be \"macromarl\" or \"acac\", got {other}"
+            )))
+        }
+    };
+    let fields: &[&str] = if acac {
+        &["env", "source", "np_seed", "start_map"]
+    } else {
+        &["env", "source"]
+    };
+    if let Some(other) = map.keys().find(|k| !fields.contains(&k.as_str())) {
+        return Err(custom(format!(
+            "unknown field `{other}` beside `params` (this form has `{}`, `params` and `steps`)",
+            fields.join("`, `")
+        )));
     }
     let Value::Object(params) = params else {
         return Err(ReplayFileError::ParamsNotAnObject(json_kind(&params)));
@@ -153,10 +179,69 @@ fn reference_spec(
             super::domain::json_to_toml(v).ok_or_else(|| ReplayFileError::NullParam(k.clone()))?;
         given.insert(k.clone(), value);
     }
+    let env = if acac {
+        acac_start_keys(map, &mut given)?;
+        super::acac::domain_of(env).ok_or_else(|| {
+            custom(format!(
+                "`{env}` is not an ACAC environment macdec has; ACAC's are {:?}",
+                super::acac::GYM_IDS.map(|(id, _)| id)
+            ))
+        })?
+    } else {
+        env.as_str()
+    };
     given
         .entry(super::domain::HORIZON_KEY)
         .or_insert_with(|| (n_steps.max(1) as i64).into());
-    EnvSpec::new(env, &given).map_err(ReplayFileError::BadParams)
+    // `params` records the reference's gym.make call: the shared kwargs its env did not read
+    // mean nothing here either (anything else unknown is refused by the domain).
+    let domain = super::registry::lookup(env).map_err(|e| ReplayFileError::BadParams(e.into()))?;
+    let own = domain
+        .keys(&toml::Table::new())
+        .expect("a domain's defaults are valid");
+    let given = super::macromarl::kwargs_read(&given, &own);
+    EnvSpec::of(domain, &given).map_err(ReplayFileError::BadParams)
+}
+
+/// The ACAC form's `np_seed` (required) and `start_map` (random starts only) as the domain's
+/// replay keys when `params` ask for a random start; refused where they mean nothing.
+fn acac_start_keys(
+    map: &serde_json::Map<String, Value>,
+    given: &mut toml::Table,
+) -> Result<(), ReplayFileError> {
+    let custom = |m: String| ReplayFileError::BadSpec(serde::de::Error::custom(m));
+    let seed = match map.get("np_seed") {
+        Some(Value::Number(n)) if n.as_u64().is_some_and(|s| s <= u64::from(u32::MAX)) => {
+            n.as_u64().unwrap_or_default()
+        }
+        Some(v) => {
+            return Err(custom(format!(
+                "`np_seed` must be numpy's seed, an integer 0..=4294967295, got {v}"
+            )))
+        }
+        None => {
+            return Err(custom(
+                "missing `np_seed` (what np.random.seed got before the reset)".into(),
+            ))
+        }
+    };
+    let random = given.get("rand_start") == Some(&toml::Value::Boolean(true));
+    match (random, map.get("start_map")) {
+        (false, Some(_)) => Err(custom(
+            "`start_map` is for random starts only, and `params.rand_start` is not true".into(),
+        )),
+        (false, None) => Ok(()),
+        (true, None) => Err(custom(
+            "missing `start_map` (the grid the random start produced)".into(),
+        )),
+        (true, Some(grid)) => {
+            let grid = super::domain::json_to_toml(grid)
+                .ok_or_else(|| custom("`start_map` holds a null".into()))?;
+            given.insert("np_seed".into(), (seed as i64).into());
+            given.insert("start_map".into(), grid);
+            Ok(())
+        }
+    }
 }
 
 fn json_kind(v: &Value) -> &'static str {
@@ -461,6 +546,40 @@ mod tests {
         assert!(e.contains("`env` must be a string"), "{e}");
         let e = error_of(r#"{"env": "BP-MA-v0", "params": {"colour": 1}, "steps": []}"#);
         assert!(e.contains("`colour`: not a key of this domain"), "{e}");
+    }
+
+    #[test]
+    fn bad_acac_forms_name_the_problem() {
+        let ovc = |extra: &str, params: &str| {
+            format!(
+                r#"{{"source": "acac", "env": "Overcooked-MA-v1", "params": {{{params}}}{extra}, "steps": [[0, 0, 0]]}}"#
+            )
+        };
+        let e = error_of(&ovc("", ""));
+        assert!(e.contains("missing `np_seed`"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": -3"#, ""));
+        assert!(e.contains("`np_seed` must be numpy's seed"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1, "start_map": [[1]]"#, ""));
+        assert!(e.contains("`start_map` is for random starts only"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""rand_start": true"#));
+        assert!(e.contains("missing `start_map`"), "{e}");
+        let e = error_of(&ovc(
+            r#", "np_seed": 1, "start_map": [[1, 1], [1, 1]]"#,
+            r#""rand_start": true"#,
+        ));
+        assert!(e.contains("`start_map`: must be 7 rows of 7 cells"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""n_agent": 6"#));
+        assert!(e.contains("`n_agent`"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1, "seed": 2"#, ""));
+        assert!(e.contains("unknown field `seed`"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, "").replace("acac", "pymarl"));
+        assert!(e.contains("`source` must be"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, "").replace("MA-v1", "MA-v7"));
+        assert!(e.contains("not an ACAC environment"), "{e}");
+        // ACAC's fixed start is fine with np_seed alone; macdec's own form keeps refusing it.
+        assert!(parse_replay(&ovc(r#", "np_seed": 1"#, "")).is_ok());
+        let e = error_of(r#"{"env": "BP-MA-v0", "np_seed": 1, "params": {}, "steps": []}"#);
+        assert!(e.contains("unknown field `np_seed`"), "{e}");
     }
 
     #[test]

@@ -228,6 +228,19 @@ impl GruActor {
         &state.out
     }
 
+    /// One acting step like [`Self::act_step`] but giving fc4's raw outputs (no log_softmax):
+    /// the Q-values when the net is MacroMARL's value-based `DDRQN`, which has these layers.
+    pub fn q_step<'s>(&self, x: &[f32], state: &'s mut GruActorState) -> &'s [f32] {
+        assert_eq!(x.len(), self.fc1.input(), "q_step: input length");
+        self.fc1.forward_row(x, LEAKY, &mut state.a1);
+        self.fc2.forward_row(&state.a1, LEAKY, &mut state.a2);
+        self.gru.step(&state.a2, &mut state.gru);
+        self.fc3.forward_row(state.gru.h(), LEAKY, &mut state.a3);
+        self.fc4
+            .forward_row(&state.a3, Activation::Identity, &mut state.out);
+        &state.out
+    }
+
     /// The GRU's parameters.
     pub fn gru(&self) -> &GruParams {
         &self.gru

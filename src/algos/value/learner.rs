@@ -171,6 +171,7 @@ impl Learner for ValueLearner {
             start_train: self.c().start_train as u64,
             target_update_freq: self.c().target_update_freq as u64,
             eval_freq: self.c().eval_freq as u64,
+            first_step: 0,
         }
     }
 

@@ -33,7 +33,7 @@ const REWARD_KEYS: [&str; 4] = [
 /// The Overcooked domain.
 pub struct OvercookedDomain;
 
-fn default_rewards() -> toml::Table {
+pub(crate) fn default_rewards() -> toml::Table {
     let r = Rewards::default();
     key_table([
         (REWARD_KEYS[0], r.subtask_finished.into()),
@@ -103,7 +103,7 @@ pub fn map_letter(keys: &toml::Table) -> char {
     params(keys).map_or('A', |p| p.map.letter().chars().next().unwrap_or('A'))
 }
 
-fn params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
+pub(crate) fn params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
     let string = |k: &str| keys.get(k).and_then(|v| v.as_str()).map(str::to_string);
     let map_letter = string("map_type").unwrap_or_default();
     let map = super::layout::MapType::parse(&map_letter).ok_or_else(|| {
@@ -124,7 +124,7 @@ fn params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
 }
 
 /// The config key of a parameter [`OvercookedParams::validate`] names.
-fn key_of(e: EnvError) -> KeyError {
+pub(crate) fn key_of(e: EnvError) -> KeyError {
     match e {
         EnvError::InvalidParameter { name, reason } => KeyError::new(
             match name {

@@ -10,6 +10,9 @@ use serde::{Deserialize, Serialize};
 
 /// Largest grid side the reference has maps for (9 x 9).
 pub const MAX_SIDE: usize = 9;
+/// Most agents a kitchen holds (ACAC's Large kitchen has 6): the capacity of the agents' buffers
+/// and of a random start's draws.
+pub const MAX_AGENTS: usize = 6;
 
 /// What a cell of a map holds, as the reference's `ITEMNAME` / `ITEMIDX` number it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -36,8 +39,9 @@ pub enum Tile {
 }
 
 impl Tile {
-    /// The tile of the reference's index `i` (maps are written with these numbers).
-    const fn of(i: u8) -> Tile {
+    /// The tile of the reference's index `i` (maps are written with these numbers; above 8,
+    /// the onion).
+    pub const fn of(i: u8) -> Tile {
         match i {
             0 => Tile::Space,
             1 => Tile::Counter,

@@ -23,7 +23,9 @@ mod domain;
 pub mod draw;
 pub mod layout;
 pub mod macro_actions;
+pub mod numpy_random;
 pub mod observe;
+pub mod rand_start;
 mod render;
 pub mod step;
 pub mod world;
@@ -33,12 +35,19 @@ mod scenarios;
 
 pub use domain::{map_letter, OvercookedDomain, PAPER_N_AGENT, REFERENCE_N_AGENT};
 
+/// The key readers ACAC's copy of the domain shares (`crate::envs::overcooked_acac`).
+pub(crate) mod domain_keys {
+    pub(crate) use super::domain::{default_rewards, key_of, params};
+}
+
 use self::astar::PyHeap;
-use self::layout::{belief_base, start_map, Cells, MapType};
+use self::layout::{belief_base, start_map, Cells, MapType, Tile};
 use self::macro_actions::{ended_after_step, low_level, names, Ctx, MacState};
+use self::numpy_random::DrawInt;
+use self::numpy_random::NumpyRandom;
 use self::observe::{macro_obs, obs_len, reset_belief, update_belief, Belief, TASKS};
 use self::step::{primitive_step, Rewards};
-use self::world::{World, STAY};
+use self::world::{Numbering, World, STAY};
 use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
 
 /// Everything that defines an Overcooked environment (the reference's constructor arguments
@@ -61,6 +70,24 @@ pub struct OvercookedParams {
     pub horizon: usize,
     /// The view radius (`obs_radius`, 2; MacroMARL never passes it).
     pub obs_radius: usize,
+    /// Whose code numbers the agents, plates and knives: gym-macro-overcooked's row-major scan
+    /// or ACAC's column-major one ([`Numbering`]).
+    pub numbering: Numbering,
+    /// Whether the env has ACAC's global state (`get_vector_state`, [`MacroEnv::write_state`]);
+    /// gym-macro-overcooked's has none.
+    pub vector_state: bool,
+    /// ACAC's `rand_start`: every reset draws a new start map ([`rand_start`]), from the run's
+    /// environment stream unless [`Self::np_seed`] is set. Before the first reset the kitchen is
+    /// the fixed start map.
+    pub rand_start: bool,
+    /// With `rand_start`: draw the starts from numpy's legacy stream seeded so (what ACAC's
+    /// worker gave `np.random.seed`, continued across resets as ACAC's worker does), not from
+    /// the run's stream. For replaying ACAC's episodes.
+    pub np_seed: Option<u32>,
+    /// With `rand_start`: the grid ACAC's first reset produced (the reference's codes, rows
+    /// first). With `np_seed` it must be what numpy's draws give, which building checks; without,
+    /// every reset starts from it.
+    pub start_map: Option<Vec<Vec<u8>>>,
 }
 
 impl Default for OvercookedParams {
@@ -74,6 +101,11 @@ impl Default for OvercookedParams {
             n_agent: PAPER_N_AGENT,
             horizon: 200,
             obs_radius: 2,
+            numbering: Numbering::RowMajor,
+            vector_state: false,
+            rand_start: false,
+            np_seed: None,
+            start_map: None,
         }
     }
 }
@@ -106,6 +138,16 @@ impl OvercookedParams {
                 format!("must be 1..=9, got {}", self.obs_radius),
             );
         }
+        if !self.rand_start && (self.np_seed.is_some() || self.start_map.is_some()) {
+            return bad(
+                if self.np_seed.is_some() {
+                    "np_seed"
+                } else {
+                    "start_map"
+                },
+                "only a random start (`rand_start = true`) draws a start map".into(),
+            );
+        }
         Ok(())
     }
 }
@@ -114,6 +156,12 @@ impl OvercookedParams {
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Overcooked {
     params: OvercookedParams,
+    /// The fixed start map (`initMap`), which random starts draw from.
+    init: Cells,
+    /// The start map every reset uses ([`OvercookedParams::start_map`]), checked.
+    fixed_start: Option<Cells>,
+    /// numpy's stream when the starts replay ACAC's ([`OvercookedParams::np_seed`]).
+    numpy: Option<NumpyRandom>,
     /// The kitchen at reset.
     start: World,
     world: World,
@@ -144,13 +192,23 @@ impl Overcooked {
                 name: "grid_dim",
                 reason: "no map for this grid and agent count".into(),
             })?;
-        let start = World::from_map(map, params.side).map_err(|e| EnvError::InvalidParameter {
-            name: "map_type",
-            reason: format!("the map has no {}", e.0),
+        let start = World::from_map(map, params.side, params.numbering).map_err(|e| {
+            EnvError::InvalidParameter {
+                name: "map_type",
+                reason: format!("the map has no {}", e.0),
+            }
         })?;
+        let numpy = params.np_seed.map(NumpyRandom::seed);
+        let fixed_start = match &params.start_map {
+            None => None,
+            Some(rows) => Some(checked_start_map(rows, &map, &params, numpy.clone())?),
+        };
         let len = obs_len(n);
         let mut env = Overcooked {
             base: belief_base(params.side, params.map),
+            init: map,
+            fixed_start,
+            numpy,
             world: start.clone(),
             start,
             beliefs: vec![
@@ -198,6 +256,19 @@ impl Overcooked {
 
     fn radius(&self) -> i32 {
         self.params.obs_radius as i32
+    }
+
+    /// ACAC's `reset` with `rand_start`: a new start kitchen (`_make_new_rand_map`, then
+    /// `_createItems`), from the fixed start map, numpy's stream or the run's `rng`.
+    fn draw_start(&mut self, rng: &mut EnvRng) {
+        let map = match (&mut self.numpy, &self.fixed_start) {
+            (Some(numpy), _) => random_start_map(&self.init, &self.params, numpy),
+            (None, Some(map)) => *map,
+            (None, None) => random_start_map(&self.init, &self.params, rng),
+        };
+        self.start
+            .restart_from(map, self.params.numbering)
+            .expect("a random start keeps every item of the start map");
     }
 
     /// `Overcooked_MA_V1.reset`: the start kitchen, full beliefs then the first view, every
@@ -316,7 +387,10 @@ impl MacroEnv for Overcooked {
         self.params.horizon
     }
 
-    fn reset(&mut self, _rng: &mut EnvRng) {
+    fn reset(&mut self, rng: &mut EnvRng) {
+        if self.params.rand_start {
+            self.draw_start(rng);
+        }
         self.reset_state();
     }
 
@@ -359,4 +433,105 @@ impl MacroEnv for Overcooked {
     fn draw(&self) -> Option<crate::draw::Picture> {
         Some(draw::draw(self))
     }
+
+    /// ACAC's `get_vector_state()`: the observation's items at their true places, without the
+    /// task one-hot (25 values for 3 agents); none for gym-macro-overcooked's env.
+    fn state_size(&self) -> usize {
+        if self.params.vector_state {
+            obs_len(self.params.n_agent) - TASKS.len()
+        } else {
+            0
+        }
+    }
+
+    fn write_state(&self, out: &mut [f32]) {
+        assert_eq!(out.len(), self.state_size(), "state buffer length");
+        observe::vector_state(&self.world, out);
+    }
+}
+
+/// A random start map of `init` (see [`rand_start`]) with the draws of `draws`.
+fn random_start_map(init: &Cells, p: &OvercookedParams, draws: &mut impl DrawInt) -> Cells {
+    let mut codes = [[0u8; layout::MAX_SIDE]; layout::MAX_SIDE];
+    for (row, tiles) in codes.iter_mut().zip(init) {
+        for (c, t) in row.iter_mut().zip(tiles) {
+            *c = *t as u8;
+        }
+    }
+    let drawn = rand_start::random_start(&codes, p.side, p.map, draws);
+    let mut out = *init;
+    for (row, codes) in out.iter_mut().zip(&drawn) {
+        for (t, &c) in row.iter_mut().zip(codes) {
+            *t = Tile::of(c);
+        }
+    }
+    out
+}
+
+/// `rows` as a start map after checking it: the side's square grid of the reference's codes,
+/// with the walls of `init` and its items, and equal to numpy's first draw when `numpy` is given.
+fn checked_start_map(
+    rows: &[Vec<u8>],
+    init: &Cells,
+    p: &OvercookedParams,
+    numpy: Option<NumpyRandom>,
+) -> Result<Cells, EnvError> {
+    let bad = |reason: String| {
+        Err(EnvError::InvalidParameter {
+            name: "start_map",
+            reason,
+        })
+    };
+    let side = p.side;
+    if rows.len() != side || rows.iter().any(|r| r.len() != side) {
+        return bad(format!("must be {side} rows of {side} cells (grid_dim)"));
+    }
+    let mut map = *init;
+    let (mut given, mut wanted) = ([0usize; 9], [0usize; 9]);
+    for (x, row) in rows.iter().enumerate() {
+        for (y, &code) in row.iter().enumerate() {
+            if code > 8 {
+                return bad(format!("cell ({x}, {y}) holds {code}, not a code 0..=8"));
+            }
+            let t = Tile::of(code);
+            let walkable = |t: Tile| matches!(t, Tile::Space | Tile::Agent);
+            if walkable(t) != walkable(init[x][y]) {
+                return bad(format!(
+                    "cell ({x}, {y}) holds {code}, but the {} map has {} there",
+                    p.map.letter(),
+                    if walkable(init[x][y]) {
+                        "floor"
+                    } else {
+                        "a counter"
+                    }
+                ));
+            }
+            given[code as usize] += 1;
+            wanted[init[x][y] as usize] += 1;
+            map[x][y] = t;
+        }
+    }
+    if given[2..] != wanted[2..] {
+        return bad(format!(
+            "holds {:?} agents and items of codes 2..=8, the start map {:?}",
+            &given[2..],
+            &wanted[2..]
+        ));
+    }
+    if let Some(mut numpy) = numpy {
+        let drawn = random_start_map(init, p, &mut numpy);
+        if let Some((x, y)) = (0..side)
+            .flat_map(|x| (0..side).map(move |y| (x, y)))
+            .find(|&(x, y)| drawn[x][y] != map[x][y])
+        {
+            return bad(format!(
+                "disagrees with numpy's draws from np_seed {}: cell ({x}, {y}) is {} in \
+                 start_map, {} by the draws",
+                p.np_seed.unwrap_or_default(),
+                map[x][y] as u8,
+                drawn[x][y] as u8
+            ));
+        }
+    }
+    Ok(map)
 }

@@ -163,6 +163,23 @@ pub fn macro_obs(w: &World, agent: usize, radius: i32, task: &str, out: &mut [f3
     write_task(out, task);
 }
 
+/// ACAC's `get_vector_state()` into `out`: every item at its true place (x / side, y / side, and
+/// chop progress for the foods), in the observation's layout without the task one-hot.
+pub fn vector_state(w: &World, out: &mut [f32]) {
+    let (xl, yl) = (w.side as f64, w.side as f64);
+    let mut idx = 0;
+    for k in 0..w.n_items() {
+        let (at, _) = w.item(k);
+        out[idx] = (f64::from(at.x) / xl) as f32;
+        out[idx + 1] = (f64::from(at.y) / yl) as f32;
+        idx += 2;
+        if k < 3 {
+            out[idx] = (f64::from(w.foods[k].chops) / f64::from(REQUIRED_CHOPS)) as f32;
+            idx += 1;
+        }
+    }
+}
+
 /// Names of the observation's entries, in layout order.
 pub fn obs_names(n_agent: usize) -> Vec<String> {
     let mut names = vec![];

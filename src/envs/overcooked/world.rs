@@ -154,63 +154,121 @@ impl Clone for World {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MissingItem(pub &'static str);
 
+/// The order in which `_createItems` scans a start map, which numbers the agents, plates and
+/// knives (each kind in the order found). Not a relabelling only: the primitive step moves agents
+/// in index order, so the order decides who wins a contended cell (`../shared/spec/acac_envs.md`
+/// §Overcooked-MA-v1 item 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Numbering {
+    /// gym-macro-overcooked (MacroMARL): row `x` outer, column `y` inner.
+    RowMajor,
+    /// ACAC's copy: column `y` outer, row `x` inner.
+    ColumnMajor,
+}
+
 impl World {
-    /// The kitchen of a start map, items in map scan order as `_createItems` finds them.
-    pub fn from_map(map: Cells, side: usize) -> Result<World, MissingItem> {
-        let mut foods: [Option<Cell>; 3] = [None; 3];
-        let (mut plates, mut knives, mut delivery, mut cooks) = (vec![], vec![], None, vec![]);
-        for (x, row) in map.iter().enumerate().take(side) {
-            for (y, &tile) in row.iter().enumerate().take(side) {
+    /// The kitchen of a start map, items numbered in `numbering`'s scan order as `_createItems`
+    /// finds them.
+    pub fn from_map(map: Cells, side: usize, numbering: Numbering) -> Result<World, MissingItem> {
+        let nowhere = Cell::new(0, 0);
+        let station = Station {
+            at: nowhere,
+            holding: None,
+        };
+        let mut w = World {
+            side,
+            map,
+            foods: [Food {
+                at: nowhere,
+                start: nowhere,
+                chopped: false,
+                chops: 0,
+            }; 3],
+            plates: [Plate {
+                at: nowhere,
+                start: nowhere,
+                holds: [false; 3],
+            }; 2],
+            knives: [station; 2],
+            delivery: station,
+            cooks: Vec::with_capacity(super::layout::MAX_AGENTS),
+        };
+        w.restart_from(map, numbering)?;
+        Ok(w)
+    }
+
+    /// Make this the kitchen of start map `map` (same side), reusing the agents' buffer, so a
+    /// reset that draws a new start allocates nothing. On an error the kitchen is unusable.
+    pub fn restart_from(&mut self, map: Cells, numbering: Numbering) -> Result<(), MissingItem> {
+        self.map = map;
+        self.cooks.clear();
+        let (mut foods, mut n_plates, mut n_knives, mut delivery) = ([false; 3], 0, 0, None);
+        for i in 0..self.side {
+            for j in 0..self.side {
+                let (x, y) = match numbering {
+                    Numbering::RowMajor => (i, j),
+                    Numbering::ColumnMajor => (j, i),
+                };
                 let c = Cell::new(x as i32, y as i32);
-                match tile {
-                    Tile::Agent => cooks.push(Cook {
+                match map[x][y] {
+                    Tile::Agent => self.cooks.push(Cook {
                         at: c,
                         start: c,
                         holding: None,
                         moved: false,
                     }),
-                    Tile::Knife => knives.push(Station {
-                        at: c,
-                        holding: None,
-                    }),
+                    Tile::Knife => {
+                        if n_knives < 2 {
+                            self.knives[n_knives] = Station {
+                                at: c,
+                                holding: None,
+                            };
+                        }
+                        n_knives += 1;
+                    }
                     Tile::Delivery => delivery = Some(c),
-                    Tile::Plate => plates.push(Plate {
-                        at: c,
-                        start: c,
-                        holds: [false; 3],
-                    }),
+                    Tile::Plate => {
+                        if n_plates < 2 {
+                            self.plates[n_plates] = Plate {
+                                at: c,
+                                start: c,
+                                holds: [false; 3],
+                            };
+                        }
+                        n_plates += 1;
+                    }
                     t => {
                         if let Some(k) = FOOD_TILES.iter().position(|&f| f == t) {
-                            foods[k].get_or_insert(c);
+                            if !foods[k] {
+                                self.foods[k] = Food {
+                                    at: c,
+                                    start: c,
+                                    chopped: false,
+                                    chops: 0,
+                                };
+                            }
+                            foods[k] = true;
                         }
                     }
                 }
             }
         }
-        let food = |k: usize| {
-            foods[k].map(|c| Food {
-                at: c,
-                start: c,
-                chopped: false,
-                chops: 0,
-            })
+        for (k, name) in FOOD_NAMES.iter().enumerate() {
+            if !foods[k] {
+                return Err(MissingItem(name));
+            }
+        }
+        if n_plates != 2 {
+            return Err(MissingItem("two plates"));
+        }
+        if n_knives != 2 {
+            return Err(MissingItem("two knives"));
+        }
+        self.delivery = Station {
+            at: delivery.ok_or(MissingItem("delivery"))?,
+            holding: None,
         };
-        Ok(World {
-            side,
-            map,
-            foods: [
-                food(0).ok_or(MissingItem("tomato"))?,
-                food(1).ok_or(MissingItem("lettuce"))?,
-                food(2).ok_or(MissingItem("onion"))?,
-            ],
-            plates: plates.try_into().map_err(|_| MissingItem("two plates"))?,
-            knives: knives.try_into().map_err(|_| MissingItem("two knives"))?,
-            delivery: Station {
-                at: delivery.ok_or(MissingItem("delivery"))?,
-                holding: None,
-            },
-            cooks,
-        })
+        Ok(())
     }
 
     /// The map's tile at `c`, a counter outside the grid.
@@ -366,7 +424,8 @@ mod tests {
 
     #[test]
     fn items_are_found_in_map_scan_order() {
-        let w = World::from_map(start_map(7, MapType::A, 3).unwrap(), 7).unwrap();
+        let w =
+            World::from_map(start_map(7, MapType::A, 3).unwrap(), 7, Numbering::RowMajor).unwrap();
         assert_eq!(w.foods[0].at, Cell::new(0, 5));
         assert_eq!(w.foods[1].at, Cell::new(1, 6));
         assert_eq!(w.foods[2].at, Cell::new(2, 6));
@@ -379,9 +438,27 @@ mod tests {
         assert_eq!(w.n_items(), 11);
     }
 
+    /// ACAC's `_createItems` scans column by column (spec acac_envs.md item 1).
+    #[test]
+    fn acac_numbers_agents_and_plates_column_by_column() {
+        let w = World::from_map(
+            start_map(7, MapType::A, 3).unwrap(),
+            7,
+            Numbering::ColumnMajor,
+        )
+        .unwrap();
+        let cooks: Vec<Cell> = w.cooks.iter().map(|c| c.at).collect();
+        assert_eq!(cooks, [Cell::new(1, 2), Cell::new(5, 2), Cell::new(1, 4)]);
+        assert_eq!(w.plates[0].at, Cell::new(6, 5));
+        assert_eq!(w.plates[1].at, Cell::new(5, 6));
+        assert_eq!(w.knives[0].at, Cell::new(1, 0));
+        assert_eq!(w.foods[0].at, Cell::new(0, 5));
+    }
+
     #[test]
     fn a_plate_carries_its_foods() {
-        let mut w = World::from_map(start_map(7, MapType::A, 2).unwrap(), 7).unwrap();
+        let mut w =
+            World::from_map(start_map(7, MapType::A, 2).unwrap(), 7, Numbering::RowMajor).unwrap();
         w.plate_contain(0, 2);
         assert_eq!(w.foods[2].at, w.plates[0].at);
         w.pickup(0, Held::Plate(0));

@@ -1,0 +1,486 @@
+//! One training iteration of MacDec-Q (`learning_methods.py: QLearn_squ`) and MacCen-Q
+//! (`learning_methods_cen_condi.py: QLearn_squ_cen_condi_0`), `docs/MACROMARL.md` §8.2:
+//!
+//! 1. squeeze each sampled sequence to the records where the net's macro-action ended (agent i's
+//!    for MacDec-Q, any agent's for MacCen-Q), dropping sequences with fewer than
+//!    `sub_trace_len`;
+//! 2. Q(h, a) from one unroll over the squeezed observations; the next-history values from the
+//!    continuation [o_0, o'_0, o'_1, ...] of the same unroll, its outputs from position 1 on;
+//! 3. double Q: a' = argmax of the online net's next values among the available macro-actions
+//!    (MacCen-Q: the conditional argmax, keeping the running macro-actions of agents that did not
+//!    finish), valued by the target net;
+//! 4. y = r + discount x gamma_b x Q'(a') x (1 - terminal), gamma_b = discount^(duration - 1);
+//! 5. loss = mean over records of max(h d, d)^2 with d = y - Q(h, a); one Adam step.
+//!
+//! MacDec-Q updates no agent when any agent's squeeze is empty (the reference returns from the
+//! learner before any optimizer step).
+//!
+//! MacDec-DDRQN (`mac_dec_ddrqn/learning_methods.py: QLearn_squ_dec_cen_0`, ICRA 2020's
+//! MacDec-MADDRQN) first takes MacCen-Q's step on its centralized net **without hysteresis**, then
+//! lets the updated centralized net choose every agent's a': agent i's component of the
+//! conditional argmax at the joint records where i finished; the decentralized nets then take
+//! MacDec-Q's hysteretic step with those actions. Parallel-MacDec-DDRQN
+//! (`parallel_mac_dec_ddrqn/learning_methods.py: QLearn_squ_dec_cen_0`) does the same with the
+//! centralized net's batch from the memory its own exploration filled and the agents' batch from
+//! the memory the agents' exploration filled.
+
+use ndarray::ArrayView1;
+use serde::{Deserialize, Serialize};
+
+use super::episode::Step;
+use crate::autograd::{SeqPacking, Tape, Var};
+use crate::nn::argmax::first_argmax;
+use crate::nn::loss::hysteretic_td_loss;
+use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig};
+
+/// A Q-net (MacroMARL's `DDRQN`: fc1, fc2, GRU, fc3, fc4, the actor's layers), its target and
+/// its optimizer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QNet {
+    /// The net being trained.
+    pub net: GruActor,
+    /// The target, hard-copied from `net`.
+    pub target: GruActor,
+    /// Adam on `net`.
+    pub adam: Adam,
+}
+
+impl QNet {
+    /// A fresh net, its target a copy, Adam at learning rate `lr`.
+    pub fn new(cfg: GruActorConfig, lr: f64, rng: &mut rand_chacha::ChaCha8Rng) -> Self {
+        QNet::from_net(GruActor::new(cfg, rng), lr)
+    }
+
+    /// `net` with a target copy and a fresh Adam.
+    pub fn from_net(net: GruActor, lr: f64) -> Self {
+        QNet {
+            target: net.clone(),
+            adam: Adam::new(AdamConfig::with_lr(lr), &net),
+            net,
+        }
+    }
+}
+
+/// The sizes the records are laid out by.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Dims {
+    /// Each agent's observation length.
+    pub obs_sizes: Vec<usize>,
+    /// Each agent's macro-action count.
+    pub n_actions: Vec<usize>,
+}
+
+impl Dims {
+    fn obs_range(&self, agent: usize) -> std::ops::Range<usize> {
+        let lo: usize = self.obs_sizes[..agent].iter().sum();
+        lo..lo + self.obs_sizes[agent]
+    }
+
+    fn action_range(&self, agent: usize) -> std::ops::Range<usize> {
+        let lo: usize = self.n_actions[..agent].iter().sum();
+        lo..lo + self.n_actions[agent]
+    }
+
+    /// Joint macro-actions (C order, agent 0 most significant).
+    pub fn n_joint(&self) -> usize {
+        self.n_actions.iter().product()
+    }
+
+    /// The C-order index of a joint macro-action (`np.ravel_multi_index`).
+    pub fn ravel(&self, actions: &[usize]) -> usize {
+        actions
+            .iter()
+            .zip(&self.n_actions)
+            .fold(0, |acc, (&a, &n)| acc * n + a)
+    }
+
+    /// Each agent's macro-action of joint index `j` (`np.unravel_index`).
+    pub fn unravel(&self, mut j: usize) -> Vec<usize> {
+        let mut out = vec![0; self.n_actions.len()];
+        for (slot, &n) in out.iter_mut().zip(&self.n_actions).rev() {
+            *slot = j % n;
+            j /= n;
+        }
+        out
+    }
+}
+
+/// The joint macro-action maximizing `q` among those whose every component is available in
+/// `avail` (per-agent masks, concatenated) and equals `running[i]` where that is `Some` (an agent
+/// still executing its macro-action): the reference's `get_conditional_argmax`, first maximal
+/// index in C order; 0 when none qualifies (all -inf in the reference).
+pub fn conditional_argmax(
+    q: &[f32],
+    running: &[Option<usize>],
+    avail: &[f32],
+    dims: &Dims,
+) -> usize {
+    let allowed = |j: usize| {
+        dims.unravel(j).iter().enumerate().all(|(i, &a)| {
+            avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
+        })
+    };
+    first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j))).unwrap_or(0)
+}
+
+/// The available macro-action with the largest value (`get_masked_Q` then `max`); 0 when none is.
+pub fn masked_argmax(q: &[f32], avail: &[f32]) -> usize {
+    first_argmax(
+        q.iter()
+            .copied()
+            .enumerate()
+            .filter(|&(a, _)| avail[a] != 0.0),
+    )
+    .unwrap_or(0)
+}
+
+/// One net's squeezed batch: sequences of kept records, flat (sequence-major).
+#[derive(Debug, Clone, Default)]
+struct Squeezed {
+    lengths: Vec<usize>,
+    width: usize,
+    /// [sum lengths, width]: the observations the macro-actions were chosen on.
+    x: Vec<f32>,
+    /// [sum (lengths + 1), width]: each sequence's first observation, then every next one.
+    x_next: Vec<f32>,
+    actions: Vec<usize>,
+    rewards: Vec<f32>,
+    gammas: Vec<f32>,
+    terminals: Vec<f32>,
+}
+
+impl Squeezed {
+    /// Keep the records `keep` accepts, reading each with `obs`/`next_obs` (the net's input
+    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go.
+    fn of<'a>(
+        batch: &[&'a [Step]],
+        sub_trace_len: usize,
+        width: usize,
+        keep: impl Fn(&Step) -> bool,
+        input: impl Fn(&'a [f32]) -> &'a [f32],
+        fields: impl Fn(&Step) -> (usize, f32, f32),
+    ) -> (Squeezed, Vec<Vec<&'a Step>>) {
+        let mut s = Squeezed {
+            width,
+            ..Squeezed::default()
+        };
+        let mut kept_records = Vec::new();
+        for seq in batch {
+            let kept: Vec<&Step> = seq.iter().filter(|r| keep(r)).collect();
+            if kept.is_empty() || kept.len() < sub_trace_len {
+                continue;
+            }
+            s.lengths.push(kept.len());
+            s.x_next.extend_from_slice(input(&kept[0].obs));
+            for r in &kept {
+                s.x.extend_from_slice(input(&r.obs));
+                s.x_next.extend_from_slice(input(&r.next_obs));
+                let (a, rew, g) = fields(r);
+                s.actions.push(a);
+                s.rewards.push(rew);
+                s.gammas.push(g);
+                s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
+            }
+            kept_records.push(kept);
+        }
+        (s, kept_records)
+    }
+
+    fn total(&self) -> usize {
+        self.actions.len()
+    }
+
+    /// Row index of each record's next value in the continuation's flat layout.
+    fn next_rows(&self) -> Vec<usize> {
+        let mut rows = Vec::with_capacity(self.total());
+        let mut start = 0;
+        for &l in &self.lengths {
+            rows.extend(start + 1..start + 1 + l);
+            start += l + 1;
+        }
+        rows
+    }
+}
+
+/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`), in flat order.
+fn outputs(
+    tape: &mut Tape,
+    net: &GruActor,
+    x: &[f32],
+    width: usize,
+    lengths: &[usize],
+) -> (Var, crate::nn::GruActorVars) {
+    let vars = net.bind(tape);
+    let packing = SeqPacking::new(lengths);
+    let mut packed = tape.pool().array(packing.total(), width);
+    for (p, &f) in packing.packed_to_flat().iter().enumerate() {
+        packed
+            .row_mut(p)
+            .assign(&ArrayView1::from(&x[f * width..(f + 1) * width]));
+    }
+    let packed = tape.constant_owned(packed);
+    let out = net.forward(tape, &vars, packed, &packing);
+    (tape.gather_rows(out, packing.flat_to_packed()), vars)
+}
+
+/// Values (no gradient) of `net` over the continuation sequences, at each record's next row.
+fn next_values(net: &GruActor, s: &Squeezed) -> Vec<Vec<f32>> {
+    let mut tape = Tape::new();
+    let lengths: Vec<usize> = s.lengths.iter().map(|l| l + 1).collect();
+    let (out, _) = outputs(&mut tape, net, &s.x_next, s.width, &lengths);
+    let v = tape.value(out);
+    s.next_rows().iter().map(|&r| v.row(r).to_vec()).collect()
+}
+
+/// What one net's TD step computed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TdTrace {
+    /// Squeezed sequence lengths.
+    pub lengths: Vec<usize>,
+    /// The bootstrap actions a' (joint indices for MacCen-Q).
+    pub next_actions: Vec<usize>,
+    /// The targets y.
+    pub targets: Vec<f32>,
+    /// The loss before the step.
+    pub loss: f32,
+}
+
+/// The TD step on `q` given the squeezed batch and a chooser of a' from the online net's next
+/// values of record k.
+fn td_step(
+    q: &mut QNet,
+    s: &Squeezed,
+    pick: impl Fn(usize, &[f32]) -> usize,
+    hysteresis: f64,
+    discount: f64,
+) -> TdTrace {
+    let online_next = next_values(&q.net, s);
+    let target_next = next_values(&q.target, s);
+    let next_actions: Vec<usize> = online_next
+        .iter()
+        .enumerate()
+        .map(|(k, row)| pick(k, row))
+        .collect();
+    let d = discount as f32;
+    let targets: Vec<f32> = (0..s.total())
+        .map(|k| {
+            let boot = target_next[k][next_actions[k]];
+            s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
+        })
+        .collect();
+    let mut tape = Tape::new();
+    let (values, vars) = outputs(&mut tape, &q.net, &s.x, s.width, &s.lengths);
+    let y = ndarray::Array1::from(targets.clone());
+    let loss = hysteretic_td_loss(&mut tape, values, &s.actions, y.view(), hysteresis as f32);
+    let loss_value = tape.scalar(loss);
+    tape.backward(loss);
+    let mut grads = GruActor::zeros(q.net.config());
+    vars.grads_into(&tape, &mut grads);
+    q.adam.step(&mut q.net, &grads);
+    TdTrace {
+        lengths: s.lengths.clone(),
+        next_actions,
+        targets,
+        loss: loss_value,
+    }
+}
+
+/// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
+/// (then no net changes).
+pub fn update_dec(
+    nets: &mut [QNet],
+    batch: &[&[Step]],
+    dims: &Dims,
+    hysteresis: f64,
+    discount: f64,
+    sub_trace_len: usize,
+) -> Option<Vec<TdTrace>> {
+    let squeezed: Vec<_> = (0..nets.len())
+        .map(|i| {
+            let obs = dims.obs_range(i);
+            Squeezed::of(
+                batch,
+                sub_trace_len,
+                obs.len(),
+                |r| r.valid[i],
+                |o| &o[obs.clone()],
+                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+            )
+        })
+        .collect();
+    if squeezed.iter().any(|(s, _)| s.lengths.is_empty()) {
+        return None;
+    }
+    Some(
+        nets.iter_mut()
+            .zip(&squeezed)
+            .enumerate()
+            .map(|(i, (q, (s, kept)))| {
+                let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+                let masks = dims.action_range(i);
+                td_step(
+                    q,
+                    s,
+                    |k, row| masked_argmax(row, &records[k].next_avail[masks.clone()]),
+                    hysteresis,
+                    discount,
+                )
+            })
+            .collect(),
+    )
+}
+
+/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing.
+pub fn update_cen(
+    q: &mut QNet,
+    batch: &[&[Step]],
+    dims: &Dims,
+    hysteresis: f64,
+    discount: f64,
+    sub_trace_len: usize,
+) -> Option<TdTrace> {
+    let width = dims.obs_sizes.iter().sum();
+    let (s, kept) = Squeezed::of(
+        batch,
+        sub_trace_len,
+        width,
+        Step::any_valid,
+        |o| o,
+        |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+    );
+    if s.lengths.is_empty() {
+        return None;
+    }
+    let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+    Some(td_step(
+        q,
+        &s,
+        |k, row| {
+            let r = records[k];
+            // Agents whose macro-action did not end keep it (`get_conditional_action`).
+            let running: Vec<Option<usize>> = r
+                .valid
+                .iter()
+                .zip(&r.actions)
+                .map(|(&v, &a)| (!v).then_some(a))
+                .collect();
+            conditional_argmax(row, &running, &r.next_avail, dims)
+        },
+        hysteresis,
+        discount,
+    ))
+}
+
+/// MacDec-DDRQN's iteration (`mac_dec_ddrqn`: `cen_batch` and `dec_batch` the same sample;
+/// `parallel_mac_dec_ddrqn`: one from each memory): the centralized net `cen` steps on
+/// `cen_batch`, then every agent's net in `decs` steps on `dec_batch` with the centralized net's
+/// choices there. `None` when `cen_batch`'s joint squeeze kept nothing; the decentralized traces
+/// are empty when `dec_batch`'s joint squeeze or some agent's squeeze kept nothing (the reference
+/// returns before their optimizer steps, after the centralized one).
+#[allow(clippy::too_many_arguments)]
+pub fn update_dec_cen(
+    cen: &mut QNet,
+    decs: &mut [QNet],
+    cen_batch: &[&[Step]],
+    dec_batch: &[&[Step]],
+    dims: &Dims,
+    hysteresis: f64,
+    discount: f64,
+    sub_trace_len: usize,
+) -> Option<(TdTrace, Vec<TdTrace>)> {
+    let width = dims.obs_sizes.iter().sum();
+    let joint = |batch: &[&'_ [Step]]| {
+        let (s, kept) = Squeezed::of(
+            batch,
+            sub_trace_len,
+            width,
+            Step::any_valid,
+            |o| o,
+            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+        );
+        let records: Vec<Step> = kept.iter().flatten().map(|&r| r.clone()).collect();
+        (s, records)
+    };
+    let choose = |records: &[Step], k: usize, row: &[f32]| {
+        let r = &records[k];
+        let running: Vec<Option<usize>> = r
+            .valid
+            .iter()
+            .zip(&r.actions)
+            .map(|(&v, &a)| (!v).then_some(a))
+            .collect();
+        conditional_argmax(row, &running, &r.next_avail, dims)
+    };
+    let (s, records) = joint(cen_batch);
+    if s.lengths.is_empty() {
+        return None;
+    }
+    // The centralized step is plain double Q (no hysteresis in `QLearn_squ_dec_cen_0`).
+    let cen_trace = td_step(cen, &s, |k, row| choose(&records, k, row), 1.0, discount);
+    let (s, records) = joint(dec_batch);
+    if s.lengths.is_empty() {
+        return Some((cen_trace, Vec::new()));
+    }
+    let joint_next: Vec<usize> = next_values(&cen.net, &s)
+        .iter()
+        .enumerate()
+        .map(|(k, row)| choose(&records, k, row))
+        .collect();
+    let squeezed: Vec<_> = (0..decs.len())
+        .map(|i| {
+            let obs = dims.obs_range(i);
+            Squeezed::of(
+                dec_batch,
+                sub_trace_len,
+                obs.len(),
+                |r| r.valid[i],
+                |o| &o[obs.clone()],
+                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+            )
+            .0
+        })
+        .collect();
+    if squeezed.iter().any(|s| s.lengths.is_empty()) {
+        return Some((cen_trace, Vec::new()));
+    }
+    let dec_traces = decs
+        .iter_mut()
+        .zip(&squeezed)
+        .enumerate()
+        .map(|(i, (q, s))| {
+            // Agent i's records are the joint records where it finished, in the same order.
+            let a_next: Vec<usize> = records
+                .iter()
+                .zip(&joint_next)
+                .filter(|(r, _)| r.valid[i])
+                .map(|(_, &j)| dims.unravel(j)[i])
+                .collect();
+            td_step(q, s, |k, _| a_next[k], hysteresis, discount)
+        })
+        .collect();
+    Some((cen_trace, dec_traces))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn joint_indices_are_c_order_and_the_conditional_argmax_keeps_running_actions() {
+        let dims = Dims {
+            obs_sizes: vec![1, 1],
+            n_actions: vec![2, 3],
+        };
+        assert_eq!(dims.ravel(&[1, 2]), 5);
+        assert_eq!(dims.unravel(4), [1, 1]);
+        let q = [0.0, 9.0, 1.0, 2.0, 3.0, 8.0];
+        let all = [1.0; 5];
+        assert_eq!(conditional_argmax(&q, &[None, None], &all, &dims), 1);
+        // Agent 0 still runs action 1: only joint 3, 4, 5 qualify.
+        assert_eq!(conditional_argmax(&q, &[Some(1), None], &all, &dims), 5);
+        // Agent 1's action 2 unavailable.
+        let avail = [1.0, 1.0, 1.0, 1.0, 0.0];
+        assert_eq!(conditional_argmax(&q, &[Some(1), None], &avail, &dims), 4);
+        assert_eq!(masked_argmax(&[1.0, 5.0, 3.0], &[1.0, 0.0, 1.0]), 2);
+    }
+}
