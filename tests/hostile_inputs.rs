@@ -511,7 +511,11 @@ fn no_key_is_dropped_a_set_with_a_line_break_nor_a_key_the_domain_does_not_read(
         }
         args.extend(["--out", s(&results)]);
         let err = refused(&macdec(&args));
-        let key = if key.is_empty() { "`TB_move_speed`" } else { key };
+        let key = if key.is_empty() {
+            "`TB_move_speed`"
+        } else {
+            key
+        };
         assert!(err.contains(key) && err.contains("leave it out"), "{err}");
     }
     assert!(!results.exists(), "no run may start");

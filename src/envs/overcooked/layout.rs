@@ -136,7 +136,9 @@ fn cells<const N: usize>(rows: [[u8; N]; N]) -> Cells {
     let mut c = [[Tile::Counter; MAX_SIDE]; MAX_SIDE];
     for (x, row) in rows.iter().enumerate() {
         for (y, &v) in row.iter().enumerate() {
-            c[x][y] = Rules::V1.tile(v, 3).expect("the literal maps hold V1's codes");
+            c[x][y] = Rules::V1
+                .tile(v, 3)
+                .expect("the literal maps hold V1's codes");
         }
     }
     c
@@ -397,7 +399,10 @@ mod tests {
                 vec![1, 1, 1, 1, 1, 1, 1, 1, 3, 3, 1],
             ]
         );
-        assert_eq!(large_start_map(11, MapType::A, 6, 4, 4, 6).unwrap()[9][5], Tile::Space);
+        assert_eq!(
+            large_start_map(11, MapType::A, 6, 4, 4, 6).unwrap()[9][5],
+            Tile::Space
+        );
         for code in 0..12 {
             let t = Rules::V0.tile(code, 6).unwrap();
             assert_eq!(Rules::V0.code(t), code);

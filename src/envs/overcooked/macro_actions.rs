@@ -311,9 +311,7 @@ pub fn low_level(
             s.done = true;
             STAY
         }
-        Macro::Deliver if v1 && me == Cell::new(1, 1) && pomap(Cell::new(2, 1)) == Tile::Agent => {
-            0
-        }
+        Macro::Deliver if v1 && me == Cell::new(1, 1) && pomap(Cell::new(2, 1)) == Tile::Agent => 0,
         Macro::GoToCounter => match free_counter(b, w.side, ctx.map) {
             Some(target) => {
                 let a = navigate(&b.pomap, w.side, me, target, heap);

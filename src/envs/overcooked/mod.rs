@@ -217,10 +217,7 @@ impl OvercookedParams {
             );
         }
         if l.obj.is_empty() || l.obj.len() > layout::MAX_FOODS {
-            return bad(
-                "obj",
-                format!("1..=6 objects, got {}", l.obj.len()),
-            );
+            return bad("obj", format!("1..=6 objects, got {}", l.obj.len()));
         }
         for (k, o) in l.obj.iter().enumerate() {
             if o.chars().count() != 1 {
@@ -283,17 +280,24 @@ impl Overcooked {
         let n = params.n_agent;
         let kit = params.kit();
         let map = match &params.large {
-            None => start_map(params.side, params.map, n).ok_or_else(|| {
-                EnvError::InvalidParameter {
+            None => {
+                start_map(params.side, params.map, n).ok_or_else(|| EnvError::InvalidParameter {
                     name: "grid_dim",
                     reason: "no map for this grid and agent count".into(),
-                }
+                })?
+            }
+            Some(l) => large_start_map(
+                params.side,
+                params.map,
+                l.obj.len(),
+                l.n_plate,
+                l.n_knife,
+                n,
+            )
+            .map_err(|reason| EnvError::InvalidParameter {
+                name: "obj",
+                reason: format!("ACAC's make_custom_map refuses the kitchen: {reason}"),
             })?,
-            Some(l) => large_start_map(params.side, params.map, l.obj.len(), l.n_plate, l.n_knife, n)
-                .map_err(|reason| EnvError::InvalidParameter {
-                    name: "obj",
-                    reason: format!("ACAC's make_custom_map refuses the kitchen: {reason}"),
-                })?,
         };
         let start = World::from_map(map, params.side, params.numbering, kit).map_err(|e| {
             EnvError::InvalidParameter {

@@ -4,8 +4,8 @@
 
 use std::fmt::Write;
 
-use super::layout::Tile;
 use super::layout::Rules;
+use super::layout::Tile;
 use super::world::{Cell, Held, World, FOOD_NAMES};
 
 /// The name of food `k`: V1's, or under V0 the letter of `obj` order ("A".."F" as ACAC's

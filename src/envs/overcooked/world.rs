@@ -488,8 +488,7 @@ mod tests {
 
     #[test]
     fn items_are_found_in_map_scan_order() {
-        let w =
-            World::from_map(
+        let w = World::from_map(
             start_map(7, MapType::A, 3).unwrap(),
             7,
             Numbering::RowMajor,
@@ -528,8 +527,7 @@ mod tests {
 
     #[test]
     fn a_plate_carries_its_foods() {
-        let mut w =
-            World::from_map(
+        let mut w = World::from_map(
             start_map(7, MapType::A, 2).unwrap(),
             7,
             Numbering::RowMajor,

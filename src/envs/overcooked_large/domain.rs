@@ -173,7 +173,14 @@ mod tests {
         let cell = |x, y| Cell::new(x, y);
         assert_eq!(
             cooks,
-            [cell(1, 4), cell(1, 6), cell(2, 4), cell(2, 6), cell(9, 4), cell(9, 6)]
+            [
+                cell(1, 4),
+                cell(1, 6),
+                cell(2, 4),
+                cell(2, 6),
+                cell(9, 4),
+                cell(9, 6)
+            ]
         );
         let plates: Vec<Cell> = w.plates[..4].iter().map(|p| p.at).collect();
         assert_eq!(plates, [cell(8, 10), cell(9, 10), cell(10, 8), cell(10, 9)]);

@@ -111,7 +111,10 @@ mod tests {
         let noisy = text.replace("tb_m_noisy = 0.0", "tb_m_noisy = 0.3");
         assert_ne!(noisy, text);
         let err = read("our1", &noisy).unwrap_err();
-        assert!(err.contains("`tb_m_noisy`") && err.contains("leave it out"), "{err}");
+        assert!(
+            err.contains("`tb_m_noisy`") && err.contains("leave it out"),
+            "{err}"
+        );
         // A hyperparameter table refuses the domain's keys: the learner's config names none.
         let err = method("our1")
             .config_from_table(toml::from_str(&text).unwrap())
