@@ -225,4 +225,37 @@ mod tests {
         assert_eq!(at(Cell::new(0, 5)), Some(Colour::Red));
         assert_eq!(at(Cell::new(5, 6)), Some(Colour::White));
     }
+
+    #[test]
+    fn the_large_kitchen_draws_its_six_agents_and_objects() {
+        let params = OvercookedParams {
+            side: 11,
+            n_agent: 6,
+            large: Some(crate::envs::overcooked::LargeKitchen::default()),
+            ..OvercookedParams::default()
+        };
+        let env = Overcooked::new(params).unwrap();
+        let pic = draw(&env);
+        assert_eq!(pic.world.width(), 11 * 32 + 1);
+        assert_eq!(pic.agent_labels.len(), 6);
+        let at = |c: Cell| {
+            let (x, y) = Grid { cell: 32 }.centre(c);
+            pic.world.pixel(x as usize, y as usize)
+        };
+        // The delivery (5,0), floor (5,5); object A (1,10) in the first food colour (as slices:
+        // fresh objects count as chopped), object F (0,7) in the sixth.
+        assert_eq!(at(Cell::new(5, 0)), Some(Colour::Goal));
+        assert_eq!(at(Cell::new(5, 5)), Some(Colour::Background));
+        let shows = |c: Cell, colour: Colour| {
+            let (px, py) = Grid { cell: 32 }.origin(c);
+            (0..32).any(|dx| {
+                (0..32).any(|dy| {
+                    pic.world.pixel((px + dx) as usize, (py + dy) as usize) == Some(colour)
+                })
+            })
+        };
+        assert!(shows(Cell::new(1, 10), Colour::Red));
+        assert!(shows(Cell::new(0, 7), Colour::Tool2));
+        assert!(!shows(Cell::new(0, 7), Colour::Red));
+    }
 }

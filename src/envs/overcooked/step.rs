@@ -328,7 +328,37 @@ fn deliver(
 
 #[cfg(test)]
 mod tests {
+    use super::super::layout::{large_start_map, MapType};
+    use super::super::world::{Kit, Numbering};
     use super::*;
+
+    /// Four agents in a 2 x 2 block, each walking into the next one's cell clockwise: ACAC's V0
+    /// moves them all at once (`four_chain_case`); under V1 each waits for the next and nobody
+    /// moves.
+    #[test]
+    fn a_cycle_of_four_moves_at_once_only_under_v0() {
+        let kit = Kit {
+            rules: Rules::V0,
+            n_foods: 6,
+            n_plates: 4,
+            n_knives: 4,
+        };
+        let mut map = large_start_map(11, MapType::A, 6, 4, 4, 0).unwrap();
+        for (x, y) in [(3, 2), (3, 3), (4, 2), (4, 3)] {
+            map[x][y] = Tile::Agent;
+        }
+        let start = World::from_map(map, 11, Numbering::RowMajor, kit).unwrap();
+        // Row-major: 0 (3,2), 1 (3,3), 2 (4,2), 3 (4,3); right, down, up, left.
+        let actions = [0, 1, 3, 2];
+        let at = |w: &World| w.cooks.iter().map(|c| (c.at.x, c.at.y)).collect::<Vec<_>>();
+        let mut w = start.clone();
+        primitive_step(&mut w, &actions, "", &Rewards::default());
+        assert_eq!(at(&w), [(3, 3), (4, 3), (3, 2), (4, 2)]);
+        let mut v1 = start.clone();
+        v1.kit.rules = Rules::V1;
+        primitive_step(&mut v1, &actions, "", &Rewards::default());
+        assert_eq!(at(&v1), at(&start));
+    }
 
     #[test]
     fn dish_names_follow_the_references_food_order() {
