@@ -63,9 +63,15 @@ pub fn render(w: &World) -> String {
         let _ = writeln!(s, "knife {} holds {}", k + 1, held(w, kn.holding));
     }
     for (k, f) in w.foods.iter().enumerate().take(w.kit.n_foods) {
+        // A Large kitchen's fresh object counts as chopped (spec acac_envs.md §Overcooked-MA-v0).
+        let fresh_chopped = if f.chopped && f.chops < 3 {
+            " (fresh, counts as chopped)"
+        } else {
+            ""
+        };
         let _ = writeln!(
             s,
-            "{} at ({}, {}) chopped {}/3",
+            "{} at ({}, {}) chopped {}/3{fresh_chopped}",
             food_name(w, k),
             f.at.x,
             f.at.y,
