@@ -110,7 +110,7 @@ pub fn names(map: MapType) -> &'static [&'static str] {
 }
 
 /// The macro-action names of a Large kitchen of objects `obj` (`Overcooked_MA_V0`'s
-/// `macroActionName`): "stay", "get <o>" per object, "get plate k", "go to knife k",
+/// `macroActionName`): "stay", "get `<o>`" per object, "get plate k", "go to knife k",
 /// "delivery", "chop", "go to counter" on maps B and C, the four moves. The published kitchen's
 /// are [`NAMES_LARGE_A`] / [`NAMES_LARGE_BC`]; any other's are built once per process and kept.
 pub fn large_names(map: MapType, obj: &[String], kit: &Kit) -> &'static [&'static str] {
