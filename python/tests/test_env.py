@@ -15,7 +15,7 @@ IDS = macdec.env_ids()
 
 
 def test_every_built_in_domain_is_listed():
-    assert IDS == ["BP_MA", "BP-MA-v0", "OSD_S_4", "OSD-D-v7", "OSD-T-v0", "OSD-T-v1", "OSD-F-v0", "Overcooked-MA-v1", "ACAC-Overcooked-MA-v1"]
+    assert IDS == ["BP_MA", "BP-MA-v0", "OSD_S_4", "OSD-D-v7", "OSD-T-v0", "OSD-T-v1", "OSD-F-v0", "Overcooked-MA-v1", "ACAC-Overcooked-MA-v1", "ACAC-Overcooked-MA-v0"]
 
 
 def test_version_is_the_crates(root):

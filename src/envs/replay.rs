@@ -583,6 +583,34 @@ mod tests {
     }
 
     #[test]
+    fn bad_overcooked_large_forms_name_the_problem() {
+        let ovc = |extra: &str, params: &str| {
+            format!(
+                r#"{{"source": "acac", "env": "Overcooked-MA-v0", "params": {{{params}}}{extra}, "steps": [[0, 0, 0, 0, 0, 0]]}}"#
+            )
+        };
+        assert!(parse_replay(&ovc(r#", "np_seed": 1"#, "")).is_ok());
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""n_agent": 7"#));
+        assert!(e.contains("`n_agent`") && e.contains("2..=6"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""obj": ["lettuce"]"#));
+        assert!(e.contains("`obj`") && e.contains("one character"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""grid_dim": [7, 7]"#));
+        assert!(e.contains("`grid_dim`") && e.contains("[11, 11]"), "{e}");
+        let e = error_of(&ovc(
+            r#", "np_seed": 1, "start_map": [[1, 1], [1, 1]]"#,
+            r#""rand_start": true"#,
+        ));
+        assert!(e.contains("must be 11 rows of 11 cells"), "{e}");
+        let mut rows = vec![vec![1; 11]; 11];
+        rows[0][3] = 12;
+        let e = error_of(&ovc(
+            &format!(r#", "np_seed": 1, "start_map": {rows:?}"#),
+            r#""rand_start": true"#,
+        ));
+        assert!(e.contains("cell (0, 3) holds 12, not a code"), "{e}");
+    }
+
+    #[test]
     fn busy_agents_may_hold_any_integer() {
         let file = parse_replay(&bp10("[[2, 7], [-1, 7], [99, 7]]")).unwrap();
         let replay = run_replay(&file, false).unwrap();
