@@ -203,7 +203,7 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
 
 /// Put every run of `exp` on one grid of environment steps from 0 to the smallest last step
 /// any run reached, with as many points as the sparsest run has evaluations up to there (at
-/// most [`MAX_GRID`]): each run's value at a step is linearly interpolated between its
+/// most 1,000): each run's value at a step is linearly interpolated between its
 /// evaluations (its first value before its first evaluation), and its points' episode is the
 /// step, so every run is complete at the same last "episode" and the tables compare equal
 /// budgets. A run that never reached a step past 0 is left out with a note.
