@@ -13,6 +13,7 @@
 //! its quick start and its learner; within a family, methods differ in exhaustive `match`es on its
 //! own enum, and nothing outside the folder matches on one of its methods.
 
+pub mod acac;
 pub mod actor_critic;
 pub mod config_checks;
 pub mod families;

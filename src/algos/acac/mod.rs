@@ -1,0 +1,19 @@
+//! ACAC (Jung, Hong, Yoon, Lee, Lim, *Agent-Centric Actor-Critic for Asynchronous Multi-Agent
+//! Reinforcement Learning*, ICML 2025; GitHub `LGAI-Research/acac`): `acac`, `acac-vanilla` and
+//! `acac-micro-gae`, ACAC's three `--alg_name`s.
+//!
+//! A family of its own: per-agent GRU actors over each agent's own macro-observations, a critic
+//! that encodes each agent's history with its own GRU and attends over the agents with a GPT-2
+//! block, macro-level GAE and PPO, on ACAC's settings layered from its own parameter files
+//! ([`config`]). The nets are in `crate::nn` (`gpt2*`, `layer_norm`, `popart`,
+//! `time_embedding`, `value_head`, `acac_joint_value`).
+//!
+//! State (README "ACAC"): methods, config and published settings, and the macro-level GAE
+//! ([`gae`]) exist and are tested; the learner ([`learner`]) does not yet and refuses runs.
+
+pub mod config;
+pub mod error;
+pub mod family;
+pub mod gae;
+pub mod learner;
+pub mod method;
