@@ -411,6 +411,27 @@ pub fn check(
             ));
         }
     }
+    // ACAC's learner feeds the actors' time embedding only when the critic's is on
+    // (`if not self.controller.time_emb: obs_seq_agent = None`): unequal flags crash its
+    // actor forward, so they must agree.
+    if c.time_emb != c.time_emb_actor {
+        return Err((
+            "time_emb_actor",
+            format!(
+                "must equal time_emb ({}): ACAC's learner gives the actors a time embedding \
+                 exactly when the critic has one, got {}",
+                c.time_emb, c.time_emb_actor
+            ),
+        ));
+    }
+    // ACAC counts its primitive-step budget at evaluations only (`log_diagnostics`): without
+    // them its run never ends.
+    if !c.eval_policy {
+        return Err((
+            "eval_policy",
+            "must be true: ACAC counts its budget of primitive steps at evaluations".into(),
+        ));
+    }
     check_positive(&[
         ("env_terminate_step", shape.horizon),
         ("total_epi", c.total_epi),
@@ -653,5 +674,7 @@ mod tests {
         assert_eq!(bad(&|c| c.use_attention = false), "use_attention");
         assert_eq!(bad(&|c| c.time_emb_alg = TimeEmbAlg::Learn), "time_emb_alg");
         assert_eq!(bad(&|c| c.eval_num_epi = 0), "eval_num_epi");
+        assert_eq!(bad(&|c| c.time_emb_actor = false), "time_emb_actor");
+        assert_eq!(bad(&|c| c.eval_policy = false), "eval_policy");
     }
 }

@@ -5,11 +5,23 @@
 pub enum AcacError {
     /// The method's learner is not in macdec yet (README "ACAC": what exists and what does not).
     #[error(
-        "{method}: ACAC's learner is not implemented in macdec yet; its config, published \
-         settings and experiment files are (README \"ACAC\")"
+        "{method}: this ACAC method's learner is not implemented in macdec yet (`acac` and \
+         `acac-micro-gae` are; README \"ACAC\")"
     )]
     LearnerMissing {
         /// The method asked for (its command-line name).
         method: &'static str,
+    },
+    /// An update could not run on the batch collected (named by the reference's check).
+    #[error("{method} seed {seed}, after {episodes} episodes: {reason}")]
+    Update {
+        /// The method.
+        method: &'static str,
+        /// The run's seed.
+        seed: u64,
+        /// Training episodes done.
+        episodes: u64,
+        /// Why.
+        reason: String,
     },
 }

@@ -83,19 +83,29 @@ pub fn macro_discounts(discounts: &[f32], gamma: f64) -> Vec<f32> {
 
 /// `_get_gae` for one episode with discount `gamma` and GAE's `lambda`.
 pub fn episode_gae(e: GaeEpisode<'_>, gamma: f64, lambda: f64) -> Result<Gae, GaeError> {
+    episode_gae_lambdas(e, gamma, &vec![lambda as f32; e.rewards.len()])
+}
+
+/// `_get_gae` with a lambda per joint macro-step: `acac`'s constant lambda, or
+/// `acac_micro_gae`'s (`_get_gae_old`) lambda to each macro-step's duration in primitive steps,
+/// lambda_k = lambda^t_k / lambda^t_(k-1), which makes the recursion per primitive step.
+pub fn episode_gae_lambdas(
+    e: GaeEpisode<'_>,
+    gamma: f64,
+    lambdas: &[f32],
+) -> Result<Gae, GaeError> {
     let len = e.rewards.len();
-    if e.bootstrap.len() != len || e.discounts.len() != len {
+    if e.bootstrap.len() != len || e.discounts.len() != len || lambdas.len() != len {
         return Err(GaeError::Lengths {
             rewards: len,
             bootstrap: e.bootstrap.len(),
-            discounts: e.discounts.len(),
+            discounts: e.discounts.len().min(lambdas.len()),
         });
     }
     if len < 2 {
         return Err(GaeError::TooShort(len));
     }
     let d = macro_discounts(e.discounts, gamma);
-    let lambda = lambda as f32;
     let (r, b) = (e.rewards, e.bootstrap);
     let value_before = |k: usize| if k == 0 { e.initial_value } else { b[k - 1] };
     let end = len - 1;
@@ -107,7 +117,7 @@ pub fn episode_gae(e: GaeEpisode<'_>, gamma: f64, lambda: f64) -> Result<Gae, Ga
     };
     for k in (0..end).rev() {
         let delta = r[k] + d[k] * b[k] - value_before(k);
-        adv[k] = delta + d[k] * lambda * adv[k + 1];
+        adv[k] = delta + d[k] * lambdas[k] * adv[k + 1];
     }
     let returns = (0..len)
         .map(|k| {
@@ -205,6 +215,36 @@ mod tests {
                 got.advantages[k]
             );
         }
+    }
+
+    #[test]
+    fn micro_gae_raises_lambda_to_each_steps_duration() {
+        // gamma 0.5, lambda 0.5; steps end at primitive steps 0, 1, 3 -> d = 0.5, 0.5, 0.25 and
+        // micro lambdas 0.5, 0.5, 0.25 (durations 1, 1, 2). v_init 1, b = [2, 4, 8], r = [1, 2, 3].
+        // A_2 = 3 + 0.25 * 8 - 4 = 1
+        // A_1 = 2 + 0.5 * 4 - 2 + 0.5 * 0.5 * 1 = 2.25
+        // A_0 = 1 + 0.5 * 2 - 1 + 0.5 * 0.5 * 2.25 = 1.5625
+        // With durations 1 the micro form equals the macro one; make step 1 last 2 steps:
+        // ends 0, 2, 3 -> d = 0.5, 0.25, 0.5, lambdas 0.5, 0.25, 0.5.
+        // A_2 = 3 + 0.5 * 8 - 4 = 3
+        // A_1 = 2 + 0.25 * 4 - 2 + 0.25 * 0.25 * 3 = 1.1875
+        // A_0 = 1 + 0.5 * 2 - 1 + 0.5 * 0.5 * 1.1875 = 1.296875
+        let e = GaeEpisode {
+            rewards: &[1.0, 2.0, 3.0],
+            initial_value: 1.0,
+            bootstrap: &[2.0, 4.0, 8.0],
+            discounts: &[1.0, 0.25, 0.125],
+            terminated: false,
+        };
+        let g = episode_gae_lambdas(e, 0.5, &[0.5, 0.25, 0.5]).unwrap();
+        assert_eq!(g.advantages, vec![1.296875, 1.1875, 3.0]);
+        // The macro form on the same episode uses 0.5 at step 1: A_1 = 1 + 0.125 * 3 = 1.375.
+        let m = episode_gae(e, 0.5, 0.5).unwrap();
+        assert_eq!(m.advantages[1], 1.375);
+        assert!(matches!(
+            episode_gae_lambdas(e, 0.5, &[0.5]),
+            Err(GaeError::Lengths { .. })
+        ));
     }
 
     #[test]

@@ -8,12 +8,15 @@
 //! ([`config`]). The nets are in `crate::nn` (`gpt2*`, `layer_norm`, `popart`,
 //! `time_embedding`, `value_head`, `acac_joint_value`).
 //!
-//! State (README "ACAC"): methods, config and published settings, and the macro-level GAE
-//! ([`gae`]) exist and are tested; the learner ([`learner`]) does not yet and refuses runs.
+//! State (README "ACAC"): `acac` and `acac-micro-gae` train ([`learner`], [`update`]);
+//! `acac-vanilla` is refused until its learner is written.
 
+pub mod batch;
 pub mod config;
 pub mod error;
 pub mod family;
 pub mod gae;
 pub mod learner;
 pub mod method;
+pub mod nets;
+pub mod update;

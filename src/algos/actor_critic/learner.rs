@@ -232,6 +232,7 @@ impl Learner for AcLearner {
             train_freq: c.train_freq as u64,
             target_update_freq: c.c_target_update_freq as u64,
             eval_period: c.eval_period() as u64,
+            eval_after_update: false,
         }
     }
 
