@@ -6,8 +6,9 @@ The env is built as ACAC's runner builds it: the kwargs are what `scripts/params
 get_env_params` returns for `scripts/params/default.json` overridden by `env/<NAME>.json`
 (`--setting ovcAR7`), `gym.make(env_id, **kwargs)`, Overcooked behind ACAC's `MacEnvWrapper`.
 Then `np.random.seed(--np-seed)`, one `reset()`, and free agents draw uniform macro-actions from
-their own `RandomState(--random-seed)` (never the global stream) until done or the horizon
-(`env_terminate_step` unless --horizon).
+their own `RandomState(--random-seed)` (never the global stream), or follow --plan ('[[1, 15],
+[0]]': agent i starts its list's macro-actions in order whenever it is free and repeats the last
+one), until done or the horizon (`env_terminate_step` unless --horizon).
 
 It writes NAME.actions.json, the input of `macdec replay --actions`:
   {"source": "acac", "env": ID, "params": {kwargs}, "np_seed": S, "start_map": [[...]] (random
@@ -58,6 +59,7 @@ def main():
     parser.add_argument("--setting", required=True, help="scripts/params/env/NAME.json, e.g. ovcA7")
     parser.add_argument("--np-seed", type=int, required=True, help="np.random.seed before reset")
     parser.add_argument("--random-seed", type=int, default=0, help="the free agents' actions")
+    parser.add_argument("--plan", help="JSON list per agent of macro-actions started in order")
     parser.add_argument("--horizon", type=int, help="most steps (env_terminate_step by default)")
     parser.add_argument("--out", required=True, help="output path without extension")
     args = parser.parse_args()
@@ -99,10 +101,23 @@ def main():
 
     lines = [{"t": 0, "obs": [as_floats(o) for o in obs], **state_fields()}]
     rng = np.random.RandomState(args.random_seed)
+    plan = json.loads(args.plan) if args.plan else None
+    if plan is not None and len(plan) != n_agent:
+        parser.error(f"--plan needs one list per agent ({n_agent})")
+    started = [0] * n_agent
     free = [True] * n_agent
     steps = []
     for t in range(1, (args.horizon or horizon) + 1):
-        actions = [int(rng.randint(n)) if free[i] else -1 for i, n in enumerate(n_actions)]
+        if plan is None:
+            actions = [int(rng.randint(n)) if free[i] else -1 for i, n in enumerate(n_actions)]
+        else:
+            actions = []
+            for i in range(n_agent):
+                if free[i]:
+                    actions.append(int(plan[i][min(started[i], len(plan[i]) - 1)]))
+                    started[i] += 1
+                else:
+                    actions.append(-1)
         steps.append(actions)
         obs, rewards, done, info = env.step(actions)
         mac_done = as_ints(info["mac_done"])

@@ -12,6 +12,10 @@
 #                                 # 42) into reproduction/macromarl: Warehouse C, D, E and the
 #                                 # ablation, then Overcooked A, B, C, all 20 seeds, five seeds at
 #                                 # a time so every block fills evenly
+#   scripts/campaign.sh macromarl-value # MacroMARL's value-based blocks (issue 44) into
+#                                 # reproduction/macromarl_value: seeds 0..5 of Box Pushing 8, 10,
+#                                 # 12, 20, 30, Warehouse A, B, C and Overcooked A, B, then Box
+#                                 # Pushing's seeds 5..20
 #   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
 #                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
@@ -64,6 +68,24 @@ macromarl_rest_lane() {
     done
 }
 
+train_macromarl_value() {
+    "$MACDEC" train --config "experiments/macromarl_value/$1.toml" --out "$OUT/macromarl_value" \
+        --jobs 1 --quiet --no-plot "${@:2}"
+}
+
+macromarl_value_lane() {
+    set -e
+    for block in bp8 bp10 bp12 bp20 bp30 wh_a wh_b wh_c overcooked_a overcooked_b; do
+        train_macromarl_value "$block" --seeds 0..5
+    done
+    # Box Pushing's published 20 seeds, five at a time.
+    for first in 5 10 15; do
+        for block in bp8 bp10 bp12 bp20 bp30; do
+            train_macromarl_value "$block" --seeds "$first..$((first + 5))"
+        done
+    done
+}
+
 lanes() {
     pids=()
     for _ in $(seq "$JOBS"); do
@@ -101,6 +123,9 @@ macromarl)
 macromarl-rest)
     lanes macromarl_rest_lane
     ;;
+macromarl-value)
+    lanes macromarl_value_lane
+    ;;
 collect)
     find "$OUT" -name finished -type f | sort | while read -r marker; do
         dir=$(dirname "$marker")
@@ -114,14 +139,15 @@ collect)
     find "$OUT" -maxdepth 2 -name shared_curves.toml -type f -exec git add -f {} +
     ;;
 status)
-    # Curves are <experiment>/<curve>/ and, for MacroMARL, macromarl/<block>/<method>/.
-    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/; do
+    # Curves are <experiment>/<curve>/ and, for MacroMARL, macromarl/<block>/<method>/ and
+    # macromarl_value/<block>/<method>/.
+    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/ "$OUT"/macromarl_value/*/*/; do
         n=$(find "$curve" -mindepth 2 -maxdepth 2 -name finished | wc -l)
         [[ $n -gt 0 ]] && echo "${curve#"$OUT"/}: $n finished"
     done
     ;;
 *)
-    echo "usage: $0 run|macromarl|macromarl-rest|collect|status" >&2
+    echo "usage: $0 run|macromarl|macromarl-rest|macromarl-value|collect|status" >&2
     exit 2
     ;;
 esac

@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
-"""Learning curves from MacroMARL's own actor-critic code (yuchen-x/MacroMARL), for comparison with ours.
+"""Learning curves from MacroMARL's own code (yuchen-x/MacroMARL), for comparison with ours.
 
 Usage (Python 3.11 with torch, numpy and gym==0.26.2):
     python3 scripts/macromarl_reference_curve.py --ref PATH/TO/MacroMARL \
-        --overcooked PATH/TO/gym-macro-overcooked --out DIR -- <pg_based_main.py's own flags>
+        --overcooked PATH/TO/gym-macro-overcooked --out DIR [--main value] -- <the entry's own flags>
 
-The reference entry point `scripts/pg_based_main.py` runs unchanged, in-process (runpy), with its
-working directory set to DIR (it writes `performance/` and `policy_nns/` there). The only things
-done around it:
+The reference entry point runs unchanged, in-process (runpy), with its working directory set to
+DIR (it writes `performance/` and `policy_nns/` there): `scripts/pg_based_main.py` (the
+actor-critic methods; `--main pg`, the default) or `scripts/value_based_main.py` (MacDec-Q,
+MacCen-Q and the DDRQN variants; `--main value`). The only things done around it:
   * `<ref>/src` and the gym-macro-overcooked checkout go on sys.path (pg_based_main.py imports
     `gym_macro_overcooked` unconditionally, even for Box Pushing);
   * stand-in modules, when they are not installed, for `IPython` (the env files import it for a
@@ -24,9 +25,10 @@ done around it:
 The runner forks `--n_env` worker processes (multiprocessing, fork start method).
 
 Outputs in DIR:
-  curve.csv    `episode,return`: evaluation k (mean discounted return of 10 *sampled* test
-               episodes, docs/MACROMARL.md §2.5) at episode k * (eval_freq - eval_freq % train_freq), the first
-               at episode 0, before training. Written as each evaluation is printed (parsed from
+  curve.csv    `episode,return`: evaluation k (actor-critic: mean discounted return of 10
+               *sampled* test episodes, docs/MACROMARL.md §2.5, at episode k * (eval_freq -
+               eval_freq % train_freq); value-based: one greedy episode's discounted return at
+               episode k * eval_freq, docs/MACROMARL.md §8), the first at episode 0, before training. Written as each evaluation is printed (parsed from
                the reference's own progress line, so a long run can be watched), and rewritten at
                the end from the reference's pickle `performance/<save_dir>/test/test_perform<run_id>
                .pickle`, which is checked against the printed values.
@@ -117,15 +119,24 @@ def write_curve(out, rows):
     os.replace(tmp, os.path.join(out, "curve.csv"))
 
 
-EVAL_LINE = re.compile(
-    r"Finished: (\d+)/\d+ Evaluate learned policies with averaged returns (\S+) \.\.\.")
+# Each entry's progress line after an evaluation: the actor-critic runner's, and the value-based
+# learners' (printed when the episode count is a multiple of eval_freq, with the latest return).
+EVAL_LINES = {
+    "pg": re.compile(
+        r"Finished: (\d+)/\d+ Evaluate learned policies with averaged returns (\S+) \.\.\."),
+    "value": re.compile(r"to finish (\d+)(?:\.0)? episodes .* latest return \((\S+)\)"),
+}
+# What the value-based learners print once the evaluation record is saved; MacCenQ and the two
+# DDRQN learners then end with a NameError (docs/MACROMARL.md §8), which is not a failed run.
+FINISHED = "inish entire training"
 
 
 class Tee:
     """The reference's stdout, copied to log.txt; each evaluation line updates curve.csv."""
 
-    def __init__(self, out, stream):
+    def __init__(self, out, stream, eval_line):
         self.out, self.stream, self.buf, self.rows = out, stream, "", []
+        self.eval_line, self.finished = eval_line, False
         self.log = open(os.path.join(out, "log.txt"), "w")
 
     def write(self, s):
@@ -135,8 +146,9 @@ class Tee:
         *lines, self.buf = self.buf.split("\n")
         new = False
         for line in lines:
-            m = EVAL_LINE.search(line)
-            if m:
+            self.finished = self.finished or FINISHED in line
+            m = self.eval_line.search(line)
+            if m and (int(m.group(1)), float(m.group(2))) not in self.rows[-1:]:
                 self.rows.append((int(m.group(1)), float(m.group(2))))
                 new = True
         if new:
@@ -156,11 +168,13 @@ def main():
     p.add_argument("--ref", required=True, help="checkout of yuchen-x/MacroMARL")
     p.add_argument("--overcooked", required=True, help="checkout of WeihaoTan/gym-macro-overcooked")
     p.add_argument("--out", required=True, help="working directory for the reference run")
-    p.add_argument("args", nargs=argparse.REMAINDER, help="-- then pg_based_main.py's own flags")
+    p.add_argument("--main", choices=["pg", "value"], default="pg",
+                   help="pg_based_main.py (actor-critic, default) or value_based_main.py")
+    p.add_argument("args", nargs=argparse.REMAINDER, help="-- then the entry's own flags")
     a = p.parse_args()
     argv = a.args[1:] if a.args[:1] == ["--"] else a.args
     ref = os.path.abspath(a.ref)
-    script = os.path.join(ref, "scripts", "pg_based_main.py")
+    script = os.path.join(ref, "scripts", f"{a.main}_based_main.py")
     if not os.path.isfile(script):
         sys.exit(f"no reference script {script}")
     save_dir = flag(argv, "save_dir", "test")
@@ -168,8 +182,11 @@ def main():
         sys.exit("give the reference a plain --save_dir name (it becomes a directory under --out)")
     run_id = int(flag(argv, "run_id", "0"))
     eval_freq = int(flag(argv, "eval_freq", "100"))
-    train_freq = int(flag(argv, "train_freq", "2"))
-    period = eval_freq - eval_freq % train_freq
+    if a.main == "pg":
+        train_freq = int(flag(argv, "train_freq", "2"))
+        period = eval_freq - eval_freq % train_freq
+    else:
+        period = eval_freq
     if int(flag(argv, "seed", "0")) == 0:
         print("warning: --seed 0 (the default) leaves the main process unseeded", file=sys.stderr)
 
@@ -194,12 +211,17 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     out = os.path.abspath(a.out)
     os.chdir(out)
-    tee = Tee(out, sys.stdout)
+    tee = Tee(out, sys.stdout, EVAL_LINES[a.main])
     sys.stdout = tee
     sys.argv = [script] + argv
     wall0 = time.monotonic()
     try:
         runpy.run_path(script, run_name="__main__")
+    except NameError as e:
+        if not (a.main == "value" and tee.finished):
+            raise
+        print(f"note: the reference ended with its known NameError after saving ({e})",
+              file=sys.stderr)
     finally:
         sys.stdout = tee.stream
         tee.log.close()
@@ -216,9 +238,15 @@ def main():
         returns = pickle.load(f)
     rows = [(k * period, r) for k, r in enumerate(returns)]
     printed = tee.rows
-    if [e for e, _ in printed] != [e for e, _ in rows] or any(
-        abs(float(x) - float(y)) > 1e-9 * max(1.0, abs(float(y)))
-        for (_, x), (_, y) in zip(printed, rows)
+    recorded = dict(rows)
+    if a.main == "pg":
+        same = [e for e, _ in printed] == [e for e, _ in rows]
+    else:
+        # The value-based learners print only at some evaluations (not before training).
+        same = all(e in recorded for e, _ in printed)
+    if not same or any(
+        abs(float(x) - float(recorded[e])) > 1e-9 * max(1.0, abs(float(recorded[e])))
+        for e, x in printed
     ):
         sys.exit("the pickled evaluation record differs from the printed one")
     write_curve(out, rows)

@@ -82,6 +82,13 @@ fn stepping_and_resetting_allocate_nothing() {
         keys.insert("rand_start".into(), rand_start.into());
         specs.push(EnvSpec::new("ACAC-Overcooked-MA-v1", &keys).unwrap());
     }
+    // ACAC's Overcooked-Large, maps A-C, and map B's random starts.
+    for (map, rand_start) in [("A", false), ("B", false), ("C", false), ("B", true)] {
+        let mut keys = toml::Table::new();
+        keys.insert("map_type".into(), map.into());
+        keys.insert("rand_start".into(), rand_start.into());
+        specs.push(EnvSpec::new("ACAC-Overcooked-MA-v0", &keys).unwrap());
+    }
     for spec in specs {
         let mut env = spec.build().unwrap();
         let mut policy_rng = ChaCha8Rng::seed_from_u64(3);

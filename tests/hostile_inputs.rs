@@ -489,6 +489,39 @@ fn a_nan_rate_and_a_seed_beyond_the_largest_are_named_before_any_run() {
 }
 
 #[test]
+fn no_key_is_dropped_a_set_with_a_line_break_nor_a_key_the_domain_does_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("results");
+    let err = refused(&macdec(&[
+        "train",
+        "--set",
+        "total_epi=30\neval_freq=5",
+        "--out",
+        s(&results),
+    ]));
+    assert!(err.contains("line break"), "{err}");
+    for (set, key) in [
+        ("tb_m_noisy=0.5", "`tb_m_noisy`"),
+        ("env_name=\"BP-MA-v0\"", ""),
+    ] {
+        let mut args = vec!["train", "--set", set];
+        if key.is_empty() {
+            // MacroMARL's Box Pushing with a kwarg only its Warehouses read.
+            args.extend(["--methods", "mac-iac", "--set", "TB_move_speed=0.6"]);
+        }
+        args.extend(["--out", s(&results)]);
+        let err = refused(&macdec(&args));
+        let key = if key.is_empty() {
+            "`TB_move_speed`"
+        } else {
+            key
+        };
+        assert!(err.contains(key) && err.contains("leave it out"), "{err}");
+    }
+    assert!(!results.exists(), "no run may start");
+}
+
+#[test]
 fn a_robot_reads_its_weight_file_before_building_a_net_the_manifest_sizes() {
     use sha2::Digest;
     let dir = tempfile::tempdir().unwrap();

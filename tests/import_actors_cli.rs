@@ -42,10 +42,47 @@ fn list(paths: &[PathBuf]) -> String {
 fn imported_actors_evaluate_exactly_as_deployed_on_robot_processes() {
     let dir = tempfile::tempdir().unwrap();
     let params = dir.path().join("params.json");
-    std::fs::write(&params, r#"{"grid_dim": [6, 6], "TB_move_speed": 0.8}"#).unwrap();
     let env = macdec::envs::bp_ma_v0::spec(6, 100);
     let agents = write_actors(dir.path(), &env, [16, 12], 8);
     let policy = dir.path().join("policy");
+    // A kwarg MacroMARL's script passes to every env but Box Pushing does not read is refused by
+    // name, as `train` refuses it, and so is --tb-m-noisy, which BP-MA-v0 has no key for.
+    std::fs::write(&params, r#"{"grid_dim": [6, 6], "TB_move_speed": 0.8}"#).unwrap();
+    let agent_list = list(&agents);
+    let import = |extra: &[&str]| {
+        let args = [
+            &[
+                "import",
+                "--reference",
+                "macromarl",
+                "--env",
+                "BP-MA-v0",
+                "--params",
+                params.to_str().unwrap(),
+                "--agents",
+                &agent_list,
+                "--out",
+                policy.to_str().unwrap(),
+            ][..],
+            extra,
+        ]
+        .concat();
+        run(&args)
+    };
+    let refused = import(&[]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && stderr.contains("`TB_move_speed`"),
+        "{stderr}"
+    );
+    std::fs::write(&params, r#"{"grid_dim": [6, 6]}"#).unwrap();
+    let refused = import(&["--tb-m-noisy", "0.3"]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && stderr.contains("`tb_m_noisy`"),
+        "{stderr}"
+    );
+    assert!(!policy.exists(), "a refused import writes nothing");
     let out = run(&[
         "import",
         "--reference",
@@ -136,6 +173,19 @@ fn bad_actor_files_and_arguments_are_refused_and_nothing_is_written() {
     let e = import(&["--env", "BP-MA-v0", "--agents", &format!("{w0},{a1}")]);
     assert!(
         e.contains("fc1.weight") && e.contains("5 observation values"),
+        "{e}"
+    );
+    // Agents whose actors have different widths: named as such, not as an unreadable file.
+    let narrow_dir = dir.path().join("narrow");
+    std::fs::create_dir(&narrow_dir).unwrap();
+    let narrow = write_actors(&narrow_dir, &env, [6, 8], 4);
+    let n1 = narrow[1].to_str().unwrap();
+    let e = import(&["--env", "BP-MA-v0", "--agents", &format!("{a0},{n1}")]);
+    assert!(
+        e.contains("widths [6, 8]")
+            && e.contains("[8, 8]")
+            && e.contains("share one architecture")
+            && !e.contains("not a safetensors file"),
         "{e}"
     );
     let e = import(&["--env", "Pong-v0", "--agents", a0]);

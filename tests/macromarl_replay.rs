@@ -197,3 +197,34 @@ fn acac_random_starts_replay_numpys_draws() {
         ],
     );
 }
+
+#[test]
+fn acac_overcooked_ma_v0_replays_acacs_code() {
+    // Overcooked-Large, fixed starts: random episodes with cycles of agents moving at once (maps
+    // A and C), wrong deliveries, refreshed objects chopped; planned dishes on all three maps
+    // (map A after two wrong deliveries and a chop, B and C handed over the divider).
+    in_folder(
+        "acac",
+        &[
+            "ovc_a11_random22",
+            "ovc_b11_random8",
+            "ovc_c11_random22",
+            "ovc_a11_plan_dish",
+            "ovc_b11_plan_counter",
+            "ovc_c11_plan_counter",
+        ],
+    );
+}
+
+#[test]
+fn acac_overcooked_ma_v0_random_starts_replay_numpys_draws() {
+    // ovcAR11_N6 etc.: each `start_map` is checked against numpy's draws from its `np_seed`.
+    in_folder(
+        "acac",
+        &[
+            "ovc_ar11_np7_random7",
+            "ovc_br11_np8_random8",
+            "ovc_cr11_np9_random9",
+        ],
+    );
+}

@@ -49,9 +49,18 @@ class VectorEnv:
         step: every agent of a copy that ended and was reset), ``final_mac_done`` (the step's own
         flags, before any reset) and ``executed`` ``[N, n_agents]``, ``action_mask`` and
         ``final_obs``."""
-        a = np.asarray(actions)
+        expected = (self.num_envs, self.n_agents)
+        try:
+            a = np.asarray(actions)
+        except ValueError:
+            raise ValueError(f"actions must be an integer array of shape (num_envs, n_agents) = {expected}, got a ragged sequence") from None
+        if a.shape != expected:
+            raise ValueError(f"actions must be an integer array of shape (num_envs, n_agents) = {expected}, got shape {a.shape}")
         if a.dtype.kind not in "iu":
             raise ValueError(f"actions must be integers, got dtype {a.dtype}")
+        if a.dtype.kind == "u" and a.size and a.max() > np.iinfo(np.int64).max:
+            env, agent = np.unravel_index(int(a.argmax()), expected)
+            raise ValueError(f"env {env}, agent {agent}: the macro-action must be in 0..{self.n_actions[agent]}, got {a.max()}")
         return self._core.step(np.ascontiguousarray(a, dtype=np.int64))
 
     def close(self) -> None:

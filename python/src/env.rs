@@ -3,6 +3,7 @@
 //! Domains are built by [`EnvSpec::new`] from the id and keys, exactly as configs and `macdec
 //! replay` build them.
 
+use crate::guarded;
 use macdec::envs::{registry, AnyEnv, EnvError, EnvRng, EnvSpec, MacroEnv, StepOutcome};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -92,15 +93,17 @@ impl Env {
     #[new]
     #[pyo3(signature = (env_id, params=None))]
     fn new(env_id: &str, params: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let spec = spec_of(env_id, params)?;
-        let env = build(&spec)?;
-        let n = env.n_agents();
-        Ok(Env {
-            spec,
-            env,
-            rng: rng_of(None),
-            actions: vec![0; n],
-            running: false,
+        guarded(|| {
+            let spec = spec_of(env_id, params)?;
+            let env = build(&spec)?;
+            let n = env.n_agents();
+            Ok(Env {
+                spec,
+                env,
+                rng: rng_of(None),
+                actions: vec![0; n],
+                running: false,
+            })
         })
     }
 
@@ -153,8 +156,8 @@ impl Env {
     }
 
     /// A short description (`Box Pushing 10x10, horizon 100`).
-    fn describe(&self) -> String {
-        self.env.describe()
+    fn describe(&self) -> PyResult<String> {
+        guarded(|| Ok(self.env.describe()))
     }
 
     /// The names of agent `agent`'s macro-actions.
@@ -165,57 +168,64 @@ impl Env {
 
     /// The names of agent `agent`'s observation entries.
     fn obs_names(&self, agent: usize) -> PyResult<Vec<String>> {
-        self.check_agent(agent)?;
-        Ok(self.env.obs_names(agent))
+        guarded(|| {
+            self.check_agent(agent)?;
+            Ok(self.env.obs_names(agent))
+        })
     }
 
     /// Start an episode; `seed` restarts the random stream (`None` continues it).
     #[pyo3(signature = (seed=None))]
-    fn reset(&mut self, seed: Option<u64>) {
-        if let Some(s) = seed {
-            self.rng = rng_of(Some(s));
-        }
-        self.env.reset(&mut self.rng);
-        self.running = true;
+    fn reset(&mut self, seed: Option<u64>) -> PyResult<()> {
+        guarded(|| {
+            if let Some(s) = seed {
+                self.rng = rng_of(Some(s));
+            }
+            self.env.reset(&mut self.rng);
+            self.running = true;
+            Ok(())
+        })
     }
 
     /// One primitive step. `actions[i]` is agent i's macro-action, used only if it is free; a
     /// busy agent's entry is ignored (pass -1). Returns `(reward, terminated, truncated)`.
     fn step(&mut self, actions: Vec<i64>) -> PyResult<(f64, bool, bool)> {
-        if !self.running {
-            return Err(step_error(EnvError::EpisodeOver));
-        }
-        let n = self.env.n_agents();
-        if actions.len() != n {
-            return Err(step_error(EnvError::WrongActionCount {
-                expected: n,
-                got: actions.len(),
-            }));
-        }
-        for (agent, &a) in actions.iter().enumerate() {
-            self.actions[agent] = if self.env.is_free(agent) {
-                let n_actions = self.env.n_actions()[agent];
-                usize::try_from(a)
-                    .ok()
-                    .filter(|&a| a < n_actions)
-                    .ok_or_else(|| {
-                        PyValueError::new_err(format!(
-                            "agent {agent} may choose now and needs a macro-action in 0..{n_actions}, got {a}"
-                        ))
-                    })?
-            } else {
-                0
-            };
-        }
-        let out = self
-            .env
-            .step(&self.actions, &mut self.rng)
-            .map_err(step_error)?;
-        if out.done {
-            self.running = false;
-        }
-        let (terminated, truncated) = end_flags(&out, self.env.t(), self.env.horizon());
-        Ok((out.reward, terminated, truncated))
+        guarded(|| {
+            if !self.running {
+                return Err(step_error(EnvError::EpisodeOver));
+            }
+            let n = self.env.n_agents();
+            if actions.len() != n {
+                return Err(step_error(EnvError::WrongActionCount {
+                    expected: n,
+                    got: actions.len(),
+                }));
+            }
+            for (agent, &a) in actions.iter().enumerate() {
+                self.actions[agent] = if self.env.is_free(agent) {
+                    let n_actions = self.env.n_actions()[agent];
+                    usize::try_from(a)
+                        .ok()
+                        .filter(|&a| a < n_actions)
+                        .ok_or_else(|| {
+                            PyValueError::new_err(format!(
+                                "agent {agent} may choose now and needs a macro-action in 0..{n_actions}, got {a}"
+                            ))
+                        })?
+                } else {
+                    0
+                };
+            }
+            let out = self
+                .env
+                .step(&self.actions, &mut self.rng)
+                .map_err(step_error)?;
+            if out.done {
+                self.running = false;
+            }
+            let (terminated, truncated) = end_flags(&out, self.env.t(), self.env.horizon());
+            Ok((out.reward, terminated, truncated))
+        })
     }
 
     /// Agent `agent`'s current (held) macro-observation, float32.
@@ -253,12 +263,14 @@ impl Env {
     }
 
     /// The global state (float32), or `None` for a domain without one.
-    fn state<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f32>>> {
-        let n = self.env.state_size();
-        (n > 0).then(|| {
-            let mut s = vec![0.0; n];
-            self.env.write_state(&mut s);
-            s.into_pyarray_bound(py)
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<f32>>>> {
+        guarded(|| {
+            let n = self.env.state_size();
+            Ok((n > 0).then(|| {
+                let mut s = vec![0.0; n];
+                self.env.write_state(&mut s);
+                s.into_pyarray_bound(py)
+            }))
         })
     }
 
@@ -269,22 +281,26 @@ impl Env {
         &self,
         py: Python<'py>,
         team_return: f64,
-    ) -> Option<Bound<'py, PyArray3<u8>>> {
-        let canvas = macdec::render::draw_frame(&self.env, team_return)?;
-        let palette = macdec::draw::palette::gif_palette();
-        let mut rgb = Vec::with_capacity(canvas.pixels().len() * 3);
-        for &p in canvas.pixels() {
-            let at = 3 * p as usize;
-            rgb.extend_from_slice(palette.get(at..at + 3).unwrap_or(&[0, 0, 0]));
-        }
-        let image = ndarray::Array3::from_shape_vec((canvas.height(), canvas.width(), 3), rgb)
-            .expect("one RGB triple per pixel");
-        Some(image.into_pyarray_bound(py))
+    ) -> PyResult<Option<Bound<'py, PyArray3<u8>>>> {
+        guarded(|| {
+            let Some(canvas) = macdec::render::draw_frame(&self.env, team_return) else {
+                return Ok(None);
+            };
+            let palette = macdec::draw::palette::gif_palette();
+            let mut rgb = Vec::with_capacity(canvas.pixels().len() * 3);
+            for &p in canvas.pixels() {
+                let at = 3 * p as usize;
+                rgb.extend_from_slice(palette.get(at..at + 3).unwrap_or(&[0, 0, 0]));
+            }
+            let image = ndarray::Array3::from_shape_vec((canvas.height(), canvas.width(), 3), rgb)
+                .expect("one RGB triple per pixel");
+            Ok(Some(image.into_pyarray_bound(py)))
+        })
     }
 
     /// A text picture of the state.
-    fn render_ascii(&self) -> String {
-        self.env.render_ascii()
+    fn render_ascii(&self) -> PyResult<String> {
+        guarded(|| Ok(self.env.render_ascii()))
     }
 }
 
@@ -341,26 +357,28 @@ impl VectorEnv {
     #[new]
     #[pyo3(signature = (env_id, num_envs, params=None))]
     fn new(env_id: &str, num_envs: usize, params: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        if num_envs == 0 || num_envs > MAX_NUM_ENVS {
-            return Err(PyValueError::new_err(format!(
-                "num_envs must be 1..={MAX_NUM_ENVS}, got {num_envs}"
-            )));
-        }
-        let spec = spec_of(env_id, params)?;
-        let first = build(&spec)?;
-        let n_agents = first.n_agents();
-        let obs_width = first.obs_sizes().iter().copied().max().unwrap_or(0);
-        let act_width = first.n_actions().iter().copied().max().unwrap_or(0);
-        let envs = vec![first; num_envs];
-        Ok(VectorEnv {
-            spec,
-            rngs: (0..num_envs).map(|_| rng_of(None)).collect(),
-            envs,
-            n_agents,
-            obs_width,
-            act_width,
-            actions: vec![0; n_agents],
-            reset_done: false,
+        guarded(|| {
+            if num_envs == 0 || num_envs > MAX_NUM_ENVS {
+                return Err(PyValueError::new_err(format!(
+                    "num_envs must be 1..={MAX_NUM_ENVS}, got {num_envs}"
+                )));
+            }
+            let spec = spec_of(env_id, params)?;
+            let first = build(&spec)?;
+            let n_agents = first.n_agents();
+            let obs_width = first.obs_sizes().iter().copied().max().unwrap_or(0);
+            let act_width = first.n_actions().iter().copied().max().unwrap_or(0);
+            let envs = vec![first; num_envs];
+            Ok(VectorEnv {
+                spec,
+                rngs: (0..num_envs).map(|_| rng_of(None)).collect(),
+                envs,
+                n_agents,
+                obs_width,
+                act_width,
+                actions: vec![0; n_agents],
+                reset_done: false,
+            })
         })
     }
 
@@ -409,33 +427,36 @@ impl VectorEnv {
     /// Reset every copy; copy k restarts its stream at `seed + k` (`None`: fresh OS seeds).
     /// Returns `(obs [N, n_agents, max_obs] float32, action_mask [N, n_agents, max_actions] bool)`.
     #[pyo3(signature = (seed=None))]
+    #[allow(clippy::type_complexity)]
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
         seed: Option<u64>,
-    ) -> (Bound<'py, PyArray3<f32>>, Bound<'py, PyArray3<bool>>) {
-        let (n, a, w, m) = (
-            self.envs.len(),
-            self.n_agents,
-            self.obs_width,
-            self.act_width,
-        );
-        let mut obs = vec![0.0f32; n * a * w];
-        let mut mask = vec![false; n * a * m];
-        let envs = &mut self.envs;
-        let rngs = &mut self.rngs;
-        py.allow_threads(|| {
-            for (k, (env, rng)) in envs.iter_mut().zip(rngs.iter_mut()).enumerate() {
-                if let Some(s) = seed {
-                    *rng = rng_of(Some(s.wrapping_add(k as u64)));
+    ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyArray3<bool>>)> {
+        guarded(|| {
+            let (n, a, w, m) = (
+                self.envs.len(),
+                self.n_agents,
+                self.obs_width,
+                self.act_width,
+            );
+            let mut obs = vec![0.0f32; n * a * w];
+            let mut mask = vec![false; n * a * m];
+            let envs = &mut self.envs;
+            let rngs = &mut self.rngs;
+            py.allow_threads(|| {
+                for (k, (env, rng)) in envs.iter_mut().zip(rngs.iter_mut()).enumerate() {
+                    if let Some(s) = seed {
+                        *rng = rng_of(Some(s.wrapping_add(k as u64)));
+                    }
+                    env.reset(rng);
+                    write_obs(env, w, &mut obs[k * a * w..(k + 1) * a * w]);
+                    write_mask(env, m, &mut mask[k * a * m..(k + 1) * a * m]);
                 }
-                env.reset(rng);
-                write_obs(env, w, &mut obs[k * a * w..(k + 1) * a * w]);
-                write_mask(env, m, &mut mask[k * a * m..(k + 1) * a * m]);
-            }
-        });
-        self.reset_done = true;
-        (array3(py, obs, (n, a, w)), array3(py, mask, (n, a, m)))
+            });
+            self.reset_done = true;
+            Ok((array3(py, obs, (n, a, w)), array3(py, mask, (n, a, m))))
+        })
     }
 
     /// One primitive step of every copy. `actions`: int64 [N, n_agents], a busy agent's entry
@@ -457,51 +478,53 @@ impl VectorEnv {
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyDict>,
     )> {
-        if !self.reset_done {
-            return Err(PyRuntimeError::new_err("call reset() before step()"));
-        }
-        let (n, a, w, m) = (
-            self.envs.len(),
-            self.n_agents,
-            self.obs_width,
-            self.act_width,
-        );
-        let view = actions.as_array();
-        if view.shape() != [n, a] {
-            return Err(PyValueError::new_err(format!(
-                "actions must have shape (num_envs, n_agents) = ({n}, {a}), got {:?}",
-                view.shape()
-            )));
-        }
-        let flat: Vec<i64> = view.iter().copied().collect();
-        let mut out = Outputs {
-            obs: vec![0.0; n * a * w],
-            final_obs: vec![0.0; n * a * w],
-            rewards: vec![0.0; n],
-            terminated: vec![false; n],
-            truncated: vec![false; n],
-            mac_done: vec![false; n * a],
-            final_mac_done: vec![false; n * a],
-            executed: vec![0; n * a],
-            mask: vec![false; n * a * m],
-        };
-        let envs = &mut self.envs;
-        let rngs = &mut self.rngs;
-        let scratch = &mut self.actions;
-        py.allow_threads(|| step_all(envs, rngs, scratch, &flat, (a, w, m), &mut out))?;
-        let infos = PyDict::new_bound(py);
-        infos.set_item("mac_done", array2(py, out.mac_done, (n, a)))?;
-        infos.set_item("final_mac_done", array2(py, out.final_mac_done, (n, a)))?;
-        infos.set_item("executed", array2(py, out.executed, (n, a)))?;
-        infos.set_item("action_mask", array3(py, out.mask, (n, a, m)))?;
-        infos.set_item("final_obs", array3(py, out.final_obs, (n, a, w)))?;
-        Ok((
-            array3(py, out.obs, (n, a, w)),
-            out.rewards.into_pyarray_bound(py),
-            out.terminated.into_pyarray_bound(py),
-            out.truncated.into_pyarray_bound(py),
-            infos,
-        ))
+        guarded(|| {
+            if !self.reset_done {
+                return Err(PyRuntimeError::new_err("call reset() before step()"));
+            }
+            let (n, a, w, m) = (
+                self.envs.len(),
+                self.n_agents,
+                self.obs_width,
+                self.act_width,
+            );
+            let view = actions.as_array();
+            if view.shape() != [n, a] {
+                return Err(PyValueError::new_err(format!(
+                    "actions must have shape (num_envs, n_agents) = ({n}, {a}), got {:?}",
+                    view.shape()
+                )));
+            }
+            let flat: Vec<i64> = view.iter().copied().collect();
+            let mut out = Outputs {
+                obs: vec![0.0; n * a * w],
+                final_obs: vec![0.0; n * a * w],
+                rewards: vec![0.0; n],
+                terminated: vec![false; n],
+                truncated: vec![false; n],
+                mac_done: vec![false; n * a],
+                final_mac_done: vec![false; n * a],
+                executed: vec![0; n * a],
+                mask: vec![false; n * a * m],
+            };
+            let envs = &mut self.envs;
+            let rngs = &mut self.rngs;
+            let scratch = &mut self.actions;
+            py.allow_threads(|| step_all(envs, rngs, scratch, &flat, (a, w, m), &mut out))?;
+            let infos = PyDict::new_bound(py);
+            infos.set_item("mac_done", array2(py, out.mac_done, (n, a)))?;
+            infos.set_item("final_mac_done", array2(py, out.final_mac_done, (n, a)))?;
+            infos.set_item("executed", array2(py, out.executed, (n, a)))?;
+            infos.set_item("action_mask", array3(py, out.mask, (n, a, m)))?;
+            infos.set_item("final_obs", array3(py, out.final_obs, (n, a, w)))?;
+            Ok((
+                array3(py, out.obs, (n, a, w)),
+                out.rewards.into_pyarray_bound(py),
+                out.terminated.into_pyarray_bound(py),
+                out.truncated.into_pyarray_bound(py),
+                infos,
+            ))
+        })
     }
 }
 

@@ -6,6 +6,7 @@
 //! (the highest score, ties to the lowest index); an actor may sample instead, from the streams
 //! `macdec eval --sample` draws from (the run seed's evaluation stream).
 
+use crate::guarded;
 use macdec::deploy::drive::link::choose_action;
 use macdec::deploy::drive::local_eval::{agent_sampler, Choice};
 use macdec::deploy::drive::team::CentralPolicy;
@@ -112,23 +113,25 @@ impl Policy {
     /// Load the policy directory `dir` (or a run directory, whose `policy/` is read).
     #[staticmethod]
     fn load(py: Python<'_>, dir: PathBuf) -> PyResult<Self> {
-        if !dir.is_dir() {
-            return Err(PyFileNotFoundError::new_err(format!(
-                "{}: no such policy directory",
-                dir.display()
-            )));
-        }
-        let dir = policy_dir(&dir);
-        let loaded = py.allow_threads(|| load_acting(&dir).map_err(|e| e.to_string()));
-        let (manifest, acting, kinds) =
-            loaded.map_err(|e| PyValueError::new_err(format!("loading {}: {e}", dir.display())))?;
-        Ok(Policy {
-            last: vec![None; manifest.agents.len()],
-            manifest,
-            dir,
-            acting,
-            kinds,
-            probs: Vec::new(),
+        guarded(|| {
+            if !dir.is_dir() {
+                return Err(PyFileNotFoundError::new_err(format!(
+                    "{}: no such policy directory",
+                    dir.display()
+                )));
+            }
+            let dir = policy_dir(&dir);
+            let loaded = py.allow_threads(|| load_acting(&dir).map_err(|e| e.to_string()));
+            let (manifest, acting, kinds) = loaded
+                .map_err(|e| PyValueError::new_err(format!("loading {}: {e}", dir.display())))?;
+            Ok(Policy {
+                last: vec![None; manifest.agents.len()],
+                manifest,
+                dir,
+                acting,
+                kinds,
+                probs: Vec::new(),
+            })
         })
     }
 
@@ -209,12 +212,15 @@ impl Policy {
 
     /// Zero every hidden state, as at an episode's start (sampling streams go on, as across
     /// `macdec eval --sample`'s episodes).
-    fn reset(&mut self) {
-        match &mut self.acting {
-            Acting::Agents(agents) => agents.iter_mut().for_each(|a| a.policy.reset()),
-            Acting::Team(team) => team.reset(),
-        }
-        self.last.fill(None);
+    fn reset(&mut self) -> PyResult<()> {
+        guarded(|| {
+            match &mut self.acting {
+                Acting::Agents(agents) => agents.iter_mut().for_each(|a| a.policy.reset()),
+                Acting::Team(team) => team.reset(),
+            }
+            self.last.fill(None);
+            Ok(())
+        })
     }
 
     /// One primitive step: each agent whose `mac_done[i]` is true decides (greedy, or with
@@ -235,94 +241,111 @@ impl Policy {
         mac_done: Vec<bool>,
         sample: bool,
     ) -> PyResult<(Vec<Option<usize>>, Vec<Option<Bound<'py, PyArray1<f32>>>>)> {
-        let n = self.manifest.agents.len();
-        if obs.len() != n || mac_done.len() != n {
-            return Err(PyValueError::new_err(format!(
-                "expected one observation and one mac_done flag per agent ({n}), got {} and {}",
-                obs.len(),
-                mac_done.len()
-            )));
-        }
-        let centralized = matches!(self.acting, Acting::Team(_));
-        for (i, (o, layout)) in obs.iter().zip(&self.manifest.agents).enumerate() {
-            if (mac_done[i] || centralized) && o.len()? != layout.obs_size {
+        guarded(|| {
+            let n = self.manifest.agents.len();
+            if obs.len() != n || mac_done.len() != n {
                 return Err(PyValueError::new_err(format!(
-                    "agent {i}: observation has {} values, the policy expects {}",
-                    o.len()?,
-                    layout.obs_size
+                    "expected one observation and one mac_done flag per agent ({n}), got {} and {}",
+                    obs.len(),
+                    mac_done.len()
                 )));
             }
-        }
-        if sample {
-            if let Some(i) = self.kinds.iter().position(|&k| k == "q") {
-                let whose = if centralized {
-                    "the centralized net".to_string()
-                } else {
-                    format!("agent {i}'s net")
-                };
-                return Err(PyValueError::new_err(format!(
-                    "sample=True: {whose} is a Q-net, whose scores are Q-values, not log-probabilities to sample from; Q-net policies act greedily (sample=False)"
-                )));
-            }
-        }
-        let choice = if sample {
-            Choice::Sampled
-        } else {
-            Choice::Greedy
-        };
-        match &mut self.acting {
-            Acting::Agents(agents) => {
-                let mut scores = Vec::with_capacity(n);
-                for (i, agent) in agents.iter_mut().enumerate() {
-                    if !mac_done[i] {
-                        scores.push(None);
-                        continue;
-                    }
-                    let o = obs[i].as_slice()?;
-                    let mut q = vec![0.0f32; agent.policy.n_actions()];
-                    agent.policy.q_values(o, &mut q);
-                    if let Some(bad) = q.iter().find(|v| !v.is_finite()) {
-                        return Err(PyRuntimeError::new_err(format!(
-                            "agent {i}: the net answered a non-finite score ({bad}); the observation is out of the range it was trained on"
-                        )));
-                    }
-                    let sampler = if sample { agent.sampler.as_mut() } else { None };
-                    self.last[i] = Some(choose_action(&q, sampler, &mut self.probs));
-                    scores.push(Some(q.into_pyarray_bound(py)));
+            let centralized = matches!(self.acting, Acting::Team(_));
+            for (i, (o, layout)) in obs.iter().zip(&self.manifest.agents).enumerate() {
+                if (mac_done[i] || centralized) && o.len()? != layout.obs_size {
+                    return Err(PyValueError::new_err(format!(
+                        "agent {i}: observation has {} values, the policy expects {}",
+                        o.len()?,
+                        layout.obs_size
+                    )));
                 }
-                Ok((self.last.clone(), scores))
             }
-            Acting::Team(team) => {
-                let free = &mac_done;
-                let mut running = Vec::with_capacity(n);
-                for (i, last) in self.last.iter().enumerate() {
-                    match (free[i], last) {
-                        (false, None) if free.iter().any(|&f| f) => {
-                            return Err(PyValueError::new_err(format!(
-                                "agent {i} is not done but has no macro-action yet: every agent decides at an episode's start (call reset() between episodes)"
-                            )))
+            if sample {
+                if let Some(i) = self.kinds.iter().position(|&k| k == "q") {
+                    let whose = if centralized {
+                        "the centralized net".to_string()
+                    } else {
+                        format!("agent {i}'s net")
+                    };
+                    return Err(PyValueError::new_err(format!(
+                        "sample=True: {whose} is a Q-net, whose scores are Q-values, not log-probabilities to sample from; Q-net policies act greedily (sample=False)"
+                    )));
+                }
+            }
+            let choice = if sample {
+                Choice::Sampled
+            } else {
+                Choice::Greedy
+            };
+            match &mut self.acting {
+                Acting::Agents(agents) => {
+                    // All or nothing: every deciding agent's step is computed first; one
+                    // non-finite answer leaves every hidden state, sampling stream and last
+                    // action as they were (as a robot's error reply does).
+                    let mut proposed = Vec::with_capacity(n);
+                    for (i, agent) in agents.iter_mut().enumerate() {
+                        if !mac_done[i] {
+                            proposed.push(None);
+                            continue;
                         }
-                        (_, last) => running.push(last.unwrap_or(0)),
+                        let mut q = vec![0.0f32; agent.policy.n_actions()];
+                        if !agent.policy.propose(obs[i].as_slice()?, &mut q) {
+                            let bad = q.iter().find(|v| !v.is_finite()).copied();
+                            let what = match bad {
+                                Some(v) => format!("a non-finite score ({v})"),
+                                None => "a non-finite hidden state".into(),
+                            };
+                            return Err(PyRuntimeError::new_err(format!(
+                                "agent {i}: the net answered {what}; the observation is out of the range it was trained on (no agent's state changed)"
+                            )));
+                        }
+                        proposed.push(Some(q));
                     }
+                    let mut scores = Vec::with_capacity(n);
+                    for (i, (agent, q)) in agents.iter_mut().zip(proposed).enumerate() {
+                        let Some(q) = q else {
+                            scores.push(None);
+                            continue;
+                        };
+                        agent.policy.commit();
+                        let sampler = if sample { agent.sampler.as_mut() } else { None };
+                        self.last[i] = Some(choose_action(&q, sampler, &mut self.probs));
+                        scores.push(Some(q.into_pyarray_bound(py)));
+                    }
+                    Ok((self.last.clone(), scores))
                 }
-                let mut joint_obs = Vec::with_capacity(team.net().obs_len());
-                for o in &obs {
-                    joint_obs.extend_from_slice(o.as_slice()?);
-                }
-                let mut actions = running.clone();
-                let scores = team
-                    .decide_joint(&joint_obs, free, &running, choice, &mut actions)
-                    .map_err(PyRuntimeError::new_err)?
-                    .map(|s| s.to_vec().into_pyarray_bound(py));
-                if scores.is_some() {
-                    for (i, &a) in actions.iter().enumerate() {
-                        if free[i] {
-                            self.last[i] = Some(a);
+                Acting::Team(team) => {
+                    let free = &mac_done;
+                    let mut running = Vec::with_capacity(n);
+                    for (i, last) in self.last.iter().enumerate() {
+                        match (free[i], last) {
+                            (false, None) if free.iter().any(|&f| f) => {
+                                return Err(PyValueError::new_err(format!(
+                                    "agent {i} is not done but has no macro-action yet: every agent decides at an episode's start (call reset() between episodes)"
+                                )))
+                            }
+                            (_, last) => running.push(last.unwrap_or(0)),
                         }
                     }
+                    let mut joint_obs = Vec::with_capacity(team.net().obs_len());
+                    for o in &obs {
+                        joint_obs.extend_from_slice(o.as_slice()?);
+                    }
+                    let mut actions = running.clone();
+                    let scores = team
+                        .decide_joint(&joint_obs, free, &running, choice, &mut actions)
+                        .map_err(PyRuntimeError::new_err)?
+                        .map(|s| s.to_vec().into_pyarray_bound(py));
+                    if scores.is_some() {
+                        for (i, &a) in actions.iter().enumerate() {
+                            if free[i] {
+                                self.last[i] = Some(a);
+                            }
+                        }
+                    }
+                    Ok((self.last.clone(), vec![scores]))
                 }
-                Ok((self.last.clone(), vec![scores]))
             }
-        }
+        })
     }
 }

@@ -1,6 +1,7 @@
 //! Every run of a results tree as columns for `macdec.load_results`: read by the same reader
 //! as `macdec results` ([`macdec::experiment::run::tidy_table`]), so the two give the same rows.
 
+use crate::guarded;
 use macdec::experiment::run::metrics::{EVAL_RETURN_UNDISCOUNTED, LEADING_COLUMNS, WALL_SECONDS};
 use macdec::experiment::run::tidy_table::{read_run, tidy_runs, TidyError};
 use numpy::IntoPyArray;
@@ -87,36 +88,38 @@ fn read_all(root: &std::path::Path) -> Result<Columns, TidyError> {
 /// order; empty cells are NaN).
 #[pyfunction]
 pub fn read_results<'py>(py: Python<'py>, root: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    if !root.is_dir() {
-        return Err(PyFileNotFoundError::new_err(format!(
-            "{}: no such results directory",
-            root.display()
-        )));
-    }
-    let c = py
-        .allow_threads(|| read_all(&root))
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let out = PyDict::new_bound(py);
-    out.set_item("runs", PyList::new_bound(py, c.runs))?;
-    out.set_item("run_index", c.run_index.into_pyarray_bound(py))?;
-    let values = PyDict::new_bound(py);
-    let mut names: Vec<String> = LEADING_COLUMNS.iter().map(|s| s.to_string()).collect();
-    values.set_item("episode", c.episode.into_pyarray_bound(py))?;
-    values.set_item("env_steps", c.env_steps.into_pyarray_bound(py))?;
-    values.set_item("updates", c.updates.into_pyarray_bound(py))?;
-    values.set_item("eval_return", c.eval_return.into_pyarray_bound(py))?;
-    values.set_item(
-        EVAL_RETURN_UNDISCOUNTED,
-        c.eval_return_undiscounted.into_pyarray_bound(py),
-    )?;
-    names.push(EVAL_RETURN_UNDISCOUNTED.to_string());
-    for (name, col) in c.family {
-        values.set_item(&name, col.into_pyarray_bound(py))?;
-        names.push(name);
-    }
-    values.set_item(WALL_SECONDS, c.wall_seconds.into_pyarray_bound(py))?;
-    names.push(WALL_SECONDS.to_string());
-    out.set_item("values", values)?;
-    out.set_item("columns", names)?;
-    Ok(out)
+    guarded(|| {
+        if !root.is_dir() {
+            return Err(PyFileNotFoundError::new_err(format!(
+                "{}: no such results directory",
+                root.display()
+            )));
+        }
+        let c = py
+            .allow_threads(|| read_all(&root))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let out = PyDict::new_bound(py);
+        out.set_item("runs", PyList::new_bound(py, c.runs))?;
+        out.set_item("run_index", c.run_index.into_pyarray_bound(py))?;
+        let values = PyDict::new_bound(py);
+        let mut names: Vec<String> = LEADING_COLUMNS.iter().map(|s| s.to_string()).collect();
+        values.set_item("episode", c.episode.into_pyarray_bound(py))?;
+        values.set_item("env_steps", c.env_steps.into_pyarray_bound(py))?;
+        values.set_item("updates", c.updates.into_pyarray_bound(py))?;
+        values.set_item("eval_return", c.eval_return.into_pyarray_bound(py))?;
+        values.set_item(
+            EVAL_RETURN_UNDISCOUNTED,
+            c.eval_return_undiscounted.into_pyarray_bound(py),
+        )?;
+        names.push(EVAL_RETURN_UNDISCOUNTED.to_string());
+        for (name, col) in c.family {
+            values.set_item(&name, col.into_pyarray_bound(py))?;
+            names.push(name);
+        }
+        values.set_item(WALL_SECONDS, c.wall_seconds.into_pyarray_bound(py))?;
+        names.push(WALL_SECONDS.to_string());
+        out.set_item("values", values)?;
+        out.set_item("columns", names)?;
+        Ok(out)
+    })
 }

@@ -3,6 +3,7 @@
 //! thread, without the GIL, waits and polls for Ctrl-C; an interrupt raises the stop signal, the runs
 //! save their checkpoints and stop, and `KeyboardInterrupt` is raised once they have.
 
+use crate::guarded;
 use macdec::algos::families::Method;
 use macdec::experiment::definition::config::{Experiment, Overrides};
 use macdec::experiment::definition::seeds::parse_seeds;
@@ -74,72 +75,76 @@ pub fn train(
     force: bool,
     quiet: bool,
 ) -> PyResult<Vec<(PathBuf, &'static str)>> {
-    let experiment = experiment(config, is_path, methods, seeds.as_deref(), set)?;
-    let runs = experiment
-        .runs()
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let jobs = macdec::experiment::definition::limits::worker_threads(
-        jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
-        runs.len(),
-    );
-    experiment.write_shared_curves(&out).map_err(|e| {
-        PyRuntimeError::new_err(format!(
-            "recording the shared curves in {}: {e}",
-            out.display()
-        ))
-    })?;
-    let opts = RunnerOptions {
-        out: out.clone(),
-        jobs,
-        force,
-        quiet,
-        tensorboard: None,
-    };
-    let stop = StopSignal::new();
-    let worker = {
-        let (runs, stop) = (runs.clone(), stop.clone());
-        std::thread::Builder::new()
-            .name("macdec-train".into())
-            .spawn(move || train_all(&runs, &opts, force, &stop))
-            .map_err(|e| PyRuntimeError::new_err(format!("starting the training thread: {e}")))?
-    };
-    let mut interrupt = None;
-    while !worker.is_finished() {
-        py.allow_threads(|| std::thread::sleep(POLL));
-        if let Err(e) = py.check_signals() {
-            stop.stop();
-            interrupt.get_or_insert(e);
-        }
-    }
-    let statuses = py
-        .allow_threads(|| worker.join())
-        .map_err(|_| PyRuntimeError::new_err("the training thread panicked"))?;
-    if let Some(e) = interrupt {
-        return Err(e);
-    }
-    let mut failed = Vec::new();
-    let mut result = Vec::with_capacity(runs.len());
-    for (spec, status) in runs.iter().zip(&statuses) {
-        let dir = spec.dir(&out);
-        let label = match status {
-            RunStatus::Finished { .. } => "finished",
-            RunStatus::Skipped => "skipped",
-            RunStatus::Busy => "busy",
-            RunStatus::Stopped => "stopped",
-            RunStatus::Failed(e) => {
-                failed.push(format!("{}: {e}", dir.display()));
-                "failed"
-            }
-        };
-        result.push((dir, label));
-    }
-    if !failed.is_empty() {
-        return Err(PyRuntimeError::new_err(format!(
-            "{} of {} run(s) failed:\n{}",
-            failed.len(),
+    guarded(|| {
+        let experiment = experiment(config, is_path, methods, seeds.as_deref(), set)?;
+        let runs = experiment
+            .runs()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let jobs = macdec::experiment::definition::limits::worker_threads(
+            jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
             runs.len(),
-            failed.join("\n")
-        )));
-    }
-    Ok(result)
+        );
+        experiment.write_shared_curves(&out).map_err(|e| {
+            PyRuntimeError::new_err(format!(
+                "recording the shared curves in {}: {e}",
+                out.display()
+            ))
+        })?;
+        let opts = RunnerOptions {
+            out: out.clone(),
+            jobs,
+            force,
+            quiet,
+            tensorboard: None,
+        };
+        let stop = StopSignal::new();
+        let worker = {
+            let (runs, stop) = (runs.clone(), stop.clone());
+            std::thread::Builder::new()
+                .name("macdec-train".into())
+                .spawn(move || train_all(&runs, &opts, force, &stop))
+                .map_err(|e| {
+                    PyRuntimeError::new_err(format!("starting the training thread: {e}"))
+                })?
+        };
+        let mut interrupt = None;
+        while !worker.is_finished() {
+            py.allow_threads(|| std::thread::sleep(POLL));
+            if let Err(e) = py.check_signals() {
+                stop.stop();
+                interrupt.get_or_insert(e);
+            }
+        }
+        let statuses = py
+            .allow_threads(|| worker.join())
+            .map_err(|_| PyRuntimeError::new_err("the training thread panicked"))?;
+        if let Some(e) = interrupt {
+            return Err(e);
+        }
+        let mut failed = Vec::new();
+        let mut result = Vec::with_capacity(runs.len());
+        for (spec, status) in runs.iter().zip(&statuses) {
+            let dir = spec.dir(&out);
+            let label = match status {
+                RunStatus::Finished { .. } => "finished",
+                RunStatus::Skipped => "skipped",
+                RunStatus::Busy => "busy",
+                RunStatus::Stopped => "stopped",
+                RunStatus::Failed(e) => {
+                    failed.push(format!("{}: {e}", dir.display()));
+                    "failed"
+                }
+            };
+            result.push((dir, label));
+        }
+        if !failed.is_empty() {
+            return Err(PyRuntimeError::new_err(format!(
+                "{} of {} run(s) failed:\n{}",
+                failed.len(),
+                runs.len(),
+                failed.join("\n")
+            )));
+        }
+        Ok(result)
+    })
 }

@@ -2,6 +2,7 @@
 macro-action semantics, errors; vector_env equals N single environments."""
 
 import json
+import subprocess
 import warnings
 
 import numpy as np
@@ -14,7 +15,7 @@ IDS = macdec.env_ids()
 
 
 def test_every_built_in_domain_is_listed():
-    assert IDS == ["BP_MA", "BP-MA-v0", "OSD_S_4", "OSD-D-v7", "OSD-T-v0", "OSD-T-v1", "OSD-F-v0", "Overcooked-MA-v1", "ACAC-Overcooked-MA-v1"]
+    assert IDS == ["BP_MA", "BP-MA-v0", "OSD_S_4", "OSD-D-v7", "OSD-T-v0", "OSD-T-v1", "OSD-F-v0", "Overcooked-MA-v1", "ACAC-Overcooked-MA-v1", "ACAC-Overcooked-MA-v0"]
 
 
 def test_version_is_the_crates(root):
@@ -144,8 +145,13 @@ def test_bad_input_raises_errors_naming_the_problem():
         macdec.vector_env("BP_MA", 2, grid_dim=deep)
     venv = macdec.vector_env("BP_MA", 2)
     venv.reset(seed=0)
-    with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\)"):
-        venv.step(np.zeros((2, 3), dtype=np.int64))
+    for shape in [(2, 3), (4,), (2, 2, 1), ()]:
+        with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\), got shape"):
+            venv.step(np.zeros(shape, dtype=np.int64))
+    with pytest.raises(ValueError, match=r"shape \(num_envs, n_agents\) = \(2, 2\), got a ragged"):
+        venv.step([[0, 0], [0]])
+    with pytest.raises(ValueError, match=r"env 1, agent 0: the macro-action must be in 0..8, got 18446744073709551615"):
+        venv.step(np.array([[0, 0], [2**64 - 1, 0]], dtype=np.uint64))
     with pytest.raises(ValueError, match="env 1, agent 0"):
         venv.step(np.array([[0, 0], [9, 0]]))
     with pytest.raises(ValueError, match="integers"):
@@ -200,3 +206,24 @@ def test_vector_env_equals_n_single_envs(env_id, params):
                 m = vinfo["action_mask"][k, i]
                 assert m[: venv.n_actions[i]].astype(np.int8).tolist() == inf[a]["action_mask"].tolist()
     assert ends > 0, "no episode ended: the auto-reset was not tested"
+
+
+def test_a_key_the_domain_does_not_read_is_refused_never_dropped(macdec_bin, tmp_path):
+    # Box Pushing has no noise: 0.5 was kept as 0.0 and the episode ran noiseless.
+    with pytest.raises(ValueError, match=r"`tb_m_noisy`.*leave it out"):
+        macdec.parallel_env("BP_MA", tb_m_noisy=0.5)
+    with pytest.raises(ValueError, match=r"`tb_m_noisy`"):
+        macdec.vector_env("BP_MA", 2, tb_m_noisy=0.5)
+    assert macdec.parallel_env("BP_MA", tb_m_noisy=0).params["tb_m_noisy"] == 0.0
+    # MacroMARL's script passes these to every env; Box Pushing and the Warehouses do not read them.
+    with pytest.raises(ValueError, match=r"`TB_move_speed`.*does not read it"):
+        macdec.parallel_env("BP-MA-v0", TB_move_speed=0.6)
+    with pytest.raises(ValueError, match=r"`n_agent`"):
+        macdec.vector_env("OSD-D-v7", 2, n_agent=3)
+    # `train` refuses the same keys, through the same check.
+    cfg = tmp_path / "bp.toml"
+    cfg.write_text('name = "bp"\nmethods = ["mac-iac"]\n[params]\nenv_name = "BP-MA-v0"\nTB_move_speed = 0.6\n')
+    out = subprocess.run([str(macdec_bin), "train", "--config", str(cfg), "--out", str(tmp_path / "out")], capture_output=True, text=True)
+    assert out.returncode != 0 and "`TB_move_speed`" in out.stderr, out.stderr
+    with pytest.raises(ValueError, match="`TB_move_speed`"):
+        macdec.train(config=str(cfg), out=str(tmp_path / "out2"))

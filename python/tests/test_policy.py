@@ -82,3 +82,33 @@ def test_bad_policy_directories_and_observations_are_named(tmp_path):
         p.act([np.zeros(13), np.zeros(13), np.zeros(3)], [True, True, True])
     with pytest.raises(ValueError, match="one per agent"):
         p.act([np.zeros(13)], [True])
+
+
+def test_a_failed_act_leaves_every_agent_as_it_was(tmp_path):
+    (run,) = macdec.train(VALUE, out=tmp_path)
+    p = macdec.Policy.load(run)
+    env = p.make_env()
+    obs, infos = env.reset(seed=0)
+    p.act(obs, infos)
+    first = {a: s.copy() for a, s in p.scores.items()}
+    p.reset()
+    # The last agent's observation overflows its net; the agents before it decided first in
+    # the loop and must not have advanced either.
+    last = env.agents[-1]
+    bad = dict(obs)
+    bad[last] = np.full_like(obs[last], np.finfo(np.float32).max)
+    with pytest.raises(RuntimeError, match=r"agent 2: the net answered a non-finite .*no agent's state changed"):
+        p.act(bad, infos)
+    p.act(obs, infos)
+    assert all(np.array_equal(p.scores[a], first[a]) for a in first), "a failed act advanced a hidden state"
+
+
+def test_a_rust_panic_is_a_runtime_error_not_a_base_exception():
+    from macdec import _macdec
+
+    try:
+        _macdec._panic_for_test()
+    except Exception as e:  # noqa: BLE001 - the point: `except Exception` must see it
+        assert type(e) is RuntimeError and "internal error in macdec: a test panic" in str(e), repr(e)
+    else:
+        raise AssertionError("no error")

@@ -36,9 +36,10 @@ pub(super) struct ImportArgs {
     /// Warehouse 150; required for icra). MacroMARL: the published horizon by default.
     #[arg(long, value_parser = |t: &str| bounded_count(t, limits::MAX_HORIZON))]
     horizon: Option<usize>,
-    /// ICRA Warehouse: std of the Turtlebots' movement noise (paper 0).
-    #[arg(long, default_value_t = 0.0)]
-    tb_m_noisy: f64,
+    /// ICRA Warehouse: std of the Turtlebots' movement noise (paper 0). With --reference
+    /// macromarl it is the domain's `tb_m_noisy` key, refused by domains without one.
+    #[arg(long)]
+    tb_m_noisy: Option<f64>,
     /// Comma-separated state_dict safetensors files, one per agent, in agent order.
     #[arg(long, value_delimiter = ',', required = true)]
     agents: Vec<PathBuf>,
@@ -104,12 +105,20 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
             Ok(match (args.env.as_str(), args.grid) {
                 ("box-pushing", Some(grid)) => EnvSpec::new(
                     "box-pushing",
-                    &key_table([("grid_dim", (grid as i64).into()), horizon(h)]),
+                    &key_table([
+                        ("grid_dim", (grid as i64).into()),
+                        horizon(h),
+                        // Refused unless 0: Box Pushing has no noise to set.
+                        ("tb_m_noisy", args.tb_m_noisy.unwrap_or(0.0).into()),
+                    ]),
                 ),
                 ("box-pushing", None) => bail!("--env box-pushing needs --grid N"),
                 ("warehouse", None) => EnvSpec::new(
                     "warehouse",
-                    &key_table([horizon(h), ("tb_m_noisy", args.tb_m_noisy.into())]),
+                    &key_table([
+                        horizon(h),
+                        ("tb_m_noisy", args.tb_m_noisy.unwrap_or(0.0).into()),
+                    ]),
                 ),
                 ("warehouse", Some(_)) => bail!("--grid is for box-pushing; warehouse has none"),
                 (other, _) => {
@@ -141,6 +150,9 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
             }
             if let Some(h) = args.horizon {
                 given.insert(HORIZON_KEY.into(), (h as i64).into());
+            }
+            if let Some(noise) = args.tb_m_noisy {
+                given.insert("tb_m_noisy".into(), noise.into());
             }
             Ok(EnvSpec::new(&args.env, &given)?)
         }
@@ -184,7 +196,7 @@ mod tests {
         assert_eq!(args.agents, [PathBuf::from("a.safetensors")]);
         assert_eq!(args.out, PathBuf::from("o"));
         assert_eq!((args.params, args.grid, args.horizon), (None, None, None));
-        assert_eq!(args.tb_m_noisy, 0.0);
+        assert_eq!(args.tb_m_noisy, None);
         assert_eq!(args.discount, None);
         let args = parse(&["--env", "BP-MA-v0", "--reference", "macromarl"]);
         assert!(matches!(args.reference, ImportReference::Macromarl));
@@ -293,6 +305,10 @@ mod tests {
             env_error(&["--env", "BP-MA-v0", "--horizon", "100"]),
             "--reference icra: --env must be box-pushing or warehouse, got `BP-MA-v0`"
         );
+        // Box Pushing has no noise: --tb-m-noisy other than 0 is refused, not dropped.
+        let bp = ["--env", "box-pushing", "--grid", "10", "--horizon", "100"];
+        assert!(env_error(&[&bp[..], &["--tb-m-noisy", "0.2"]].concat()).contains("`tb_m_noisy`"));
+        import_env(&parse(&[&bp[..], &["--tb-m-noisy", "0"]].concat())).unwrap();
     }
 
     #[test]

@@ -31,6 +31,12 @@ pub(super) struct PlotArgs {
     /// training episodes (`2000ep`).
     #[arg(long, default_value = "auto", value_parser = crate::curve_stats::Smoothing::parse)]
     smooth: crate::curve_stats::Smoothing,
+    /// A TOML file naming outside runs (another code's per-seed logs, e.g. ACAC's) to draw
+    /// beside our curves, with --x env_steps --y undiscounted; every run of such an experiment
+    /// is then read up to the smallest last step any run reached, so the tables compare equal
+    /// budgets (README "Beside another code's logs").
+    #[arg(long)]
+    beside: Option<PathBuf>,
 }
 
 /// Draw the figures (into the results root unless `--out` says otherwise) and print the tables.
@@ -42,12 +48,14 @@ pub(super) fn run(args: PlotArgs) -> Result<()> {
         y_axis,
         x_axis,
         smooth,
+        beside,
     } = args;
     let out = out.unwrap_or_else(|| results.clone());
     let options = crate::plot::PlotOptions {
         metric: y_axis.map_or(metric, |y| y.column().to_string()),
         smoothing: smooth,
         x: x_axis,
+        beside,
     };
     plot(&results, &out, &options)
 }

@@ -24,7 +24,7 @@ macro_rules! built_in_domains {
             OsdT0(crate::envs::osd::OsdT0) = crate::envs::osd::OSD_T_V0,
             OsdT1(crate::envs::osd::OsdT1) = crate::envs::osd::OSD_T_V1,
             OsdF0(crate::envs::osd::OsdF0) = crate::envs::osd::OSD_F_V0,
-            Overcooked(crate::envs::overcooked::Overcooked) = crate::envs::overcooked::OvercookedDomain; crate::envs::overcooked_acac::OvercookedAcacDomain,
+            Overcooked(crate::envs::overcooked::Overcooked) = crate::envs::overcooked::OvercookedDomain; crate::envs::overcooked_acac::OvercookedAcacDomain; crate::envs::overcooked_large::OvercookedLargeDomain,
         }
     };
 }

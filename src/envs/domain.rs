@@ -178,6 +178,9 @@ pub trait Domain: Send + Sync + 'static {
     }
 }
 
+/// [`fill_keys`]'s reason for a key the domain does not have at all.
+pub const NOT_A_KEY: &str = "not a key of this domain";
+
 /// The usual [`Domain::keys`]: `defaults` lists every key with its default value, in order;
 /// `given` overrides some. A given key must have its default's type (an integer where a float
 /// is expected is taken as that float); integers must be >= 0, floats finite. Keys of `given`
@@ -186,7 +189,7 @@ pub fn fill_keys(given: &toml::Table, defaults: toml::Table) -> Result<toml::Tab
     let mut keys = defaults;
     for (key, value) in given {
         let Some(default) = keys.get(key) else {
-            return Err(KeyError::new(key, "not a key of this domain"));
+            return Err(KeyError::new(key, NOT_A_KEY));
         };
         let value = match (default, value) {
             (toml::Value::Float(_), toml::Value::Integer(i)) => toml::Value::Float(*i as f64),
@@ -210,6 +213,29 @@ pub fn fill_keys(given: &toml::Table, defaults: toml::Table) -> Result<toml::Tab
         keys.insert(key.clone(), value);
     }
     Ok(keys)
+}
+
+/// Records `key` at `value` whatever the domain is given, refusing any other value instead of
+/// dropping it: for a key the reference's command line has for every domain that this one does
+/// not read (`tb_m_noisy` of Box Pushing, recorded 0; `grid_dim` of a Warehouse, recorded 10).
+/// `keys` holds what [`fill_keys`] made of the given keys (an integer given for a float key is
+/// its float by then).
+pub fn fixed_key(
+    keys: &mut toml::Table,
+    key: &str,
+    value: toml::Value,
+    domain: &str,
+) -> Result<(), KeyError> {
+    match keys.get(key) {
+        Some(given) if *given != value => Err(KeyError::new(
+            key,
+            format!("{domain} does not read this key (its runs record {value}); leave it out, got {given}"),
+        )),
+        _ => {
+            keys.insert(key.into(), value);
+            Ok(())
+        }
+    }
 }
 
 /// A key table from `(key, value)` pairs, in order: `key_table([("grid_dim", 10.into())])`.

@@ -23,6 +23,7 @@ pub mod macromarl;
 pub mod osd;
 pub mod overcooked;
 pub mod overcooked_acac;
+pub mod overcooked_large;
 pub mod registry;
 pub mod replay;
 pub mod shape;

@@ -12,7 +12,10 @@
 //! horizon takes it from its params), `done` is the env's own terminal flag, and each line also
 //! has `rewards` (the per-agent list the reference returns) and, for a domain with a global state,
 //! `state` (the reference's `get_state()`), so the output diffs against the reference's trace
-//! (`scripts/macromarl_traces.py`). `"source": "macromarl"` may name that origin.
+//! (`scripts/macromarl_traces.py`). `"source": "macromarl"` may name that origin. `params` records
+//! the reference's `gym.make` call, so the kwargs MacroMARL's script passes to every environment
+//! and this one does not read are left out, as the reference left them unread; any other key the
+//! domain does not have is refused.
 //!
 //! ACAC's form adds `"source": "acac"`: `env` is ACAC's gym id (its macdec domain from
 //! [`super::acac::GYM_IDS`]), `np_seed` (required) what `np.random.seed` got before the reset, and
@@ -190,7 +193,14 @@ fn reference_spec(
     given
         .entry(super::domain::HORIZON_KEY)
         .or_insert_with(|| (n_steps.max(1) as i64).into());
-    EnvSpec::new(env, &given).map_err(ReplayFileError::BadParams)
+    // `params` records the reference's gym.make call: the shared kwargs its env did not read
+    // mean nothing here either (anything else unknown is refused by the domain).
+    let domain = super::registry::lookup(env).map_err(|e| ReplayFileError::BadParams(e.into()))?;
+    let own = domain
+        .keys(&toml::Table::new())
+        .expect("a domain's defaults are valid");
+    let given = super::macromarl::kwargs_read(&given, &own);
+    EnvSpec::of(domain, &given).map_err(ReplayFileError::BadParams)
 }
 
 /// The ACAC form's `np_seed` (required) and `start_map` (random starts only) as the domain's
@@ -570,6 +580,34 @@ mod tests {
         assert!(parse_replay(&ovc(r#", "np_seed": 1"#, "")).is_ok());
         let e = error_of(r#"{"env": "BP-MA-v0", "np_seed": 1, "params": {}, "steps": []}"#);
         assert!(e.contains("unknown field `np_seed`"), "{e}");
+    }
+
+    #[test]
+    fn bad_overcooked_large_forms_name_the_problem() {
+        let ovc = |extra: &str, params: &str| {
+            format!(
+                r#"{{"source": "acac", "env": "Overcooked-MA-v0", "params": {{{params}}}{extra}, "steps": [[0, 0, 0, 0, 0, 0]]}}"#
+            )
+        };
+        assert!(parse_replay(&ovc(r#", "np_seed": 1"#, "")).is_ok());
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""n_agent": 7"#));
+        assert!(e.contains("`n_agent`") && e.contains("2..=6"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""obj": ["lettuce"]"#));
+        assert!(e.contains("`obj`") && e.contains("one character"), "{e}");
+        let e = error_of(&ovc(r#", "np_seed": 1"#, r#""grid_dim": [7, 7]"#));
+        assert!(e.contains("`grid_dim`") && e.contains("[11, 11]"), "{e}");
+        let e = error_of(&ovc(
+            r#", "np_seed": 1, "start_map": [[1, 1], [1, 1]]"#,
+            r#""rand_start": true"#,
+        ));
+        assert!(e.contains("must be 11 rows of 11 cells"), "{e}");
+        let mut rows = vec![vec![1; 11]; 11];
+        rows[0][3] = 12;
+        let e = error_of(&ovc(
+            &format!(r#", "np_seed": 1, "start_map": {rows:?}"#),
+            r#""rand_start": true"#,
+        ));
+        assert!(e.contains("cell (0, 3) holds 12, not a code"), "{e}");
     }
 
     #[test]

@@ -61,6 +61,16 @@ impl EnvSpec {
         };
         let keys = domain.keys(given).map_err(key_error)?;
         key_horizon(&keys).map_err(key_error)?;
+        // Every key given is kept: a domain refuses what it does not read (`tb_m_noisy` for Box
+        // Pushing unless 0, MacroMARL's shared kwargs its env ignores) rather than dropping it.
+        // This is the one place every caller (configs, Python, replay files, `import`) makes a
+        // spec through, so a domain that forgot is caught here, by name.
+        if let Some(dropped) = given.keys().find(|k| !keys.contains_key(*k)) {
+            return Err(key_error(KeyError::new(
+                dropped,
+                "this domain does not read this key; leave it out",
+            )));
+        }
         Ok(EnvSpec { domain, keys })
     }
 

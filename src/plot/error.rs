@@ -45,6 +45,17 @@ pub enum PlotError {
         /// The backend's reason.
         message: String,
     },
+    /// `--beside`'s file or one of the logs it names cannot be used.
+    #[error("{path}: {reason}")]
+    Beside {
+        /// The file or directory.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// `--beside` with axes the outside logs do not have.
+    #[error("--beside draws outside logs of undiscounted returns against environment steps: give --x env_steps --y undiscounted")]
+    BesideAxes,
     /// The embedded font did not load (a build error).
     #[error("the embedded DejaVu Sans font could not be loaded")]
     Font,

@@ -5,6 +5,7 @@
 //! returns. [`plot_results`] runs the whole pipeline for `macdec plot`.
 
 pub mod axis;
+pub mod beside;
 pub mod discover;
 pub mod error;
 pub mod figure;
@@ -75,6 +76,8 @@ pub struct PlotOptions {
     /// What the curves are drawn against; figures against environment steps are named
     /// `<experiment>[_<metric>]_env_steps.*`.
     pub x: axis::XAxis,
+    /// A `--beside` file: outside runs drawn beside ours ([`beside`]).
+    pub beside: Option<PathBuf>,
 }
 
 impl Default for PlotOptions {
@@ -84,6 +87,7 @@ impl Default for PlotOptions {
             metric: discover::EVAL_RETURN.to_string(),
             smoothing: stats::Smoothing::Auto,
             x: axis::XAxis::Episode,
+            beside: None,
         }
     }
 }
@@ -104,7 +108,10 @@ pub fn plot_results_with(
     options: &PlotOptions,
 ) -> Result<PlotReport, PlotError> {
     let metric = options.metric.as_str();
-    let found = discover::discover_metric(results, metric)?;
+    let mut found = discover::discover_metric(results, metric)?;
+    if let Some(file) = &options.beside {
+        add_beside(&mut found, file, options)?;
+    }
     let mut notes = found.notes;
     std::fs::create_dir_all(out).map_err(|source| PlotError::Write {
         path: out.to_path_buf(),
@@ -142,6 +149,39 @@ pub fn plot_results_with(
         });
     }
     Ok(PlotReport { plots, notes })
+}
+
+/// Add `--beside`'s outside curves to their experiments and put each such experiment's runs on
+/// one grid of environment steps ([`beside::on_common_steps`]).
+fn add_beside(
+    found: &mut discover::Discovery,
+    file: &Path,
+    options: &PlotOptions,
+) -> Result<(), PlotError> {
+    if options.x != axis::XAxis::EnvSteps || options.metric != axis::EVAL_RETURN_UNDISCOUNTED {
+        return Err(PlotError::BesideAxes);
+    }
+    let read = beside::read_file(file)?;
+    let mut touched = std::collections::BTreeSet::new();
+    for (experiment, curve) in beside::outside_curves(file, &read)? {
+        match found.experiments.iter_mut().find(|e| e.name == experiment) {
+            Some(exp) => {
+                exp.curves.push(curve);
+                touched.insert(experiment);
+            }
+            None => found.notes.push(format!(
+                "{}: no experiment `{experiment}` in the results; {} is not drawn",
+                file.display(),
+                curve.name
+            )),
+        }
+    }
+    for exp in found.experiments.iter_mut() {
+        if touched.contains(&exp.name) {
+            beside::on_common_steps(exp, &mut found.notes);
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -281,6 +321,72 @@ mod tests {
         }
         let err = plot_results_with(&res, &out, &metric("q_loss")).unwrap_err();
         assert!(err.to_string().contains("no runs found"), "{err}");
+    }
+
+    #[test]
+    fn outside_logs_are_drawn_beside_ours_and_tested_at_equal_env_steps() {
+        let t = tempfile::tempdir().unwrap();
+        let res = t.path().join("results");
+        let bp10 = crate::envs::box_pushing::paper_spec(10);
+        // Ours: returns 0..9 at episodes 0..900, env steps 0..45000 (write_run: 50 per episode).
+        let pts: Vec<(u64, f64)> = (0..10).map(|i| (i * 100, i as f64)).collect();
+        for seed in 0..3 {
+            write_run(&res, "bp10", "our1", seed, &pts, bp10.clone(), true);
+        }
+        // Theirs: stop at 30000 steps, returns 100 + seed throughout.
+        let logs = t.path().join("logs");
+        std::fs::create_dir_all(logs.join("bp10/x")).unwrap();
+        for seed in 0..3 {
+            let rows: String = (1..=6)
+                .map(|k| format!("{},{}\n", k * 5000, 100 + seed))
+                .collect();
+            std::fs::write(
+                logs.join(format!("bp10/x/{seed}.csv")),
+                format!("Timesteps,Eval/Return\n{rows}"),
+            )
+            .unwrap();
+        }
+        let file = logs.join("beside.toml");
+        std::fs::write(
+            &file,
+            "label = \"their logs\"\n[[curve]]\nexperiment = \"bp10\"\ncurve = \"our1\"\nruns = \"bp10/x\"\n\n[[curve]]\nexperiment = \"nowhere\"\ncurve = \"our1\"\nruns = \"bp10/x\"\n",
+        )
+        .unwrap();
+        let out = t.path().join("plots");
+        let mut options = PlotOptions {
+            beside: Some(file.clone()),
+            ..PlotOptions::default()
+        };
+        let err = plot_results_with(&res, &out, &options).unwrap_err();
+        assert!(matches!(err, PlotError::BesideAxes), "{err}");
+        options.x = axis::XAxis::EnvSteps;
+        options.metric = axis::EVAL_RETURN_UNDISCOUNTED.to_string();
+        let report = plot_results_with(&res, &out, &options).unwrap();
+        let p = &report.plots[0];
+        let legends: Vec<&str> = p.summary.iter().map(|r| r.legend.as_str()).collect();
+        assert_eq!(legends, ["Our-1", "Our-1 (their logs)"]);
+        // Equal budgets: ours read up to 30000 steps (episode 600, return 6), not 9; the grid
+        // has the sparsest run's 6 points (theirs), so the last 10% is the last point.
+        assert_eq!(p.summary[0].final_episode, 30000);
+        assert_eq!(p.summary[0].final_mean, 6.0);
+        assert_eq!(p.summary[1].final_mean, 101.0);
+        assert_eq!(p.tests.len(), 2, "one Welch test each way");
+        assert!(report
+            .notes
+            .iter()
+            .any(|n| n.contains("no experiment `nowhere`")));
+        assert!(report.notes.iter().any(|n| n.contains("from 0 to 30000")));
+        let svg = std::fs::read_to_string(&p.svg).unwrap();
+        assert!(svg.contains("Our-1 (their logs) (n = 3 seeds)"), "legend");
+        // A broken log names its file.
+        std::fs::write(logs.join("bp10/x/1.csv"), "Timesteps,Eval/Return\n5,x\n").unwrap();
+        let err = plot_results_with(&res, &out, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("1.csv") && err.contains("not a finite number"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -30,6 +30,23 @@ impl NetPolicy {
     }
 }
 
+impl NetPolicy {
+    /// The first half of a step: the Q-values of `obs` from the current hidden state, computed
+    /// into a candidate state that only [`NetPolicy::commit`] makes current. Whether the values
+    /// and the candidate state came out finite. A team steps all-or-nothing with it: every
+    /// agent proposes, and only if all are finite do all commit.
+    pub fn propose(&mut self, obs: &[f32], q: &mut [f32]) -> bool {
+        self.candidate.copy_from(&self.state);
+        q.copy_from_slice(self.net.act_step(obs, &mut self.candidate));
+        q.iter().all(|x| x.is_finite()) && self.candidate.is_finite()
+    }
+
+    /// Makes the last [`NetPolicy::propose`]'s state the current one.
+    pub fn commit(&mut self) {
+        std::mem::swap(&mut self.state, &mut self.candidate);
+    }
+}
+
 impl AgentPolicy for NetPolicy {
     fn obs_len(&self) -> usize {
         self.net.obs_len()
@@ -43,10 +60,8 @@ impl AgentPolicy for NetPolicy {
     fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
         // A huge but finite observation can overflow the recurrent layer: keep the old state
         // then, so one bad message does not break the rest of the session.
-        self.candidate.copy_from(&self.state);
-        q.copy_from_slice(self.net.act_step(obs, &mut self.candidate));
-        if q.iter().all(|x| x.is_finite()) && self.candidate.is_finite() {
-            std::mem::swap(&mut self.state, &mut self.candidate);
+        if self.propose(obs, q) {
+            self.commit();
         }
     }
 }

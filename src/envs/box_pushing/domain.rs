@@ -5,8 +5,8 @@
 
 use super::{BoxPushing, Rules};
 use crate::envs::domain::{
-    fill_keys, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain, KeyError,
-    HORIZON_KEY,
+    fill_keys, fixed_key, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain,
+    KeyError, HORIZON_KEY,
 };
 use crate::envs::EnvError;
 
@@ -55,7 +55,8 @@ impl Domain for BoxPushingDomain {
 
     /// `grid_dim` (default 10), `env_terminate_step` (default: the paper's for the grid), and
     /// `tb_m_noisy`, which the reference's command line has for every domain and Box Pushing
-    /// runs record as 0: Box Pushing does not read it, so it is always recorded as 0.
+    /// runs record as 0: Box Pushing does not read it, so it is always 0 (another value is
+    /// refused, not dropped).
     fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
         let mut keys = fill_keys(
             given,
@@ -75,7 +76,12 @@ impl Domain for BoxPushingDomain {
         if !given.contains_key(HORIZON_KEY) {
             keys.insert(HORIZON_KEY.into(), (paper_horizon(grid) as i64).into());
         }
-        keys.insert("tb_m_noisy".into(), toml::Value::Float(0.0));
+        fixed_key(
+            &mut keys,
+            "tb_m_noisy",
+            toml::Value::Float(0.0),
+            "Box Pushing",
+        )?;
         BoxPushing::check_params(grid, key_usize(&keys, HORIZON_KEY)?, &Rules::ICRA)
             .map_err(key_of)?;
         Ok(keys)

@@ -12,7 +12,7 @@
 use super::layout::{LAYOUTS, N_WORK_STEPS};
 use super::{Osd, OsdParams, D7, F0, T0, T1};
 use crate::envs::domain::{fill_keys, key_f64, key_usize, Domain, KeyError, HORIZON_KEY};
-use crate::envs::macromarl::without_ignored_kwargs;
+use crate::envs::macromarl::refuse_ignored_kwargs;
 use crate::envs::EnvError;
 
 /// The domain of [`LAYOUTS`]`[V]`.
@@ -160,8 +160,8 @@ impl<const V: usize> Domain for OsdDomain<V> {
     fn keys(&self, given: &toml::Table) -> Result<toml::Table, KeyError> {
         let defaults = Self::defaults();
         let used: Vec<&str> = defaults.keys().map(String::as_str).collect();
-        let given = without_ignored_kwargs(given, &used);
-        let mut keys = fill_keys(&given, defaults)?;
+        refuse_ignored_kwargs(given, &used)?;
+        let mut keys = fill_keys(given, defaults)?;
         if Self::reads_terminate_step() && !given.contains_key(TERMINATE_STEP) {
             let horizon = keys[HORIZON_KEY].clone();
             keys.insert(TERMINATE_STEP.into(), horizon);
@@ -226,21 +226,22 @@ mod tests {
     }
 
     #[test]
-    fn shared_kwargs_are_accepted_and_dropped_unknown_keys_refused() {
-        let given = toml::toml! {
-            grid_dim = [6, 6]
-            big_box_reward = 300
-            small_box_reward = 20
-            penalty = -10
-            n_agent = 3
-            terminate_step = 200
-            TB_move_speed = 0.6
-        };
+    fn shared_kwargs_the_env_ignores_and_unknown_keys_are_refused() {
+        let given = toml::toml! { TB_move_speed = 0.6  fetch_pass_obj_tc = 5 };
         let keys = Domain::keys(&OSD_D_V7, &given).unwrap();
-        for k in ["grid_dim", "n_agent", "terminate_step", "penalty"] {
-            assert!(!keys.contains_key(k), "{k} is dropped");
-        }
         assert_eq!(key_f64(&keys, "TB_move_speed").unwrap(), 0.6);
+        // MacroMARL's script passes these to every Warehouse env, which ignores them.
+        for ignored in [
+            toml::toml! { grid_dim = [6, 6] },
+            toml::toml! { big_box_reward = 300 },
+            toml::toml! { n_agent = 3 },
+            toml::toml! { terminate_step = 200 },
+        ] {
+            let err = Domain::keys(&OSD_D_V7, &ignored).unwrap_err();
+            let key = ignored.keys().next().unwrap();
+            assert_eq!(&err.key, key, "{err:?}");
+            assert!(err.message.contains("leave it out"), "{err:?}");
+        }
         let err = Domain::keys(&OSD_D_V7, &toml::toml! { n_objs = 3 }).unwrap_err();
         assert_eq!(err.key, "n_objs");
         // OSD-F-v0 reads terminate_step.

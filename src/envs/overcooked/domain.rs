@@ -78,10 +78,15 @@ fn reward_list(keys: &toml::Table) -> Result<Rewards, KeyError> {
     Ok(rewards)
 }
 
-/// The side of `grid_dim`, which must be square.
+/// The side of `grid_dim`, which must be square (which sides a kitchen has,
+/// [`OvercookedParams::validate`] says).
 fn side(keys: &toml::Table) -> Result<usize, KeyError> {
-    let err =
-        |v: &toml::Value| KeyError::new("grid_dim", format!("expected [7, 7] or [9, 9], got {v}"));
+    let err = |v: &toml::Value| {
+        KeyError::new(
+            "grid_dim",
+            format!("expected a square grid [n, n] (Overcooked-MA-v1: [7, 7] or [9, 9]; ACAC's Large kitchen: [11, 11]), got {v}"),
+        )
+    };
     let v = keys
         .get("grid_dim")
         .ok_or_else(|| KeyError::new("grid_dim", "missing"))?;
@@ -89,7 +94,7 @@ fn side(keys: &toml::Table) -> Result<usize, KeyError> {
         return Err(err(v));
     };
     match a.as_slice() {
-        [toml::Value::Integer(x), toml::Value::Integer(y)] if x == y && (*x == 7 || *x == 9) => {
+        [toml::Value::Integer(x), toml::Value::Integer(y)] if x == y && (3..=64).contains(x) => {
             Ok(*x as usize)
         }
         _ => Err(err(v)),

@@ -10,17 +10,25 @@ use super::Overcooked;
 use crate::draw::{Canvas, Colour, Picture};
 
 /// Status-bar labels of the agents.
-pub static LABELS: [&str; 3] = ["A0", "A1", "A2"];
+pub static LABELS: [&str; 6] = ["A0", "A1", "A2", "A3", "A4", "A5"];
 
-/// Colours of the foods, in item order (tomato, lettuce, onion).
-const FOOD_COLOURS: [Colour; 3] = [Colour::Red, Colour::Working, Colour::Human];
+/// Colours of the foods, in item order (tomato, lettuce, onion; the Large kitchen's objects
+/// "A".."F" take these, then the tools' colours).
+const FOOD_COLOURS: [Colour; 6] = [
+    Colour::Red,
+    Colour::Working,
+    Colour::Human,
+    Colour::Tool0,
+    Colour::Tool1,
+    Colour::Tool2,
+];
 
-/// Pixels per cell side: 48 on the 7 x 7 kitchens, 40 on 9 x 9.
+/// Pixels per cell side: 48 on the 7 x 7 kitchens, 40 on 9 x 9, 32 on 11 x 11.
 pub fn cell_px(side: usize) -> i64 {
-    if side <= 7 {
-        48
-    } else {
-        40
+    match side {
+        0..=7 => 48,
+        8..=9 => 40,
+        _ => 32,
     }
 }
 
@@ -60,8 +68,15 @@ fn draw_food(canvas: &mut Canvas, cx: f64, cy: f64, r: f64, k: usize, chopped: b
 /// A plate at (cx, cy) with the foods it holds as small slices.
 fn draw_plate(canvas: &mut Canvas, w: &World, cx: f64, cy: f64, r: f64, p: usize) {
     canvas.ringed_circle(cx, cy, r, 1.0, Colour::Dark, Colour::White);
-    let spots = [(-0.4, 0.25), (0.4, 0.25), (0.0, -0.4)];
-    for (k, &(dx, dy)) in spots.iter().enumerate() {
+    let spots = [
+        (-0.4, 0.25),
+        (0.4, 0.25),
+        (0.0, -0.4),
+        (-0.4, -0.2),
+        (0.4, -0.2),
+        (0.0, 0.45),
+    ];
+    for (k, &(dx, dy)) in spots.iter().enumerate().take(w.kit.n_foods) {
         if w.plates[p].holds[k] {
             canvas.fill_circle(cx + dx * r, cy + dy * r, r * 0.3, FOOD_COLOURS[k]);
         }
@@ -146,13 +161,13 @@ pub fn draw(env: &Overcooked) -> Picture {
     let r = g.cell as f64 * 0.3;
     let carried = |h: Held| w.cooks.iter().any(|c| c.holding == Some(h));
     let on_plate = |k: usize| w.plates.iter().any(|p| p.holds[k]);
-    for p in 0..w.plates.len() {
+    for p in 0..w.kit.n_plates {
         if !carried(Held::Plate(p)) {
             let (cx, cy) = g.centre(w.plates[p].at);
             draw_plate(&mut canvas, w, cx, cy, r, p);
         }
     }
-    for (k, f) in w.foods.iter().enumerate() {
+    for (k, f) in w.foods.iter().enumerate().take(w.kit.n_foods) {
         if carried(Held::Food(k)) || on_plate(k) {
             continue;
         }
@@ -209,5 +224,38 @@ mod tests {
         assert_eq!(at(Cell::new(3, 3)), Some(Colour::Background));
         assert_eq!(at(Cell::new(0, 5)), Some(Colour::Red));
         assert_eq!(at(Cell::new(5, 6)), Some(Colour::White));
+    }
+
+    #[test]
+    fn the_large_kitchen_draws_its_six_agents_and_objects() {
+        let params = OvercookedParams {
+            side: 11,
+            n_agent: 6,
+            large: Some(crate::envs::overcooked::LargeKitchen::default()),
+            ..OvercookedParams::default()
+        };
+        let env = Overcooked::new(params).unwrap();
+        let pic = draw(&env);
+        assert_eq!(pic.world.width(), 11 * 32 + 1);
+        assert_eq!(pic.agent_labels.len(), 6);
+        let at = |c: Cell| {
+            let (x, y) = Grid { cell: 32 }.centre(c);
+            pic.world.pixel(x as usize, y as usize)
+        };
+        // The delivery (5,0), floor (5,5); object A (1,10) in the first food colour (as slices:
+        // fresh objects count as chopped), object F (0,7) in the sixth.
+        assert_eq!(at(Cell::new(5, 0)), Some(Colour::Goal));
+        assert_eq!(at(Cell::new(5, 5)), Some(Colour::Background));
+        let shows = |c: Cell, colour: Colour| {
+            let (px, py) = Grid { cell: 32 }.origin(c);
+            (0..32).any(|dx| {
+                (0..32).any(|dy| {
+                    pic.world.pixel((px + dx) as usize, (py + dy) as usize) == Some(colour)
+                })
+            })
+        };
+        assert!(shows(Cell::new(1, 10), Colour::Red));
+        assert!(shows(Cell::new(0, 7), Colour::Tool2));
+        assert!(!shows(Cell::new(0, 7), Colour::Red));
     }
 }

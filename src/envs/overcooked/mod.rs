@@ -14,6 +14,9 @@
 //! `_checkCollision` reads `info['collision']`, which the primitive step leaves empty, so
 //! collisions never end a macro-action (`docs/MACROMARL.md` §3.3, 5.2).
 //!
+//! ACAC's `Overcooked-MA-v0` (Overcooked-Large, `crate::envs::overcooked_large`) runs this same
+//! engine under its own rules ([`layout::Rules::V0`], [`OvercookedParams::large`]).
+//!
 //! The module follows the reference's layers: [`layout`] (maps), [`world`] (items), `step`
 //! (the primitive step), [`astar`] (navigation with Python's heap order), [`macro_actions`]
 //! and [`observe`] (belief and macro-observations); `domain` holds the config keys.
@@ -41,13 +44,13 @@ pub(crate) mod domain_keys {
 }
 
 use self::astar::PyHeap;
-use self::layout::{belief_base, start_map, Cells, MapType, Tile};
-use self::macro_actions::{ended_after_step, low_level, names, Ctx, MacState};
+use self::layout::{belief_base, large_start_map, start_map, Cells, MapType, Rules, Tile};
+use self::macro_actions::{ended_after_step, large_names, low_level, names, Ctx, MacState, Macro};
 use self::numpy_random::DrawInt;
 use self::numpy_random::NumpyRandom;
-use self::observe::{macro_obs, obs_len, reset_belief, update_belief, Belief, TASKS};
+use self::observe::{macro_obs, obs_len, reset_belief, task_len, update_belief, Belief, TASKS};
 use self::step::{primitive_step, Rewards};
-use self::world::{Numbering, World, STAY};
+use self::world::{Kit, Numbering, World, FOOD_NAMES, STAY};
 use super::{EnvError, EnvRng, MacroEnv, StepOutcome};
 
 /// Everything that defines an Overcooked environment (the reference's constructor arguments
@@ -88,6 +91,33 @@ pub struct OvercookedParams {
     /// first). With `np_seed` it must be what numpy's draws give, which building checks; without,
     /// every reset starts from it.
     pub start_map: Option<Vec<Vec<u8>>>,
+    /// ACAC's Large kitchen (`Overcooked_V0`'s rules and items) instead of `Overcooked_V1`'s.
+    pub large: Option<LargeKitchen>,
+}
+
+/// What ACAC's `Overcooked_V0` (Overcooked-Large) is built with beyond V1's keys: its objects,
+/// plates and knives. Its rules are [`Rules::V0`]; `task` is read and ignored (`self.task =
+/// obj`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LargeKitchen {
+    /// `obj`: the objects' names in item order (ACAC's settings: "A".."F"). One character each,
+    /// as ACAC's `_findItem` needs to find them, and distinct.
+    pub obj: Vec<String>,
+    /// `n_plate`: plates (ACAC's settings: 4).
+    pub n_plate: usize,
+    /// `n_knife`: knives (ACAC's settings: 4).
+    pub n_knife: usize,
+}
+
+impl Default for LargeKitchen {
+    /// ACAC's `ovcA11_N6` kitchen: objects "A".."F", 4 plates, 4 knives.
+    fn default() -> Self {
+        LargeKitchen {
+            obj: ["A", "B", "C", "D", "E", "F"].map(String::from).to_vec(),
+            n_plate: 4,
+            n_knife: 4,
+        }
+    }
 }
 
 impl Default for OvercookedParams {
@@ -106,21 +136,37 @@ impl Default for OvercookedParams {
             rand_start: false,
             np_seed: None,
             start_map: None,
+            large: None,
         }
     }
 }
 
 impl OvercookedParams {
+    /// What the kitchen holds and whose rules it follows.
+    pub fn kit(&self) -> Kit {
+        match &self.large {
+            None => Kit::V1,
+            Some(l) => Kit {
+                rules: Rules::V0,
+                n_foods: l.obj.len(),
+                n_plates: l.n_plate,
+                n_knives: l.n_knife,
+            },
+        }
+    }
+
     /// Refuse what the reference cannot build, naming the parameter.
     pub fn validate(&self) -> Result<(), EnvError> {
         let bad = |name, reason: String| Err(EnvError::InvalidParameter { name, reason });
-        if self.side != 7 && self.side != 9 {
+        if let Some(l) = &self.large {
+            self.validate_large(l)?;
+        } else if self.side != 7 && self.side != 9 {
             return bad(
                 "grid_dim",
                 format!("must be [7, 7] or [9, 9], got side {}", self.side),
             );
         }
-        if self.n_agent != 2 && self.n_agent != 3 {
+        if self.large.is_none() && self.n_agent != 2 && self.n_agent != 3 {
             return bad(
                 "n_agent",
                 format!("the maps have 2 or 3 agents, got {}", self.n_agent),
@@ -147,6 +193,51 @@ impl OvercookedParams {
                 },
                 "only a random start (`rand_start = true`) draws a start map".into(),
             );
+        }
+        Ok(())
+    }
+}
+
+impl OvercookedParams {
+    /// The Large kitchen's own limits: ACAC's 11 x 11 grid (the only one its settings use),
+    /// 2..=6 agents, 1..=6 distinct one-character objects, 1..=4 plates and knives (what ACAC's
+    /// `make_custom_map` places on that grid without overlapping).
+    fn validate_large(&self, l: &LargeKitchen) -> Result<(), EnvError> {
+        let bad = |name, reason: String| Err(EnvError::InvalidParameter { name, reason });
+        if self.side != 11 {
+            return bad(
+                "grid_dim",
+                format!("the Large kitchen is [11, 11], got side {}", self.side),
+            );
+        }
+        if !(2..=layout::MAX_AGENTS).contains(&self.n_agent) {
+            return bad(
+                "n_agent",
+                format!("the Large kitchen holds 2..=6 agents, got {}", self.n_agent),
+            );
+        }
+        if l.obj.is_empty() || l.obj.len() > layout::MAX_FOODS {
+            return bad("obj", format!("1..=6 objects, got {}", l.obj.len()));
+        }
+        for (k, o) in l.obj.iter().enumerate() {
+            if o.chars().count() != 1 {
+                return bad(
+                    "obj",
+                    format!(
+                        "object names are one character (ACAC's `_findItem` finds no other), \
+                         got {o:?}"
+                    ),
+                );
+            }
+            if l.obj[..k].contains(o) {
+                return bad("obj", format!("object {o:?} is named twice"));
+            }
+        }
+        if !(1..=layout::MAX_PLATES).contains(&l.n_plate) {
+            return bad("n_plate", format!("1..=4 plates, got {}", l.n_plate));
+        }
+        if !(1..=layout::MAX_KNIVES).contains(&l.n_knife) {
+            return bad("n_knife", format!("1..=4 knives, got {}", l.n_knife));
         }
         Ok(())
     }
@@ -187,12 +278,28 @@ impl Overcooked {
     pub fn new(params: OvercookedParams) -> Result<Self, EnvError> {
         params.validate()?;
         let n = params.n_agent;
-        let map =
-            start_map(params.side, params.map, n).ok_or_else(|| EnvError::InvalidParameter {
-                name: "grid_dim",
-                reason: "no map for this grid and agent count".into(),
-            })?;
-        let start = World::from_map(map, params.side, params.numbering).map_err(|e| {
+        let kit = params.kit();
+        let map = match &params.large {
+            None => {
+                start_map(params.side, params.map, n).ok_or_else(|| EnvError::InvalidParameter {
+                    name: "grid_dim",
+                    reason: "no map for this grid and agent count".into(),
+                })?
+            }
+            Some(l) => large_start_map(
+                params.side,
+                params.map,
+                l.obj.len(),
+                l.n_plate,
+                l.n_knife,
+                n,
+            )
+            .map_err(|reason| EnvError::InvalidParameter {
+                name: "obj",
+                reason: format!("ACAC's make_custom_map refuses the kitchen: {reason}"),
+            })?,
+        };
+        let start = World::from_map(map, params.side, params.numbering, kit).map_err(|e| {
             EnvError::InvalidParameter {
                 name: "map_type",
                 reason: format!("the map has no {}", e.0),
@@ -203,7 +310,7 @@ impl Overcooked {
             None => None,
             Some(rows) => Some(checked_start_map(rows, &map, &params, numpy.clone())?),
         };
-        let len = obs_len(n);
+        let len = obs_len(n, &kit);
         let mut env = Overcooked {
             base: belief_base(params.side, params.map),
             init: map,
@@ -221,7 +328,7 @@ impl Overcooked {
             macs: vec![MacState::FRESH; n],
             obs: vec![vec![0.0; len]; n],
             obs_sizes: vec![len; n],
-            n_actions: vec![names(params.map).len(); n],
+            n_actions: vec![Macro::count(params.map, &kit); n],
             executed: vec![0; n],
             mac_done: vec![true; n],
             t: 0,
@@ -375,12 +482,22 @@ impl MacroEnv for Overcooked {
 
     fn action_names(&self, agent: usize) -> &'static [&'static str] {
         assert!(agent < self.params.n_agent, "agent {agent} out of range");
-        names(self.params.map)
+        match &self.params.large {
+            None => names(self.params.map),
+            Some(l) => large_names(self.params.map, &l.obj, &self.params.kit()),
+        }
     }
 
     fn obs_names(&self, agent: usize) -> Vec<String> {
         assert!(agent < self.params.n_agent, "agent {agent} out of range");
-        observe::obs_names(self.params.n_agent)
+        let kit = self.params.kit();
+        match &self.params.large {
+            None => observe::obs_names(self.params.n_agent, &FOOD_NAMES, &kit),
+            Some(l) => {
+                let foods: Vec<&str> = l.obj.iter().map(String::as_str).collect();
+                observe::obs_names(self.params.n_agent, &foods, &kit)
+            }
+        }
     }
 
     fn horizon(&self) -> usize {
@@ -421,7 +538,12 @@ impl MacroEnv for Overcooked {
 
     fn describe(&self) -> String {
         format!(
-            "Overcooked map {} {}x{}, {} agents, horizon {}",
+            "Overcooked{} map {} {}x{}, {} agents, horizon {}",
+            if self.params.large.is_some() {
+                "-Large (ACAC's Overcooked-MA-v0)"
+            } else {
+                ""
+            },
             self.params.map.letter(),
             self.params.side,
             self.params.side,
@@ -438,7 +560,8 @@ impl MacroEnv for Overcooked {
     /// task one-hot (25 values for 3 agents); none for gym-macro-overcooked's env.
     fn state_size(&self) -> usize {
         if self.params.vector_state {
-            obs_len(self.params.n_agent) - TASKS.len()
+            let kit = self.params.kit();
+            obs_len(self.params.n_agent, &kit) - task_len(&kit)
         } else {
             0
         }
@@ -452,17 +575,21 @@ impl MacroEnv for Overcooked {
 
 /// A random start map of `init` (see [`rand_start`]) with the draws of `draws`.
 fn random_start_map(init: &Cells, p: &OvercookedParams, draws: &mut impl DrawInt) -> Cells {
+    let kit = p.kit();
     let mut codes = [[0u8; layout::MAX_SIDE]; layout::MAX_SIDE];
     for (row, tiles) in codes.iter_mut().zip(init) {
         for (c, t) in row.iter_mut().zip(tiles) {
-            *c = *t as u8;
+            *c = kit.rules.code(*t);
         }
     }
     let drawn = rand_start::random_start(&codes, p.side, p.map, draws);
     let mut out = *init;
     for (row, codes) in out.iter_mut().zip(&drawn) {
         for (t, &c) in row.iter_mut().zip(codes) {
-            *t = Tile::of(c);
+            *t = kit
+                .rules
+                .tile(c, kit.n_foods)
+                .expect("a random start moves the start map's own codes");
         }
     }
     out
@@ -483,17 +610,20 @@ fn checked_start_map(
         })
     };
     let side = p.side;
+    let kit = p.kit();
     if rows.len() != side || rows.iter().any(|r| r.len() != side) {
         return bad(format!("must be {side} rows of {side} cells (grid_dim)"));
     }
     let mut map = *init;
-    let (mut given, mut wanted) = ([0usize; 9], [0usize; 9]);
+    // Codes are at most 5 + 6 objects.
+    let (mut given, mut wanted) = ([0usize; 12], [0usize; 12]);
     for (x, row) in rows.iter().enumerate() {
         for (y, &code) in row.iter().enumerate() {
-            if code > 8 {
-                return bad(format!("cell ({x}, {y}) holds {code}, not a code 0..=8"));
-            }
-            let t = Tile::of(code);
+            let Some(t) = kit.rules.tile(code, kit.n_foods) else {
+                return bad(format!(
+                    "cell ({x}, {y}) holds {code}, not a code of this kitchen"
+                ));
+            };
             let walkable = |t: Tile| matches!(t, Tile::Space | Tile::Agent);
             if walkable(t) != walkable(init[x][y]) {
                 return bad(format!(
@@ -507,13 +637,13 @@ fn checked_start_map(
                 ));
             }
             given[code as usize] += 1;
-            wanted[init[x][y] as usize] += 1;
+            wanted[kit.rules.code(init[x][y]) as usize] += 1;
             map[x][y] = t;
         }
     }
     if given[2..] != wanted[2..] {
         return bad(format!(
-            "holds {:?} agents and items of codes 2..=8, the start map {:?}",
+            "holds {:?} agents and items of codes 2.., the start map {:?}",
             &given[2..],
             &wanted[2..]
         ));
@@ -528,8 +658,8 @@ fn checked_start_map(
                 "disagrees with numpy's draws from np_seed {}: cell ({x}, {y}) is {} in \
                  start_map, {} by the draws",
                 p.np_seed.unwrap_or_default(),
-                map[x][y] as u8,
-                drawn[x][y] as u8
+                kit.rules.code(map[x][y]),
+                kit.rules.code(drawn[x][y])
             ));
         }
     }

@@ -1,6 +1,6 @@
-//! What agents perceive. Two views, both laid out as the reference's `itemList` (tomato,
-//! lettuce, onion: x, y, chop progress; plates 1-2, knives 1-2, delivery, agents: x, y), then
-//! the task's one-hot over `TASKLIST`:
+//! What agents perceive. Two views, both laid out as the reference's `itemList` (the foods:
+//! x, y, chop progress; the plates, the knives, the delivery, the agents: x, y), then under
+//! `Overcooked_V1` the task's one-hot over `TASKLIST` (ACAC's `Overcooked_V0` has none):
 //!
 //! - the **belief** (`agent.obs` and `agent.pomap`, `Overcooked_V1._get_vector_obs`), updated
 //!   after every primitive step: items within `obs_radius` (Chebyshev) at their true places,
@@ -17,7 +17,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::layout::{Cells, Tile};
-use super::world::{Cell, World, REQUIRED_CHOPS};
+use super::world::{Cell, Kit, World, REQUIRED_CHOPS};
 
 /// The reference's `TASKLIST`, in one-hot order.
 pub const TASKS: [&str; 7] = [
@@ -30,10 +30,19 @@ pub const TASKS: [&str; 7] = [
     "lettuce-onion-tomato salad",
 ];
 
-/// Length of an observation with `n_agent` agents: 3 foods x 3, 5 fixed or plate items x 2,
-/// agents x 2, the 7 task flags (32 for 3 agents, 30 for 2).
-pub fn obs_len(n_agent: usize) -> usize {
-    9 + 2 * (5 + n_agent) + TASKS.len()
+/// Length of an observation with `n_agent` agents in a kitchen holding `kit`: foods x 3,
+/// plates, knives, the delivery and agents x 2, and under V1 the 7 task flags (V1: 32 for 3
+/// agents, 30 for 2; ACAC's Large kitchen: 48).
+pub fn obs_len(n_agent: usize, kit: &Kit) -> usize {
+    3 * kit.n_foods + 2 * (kit.n_plates + kit.n_knives + 1 + n_agent) + task_len(kit)
+}
+
+/// Length of the task one-hot: 7 under V1, none under V0.
+pub fn task_len(kit: &Kit) -> usize {
+    match kit.rules {
+        super::layout::Rules::V1 => TASKS.len(),
+        super::layout::Rules::V0 => 0,
+    }
 }
 
 /// One agent's belief: its last vector observation and the map it navigates on.
@@ -50,8 +59,12 @@ pub fn in_view(a: Cell, c: Cell, radius: i32) -> bool {
     radius == 0 || ((c.x - a.x).abs() <= radius && (c.y - a.y).abs() <= radius)
 }
 
-/// Write the task one-hot at the end of `out` (`oneHotTask`; all zero for a task not listed).
-fn write_task<T: From<u8>>(out: &mut [T], task: &str) {
+/// Write the task one-hot at the end of `out` (`oneHotTask`; all zero for a task not listed;
+/// nothing under V0).
+fn write_task<T: From<u8>>(out: &mut [T], task: &str, kit: &Kit) {
+    if task_len(kit) == 0 {
+        return;
+    }
     let start = out.len() - TASKS.len();
     for (k, t) in TASKS.iter().enumerate() {
         out[start + k] = T::from(u8::from(*t == task));
@@ -67,12 +80,12 @@ pub fn reset_belief(w: &World, task: &str, b: &mut Belief) {
         b.obs[idx] = f64::from(at.x) / xl;
         b.obs[idx + 1] = f64::from(at.y) / yl;
         idx += 2;
-        if k < 3 {
-            b.obs[idx] = f64::from(w.foods[k].chops) / f64::from(REQUIRED_CHOPS);
+        if let Some(f) = w.item_food(k) {
+            b.obs[idx] = f64::from(w.foods[f].chops) / f64::from(REQUIRED_CHOPS);
             idx += 1;
         }
     }
-    write_task(&mut b.obs, task);
+    write_task(&mut b.obs, task, &w.kit);
 }
 
 /// Agent `agent`'s belief after a step (`_get_vector_obs`), from its previous one, in place.
@@ -85,13 +98,13 @@ pub fn update_belief(w: &World, agent: usize, base: &Cells, radius: i32, b: &mut
     let mut idx = 0;
     for k in 0..w.n_items() {
         let (at, start) = w.item(k);
-        let food = k < 3;
+        let food = w.item_food(k);
         let (x, y);
         if in_view(me, at, radius) {
             x = f64::from(at.x) / xl;
             y = f64::from(at.y) / yl;
-            if food {
-                b.obs[idx + 2] = f64::from(w.foods[k].chops) / f64::from(REQUIRED_CHOPS);
+            if let Some(f) = food {
+                b.obs[idx + 2] = f64::from(w.foods[f].chops) / f64::from(REQUIRED_CHOPS);
             }
         } else {
             let (mut px, mut py) = (b.obs[idx] * xl, b.obs[idx + 1] * yl);
@@ -101,13 +114,13 @@ pub fn update_belief(w: &World, agent: usize, base: &Cells, radius: i32, b: &mut
             }
             x = px / xl;
             y = py / yl;
-            if food {
+            if food.is_some() {
                 b.obs[idx + 2] /= f64::from(REQUIRED_CHOPS);
             }
         }
         b.obs[idx] = x;
         b.obs[idx + 1] = y;
-        idx += if food { 3 } else { 2 };
+        idx += if food.is_some() { 3 } else { 2 };
         paint(
             &mut b.pomap,
             w.side,
@@ -151,16 +164,16 @@ pub fn macro_obs(w: &World, agent: usize, radius: i32, task: &str, out: &mut [f3
             0.0
         };
         idx += 2;
-        if k < 3 {
+        if let Some(f) = w.item_food(k) {
             out[idx] = if seen {
-                (f64::from(w.foods[k].chops) / f64::from(REQUIRED_CHOPS)) as f32
+                (f64::from(w.foods[f].chops) / f64::from(REQUIRED_CHOPS)) as f32
             } else {
                 0.0
             };
             idx += 1;
         }
     }
-    write_task(out, task);
+    write_task(out, task, &w.kit);
 }
 
 /// ACAC's `get_vector_state()` into `out`: every item at its true place (x / side, y / side, and
@@ -173,44 +186,68 @@ pub fn vector_state(w: &World, out: &mut [f32]) {
         out[idx] = (f64::from(at.x) / xl) as f32;
         out[idx + 1] = (f64::from(at.y) / yl) as f32;
         idx += 2;
-        if k < 3 {
-            out[idx] = (f64::from(w.foods[k].chops) / f64::from(REQUIRED_CHOPS)) as f32;
+        if let Some(f) = w.item_food(k) {
+            out[idx] = (f64::from(w.foods[f].chops) / f64::from(REQUIRED_CHOPS)) as f32;
             idx += 1;
         }
     }
 }
 
-/// Names of the observation's entries, in layout order.
-pub fn obs_names(n_agent: usize) -> Vec<String> {
+/// Names of the observation's entries, in layout order, for `foods` (their names) in a kitchen
+/// holding `kit`.
+pub fn obs_names(n_agent: usize, foods: &[&str], kit: &Kit) -> Vec<String> {
     let mut names = vec![];
-    for f in ["tomato", "lettuce", "onion"] {
+    for f in foods {
         names.extend([format!("{f}_x"), format!("{f}_y"), format!("{f}_chopped")]);
     }
-    let fixed = ["plate1", "plate2", "knife1", "knife2", "delivery"];
-    for item in fixed
-        .iter()
-        .map(|s| s.to_string())
-        .chain((0..n_agent).map(|i| format!("agent{i}")))
-    {
+    let fixed = (1..=kit.n_plates)
+        .map(|k| format!("plate{k}"))
+        .chain((1..=kit.n_knives).map(|k| format!("knife{k}")))
+        .chain(["delivery".to_string()]);
+    for item in fixed.chain((0..n_agent).map(|i| format!("agent{i}"))) {
         names.extend([format!("{item}_x"), format!("{item}_y")]);
     }
-    names.extend(
-        TASKS
-            .iter()
-            .map(|t| format!("task_{}", t.replace(' ', "_"))),
-    );
+    if task_len(kit) > 0 {
+        names.extend(
+            TASKS
+                .iter()
+                .map(|t| format!("task_{}", t.replace(' ', "_"))),
+        );
+    }
     names
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::layout::Rules;
+    use super::super::world::FOOD_NAMES;
     use super::*;
 
     #[test]
     fn sizes_are_32_for_three_agents_and_30_for_two() {
-        assert_eq!(obs_len(3), 32);
-        assert_eq!(obs_len(2), 30);
-        assert_eq!(obs_names(3).len(), 32);
-        assert_eq!(obs_names(2)[29], "task_lettuce-onion-tomato_salad");
+        assert_eq!(obs_len(3, &Kit::V1), 32);
+        assert_eq!(obs_len(2, &Kit::V1), 30);
+        assert_eq!(obs_names(3, &FOOD_NAMES, &Kit::V1).len(), 32);
+        assert_eq!(
+            obs_names(2, &FOOD_NAMES, &Kit::V1)[29],
+            "task_lettuce-onion-tomato_salad"
+        );
+    }
+
+    /// spec acac_envs.md §Overcooked-MA-v0: 48 values, no task one-hot.
+    #[test]
+    fn the_large_kitchen_observes_48_values() {
+        let kit = Kit {
+            rules: Rules::V0,
+            n_foods: 6,
+            n_plates: 4,
+            n_knives: 4,
+        };
+        assert_eq!(obs_len(6, &kit), 48);
+        let names = obs_names(6, &["A", "B", "C", "D", "E", "F"], &kit);
+        assert_eq!(names.len(), 48);
+        assert_eq!(names[18], "plate1_x");
+        assert_eq!(names[34], "delivery_x");
+        assert_eq!(names[47], "agent5_y");
     }
 }

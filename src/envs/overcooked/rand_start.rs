@@ -14,12 +14,10 @@
 //! Codes 0 (floor), 1 (counter) and 2 (agent) are shared by both Overcooked versions; the item
 //! codes above 2 are each version's own. Allocation-free, so a reset may call it.
 
-use super::layout::MapType;
+use super::layout::{MapType, MAX_AGENTS};
 use super::numpy_random::DrawInt;
 use super::world::Cell;
 
-/// Most agents a random start places (ACAC's Large kitchen has 6).
-pub const MAX_AGENTS: usize = 6;
 /// Border cells of the largest grid (11 x 11): 4 x 9.
 const MAX_BORDER: usize = 36;
 

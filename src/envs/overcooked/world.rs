@@ -1,6 +1,7 @@
 //! The kitchen's objects and the map that mirrors them (`items.py` and `Overcooked_V1`'s item
-//! lists): three foods, two plates, two knives (cutting boards), the delivery counter and the
-//! agents, each where the reference keeps it, with the reference's moves, pick-ups and put-downs.
+//! lists; ACAC's `Overcooked_V0` has more of each): the foods, the plates, the knives (cutting
+//! boards), the delivery counter and the agents, each where the reference keeps it, with the
+//! reference's moves, pick-ups and put-downs.
 //!
 //! The map (`self.map` in the reference) is not derived from the objects: the step writes it
 //! beside them, and a few of its writes can disagree with them (a refreshed food written over a
@@ -8,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::layout::{Cells, Tile};
+use super::layout::{Cells, Rules, Tile, MAX_FOODS, MAX_KNIVES, MAX_PLATES};
 
 /// A grid cell `(x, y)`: `x` the row of the printed map, `y` the column (the reference's order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -42,45 +43,46 @@ pub const DIRECTION: [(i32, i32); 4] = [(0, 1), (1, 0), (0, -1), (-1, 0)];
 /// The primitive action "stay".
 pub const STAY: u8 = 4;
 
-/// The foods in the reference's item order (tomato, lettuce, onion).
-pub const FOOD_TILES: [Tile; 3] = [Tile::Tomato, Tile::Lettuce, Tile::Onion];
-/// The foods' `rawName`s, in [`FOOD_TILES`] order.
+/// `Overcooked_V1`'s foods' `rawName`s, in item order (tiles `Food(0)`, `Food(1)`, `Food(2)`).
 pub const FOOD_NAMES: [&str; 3] = ["tomato", "lettuce", "onion"];
+/// Where an unused slot of the item buffers is: off the grid, so no search finds it.
+pub const NOWHERE: Cell = Cell::new(-1, -1);
 /// Chops a food needs (`Food.required_chopped_times`).
 pub const REQUIRED_CHOPS: u32 = 3;
 
 /// Something an agent, a knife or the delivery counter can hold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Held {
-    /// Food `k` in [`FOOD_TILES`] order.
+    /// Food `k` in item order.
     Food(usize),
     /// Plate `k` (0 is the first in map scan order, "plate 1").
     Plate(usize),
 }
 
-/// A tomato, lettuce or onion.
+/// A food (`Overcooked_V1`: tomato, lettuce, onion; ACAC's Large kitchen: an object of `obj`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Food {
     /// Where it is now (on a counter, a knife, a plate or carried, the carrier's cell).
     pub at: Cell,
     /// Its start counter, where the reference's `Food.refresh` puts it back whole.
     pub start: Cell,
-    /// Chopped [`REQUIRED_CHOPS`] times: it may go onto a plate.
+    /// Chopped [`REQUIRED_CHOPS`] times, or a Large kitchen's food not yet refreshed: it may go
+    /// onto a plate.
     pub chopped: bool,
     /// Chops so far, 0 to [`REQUIRED_CHOPS`].
     pub chops: u32,
 }
 
 /// A plate and the foods on it (the reference's `containing` list; each food exists once, so
-/// flags in [`FOOD_TILES`] order say the same).
+/// flags in item order say the same).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Plate {
     /// Where it is now.
     pub at: Cell,
     /// Its start counter, where it goes back after a delivery that is not the finished dish.
     pub start: Cell,
-    /// Which foods are on it, in [`FOOD_TILES`] order.
-    pub holds: [bool; 3],
+    /// Which foods are on it, in item order.
+    pub holds: [bool; MAX_FOODS],
 }
 
 /// A knife's cutting board or the delivery counter: fixed, and holding at most one thing.
@@ -112,12 +114,14 @@ pub struct World {
     pub side: usize,
     /// The tiles as the reference's `self.map` holds them, written beside the objects.
     pub map: Cells,
-    /// Tomato, lettuce, onion, in [`FOOD_TILES`] order.
-    pub foods: [Food; 3],
-    /// The two plates, in map scan order.
-    pub plates: [Plate; 2],
-    /// The two cutting boards, in map scan order.
-    pub knives: [Station; 2],
+    /// What the kitchen holds and whose rules it follows.
+    pub kit: Kit,
+    /// The foods in item order (`kit.n_foods` of them; the rest [`NOWHERE`]).
+    pub foods: [Food; MAX_FOODS],
+    /// The plates, in map scan order (`kit.n_plates`; the rest [`NOWHERE`]).
+    pub plates: [Plate; MAX_PLATES],
+    /// The cutting boards, in map scan order (`kit.n_knives`; the rest [`NOWHERE`]).
+    pub knives: [Station; MAX_KNIVES],
     /// The delivery counter.
     pub delivery: Station,
     /// The agents, in agent order.
@@ -129,6 +133,7 @@ impl Clone for World {
         World {
             side: self.side,
             map: self.map,
+            kit: self.kit,
             foods: self.foods,
             plates: self.plates,
             knives: self.knives,
@@ -142,6 +147,7 @@ impl Clone for World {
     fn clone_from(&mut self, source: &Self) {
         self.side = source.side;
         self.map = source.map;
+        self.kit = source.kit;
         self.foods = source.foods;
         self.plates = source.plates;
         self.knives = source.knives;
@@ -153,6 +159,29 @@ impl Clone for World {
 /// Why a start map cannot make a kitchen (the reference's maps always can).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct MissingItem(pub &'static str);
+
+/// How many foods, plates and knives a kitchen has, and whose rules it follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Kit {
+    /// `Overcooked_V1` or ACAC's `Overcooked_V0`.
+    pub rules: Rules,
+    /// Foods (V1: 3; V0: `len(obj)`).
+    pub n_foods: usize,
+    /// Plates (V1: 2; V0: `n_plate`).
+    pub n_plates: usize,
+    /// Knives (V1: 2; V0: `n_knife`).
+    pub n_knives: usize,
+}
+
+impl Kit {
+    /// `Overcooked_V1`'s kitchen: tomato, lettuce, onion, two plates, two knives.
+    pub const V1: Kit = Kit {
+        rules: Rules::V1,
+        n_foods: 3,
+        n_plates: 2,
+        n_knives: 2,
+    };
+}
 
 /// The order in which `_createItems` scans a start map, which numbers the agents, plates and
 /// knives (each kind in the order found). Not a relabelling only: the primitive step moves agents
@@ -167,42 +196,54 @@ pub enum Numbering {
 }
 
 impl World {
-    /// The kitchen of a start map, items numbered in `numbering`'s scan order as `_createItems`
-    /// finds them.
-    pub fn from_map(map: Cells, side: usize, numbering: Numbering) -> Result<World, MissingItem> {
-        let nowhere = Cell::new(0, 0);
+    /// The kitchen of a start map holding `kit`'s items, numbered in `numbering`'s scan order as
+    /// `_createItems` finds them.
+    pub fn from_map(
+        map: Cells,
+        side: usize,
+        numbering: Numbering,
+        kit: Kit,
+    ) -> Result<World, MissingItem> {
         let station = Station {
-            at: nowhere,
+            at: NOWHERE,
             holding: None,
         };
         let mut w = World {
             side,
             map,
+            kit,
             foods: [Food {
-                at: nowhere,
-                start: nowhere,
+                at: NOWHERE,
+                start: NOWHERE,
                 chopped: false,
                 chops: 0,
-            }; 3],
+            }; MAX_FOODS],
             plates: [Plate {
-                at: nowhere,
-                start: nowhere,
-                holds: [false; 3],
-            }; 2],
-            knives: [station; 2],
+                at: NOWHERE,
+                start: NOWHERE,
+                holds: [false; MAX_FOODS],
+            }; MAX_PLATES],
+            knives: [station; MAX_KNIVES],
             delivery: station,
-            cooks: Vec::with_capacity(super::rand_start::MAX_AGENTS),
+            cooks: Vec::with_capacity(super::layout::MAX_AGENTS),
         };
         w.restart_from(map, numbering)?;
         Ok(w)
     }
 
-    /// Make this the kitchen of start map `map` (same side), reusing the agents' buffer, so a
-    /// reset that draws a new start allocates nothing. On an error the kitchen is unusable.
+    /// Make this the kitchen of start map `map` (same side and kit), reusing the agents' buffer,
+    /// so a reset that draws a new start allocates nothing. On an error the kitchen is unusable.
+    ///
+    /// Foods start unchopped, except in ACAC's Large kitchen: `GeneralFood` passes its name
+    /// where `Food` takes `chopped`, so a fresh object counts as chopped (a truthy string) until
+    /// a wrong delivery's `refresh()` sets it to `False` (spec acac_envs.md §Overcooked-MA-v0).
     pub fn restart_from(&mut self, map: Cells, numbering: Numbering) -> Result<(), MissingItem> {
         self.map = map;
         self.cooks.clear();
-        let (mut foods, mut n_plates, mut n_knives, mut delivery) = ([false; 3], 0, 0, None);
+        let kit = self.kit;
+        let fresh_chopped = kit.rules == Rules::V0;
+        let (mut foods, mut n_plates, mut n_knives, mut delivery) =
+            ([false; MAX_FOODS], 0, 0, None);
         for i in 0..self.side {
             for j in 0..self.side {
                 let (x, y) = match numbering {
@@ -218,7 +259,7 @@ impl World {
                         moved: false,
                     }),
                     Tile::Knife => {
-                        if n_knives < 2 {
+                        if n_knives < kit.n_knives {
                             self.knives[n_knives] = Station {
                                 at: c,
                                 holding: None,
@@ -228,41 +269,39 @@ impl World {
                     }
                     Tile::Delivery => delivery = Some(c),
                     Tile::Plate => {
-                        if n_plates < 2 {
+                        if n_plates < kit.n_plates {
                             self.plates[n_plates] = Plate {
                                 at: c,
                                 start: c,
-                                holds: [false; 3],
+                                holds: [false; MAX_FOODS],
                             };
                         }
                         n_plates += 1;
                     }
-                    t => {
-                        if let Some(k) = FOOD_TILES.iter().position(|&f| f == t) {
-                            if !foods[k] {
-                                self.foods[k] = Food {
-                                    at: c,
-                                    start: c,
-                                    chopped: false,
-                                    chops: 0,
-                                };
-                            }
-                            foods[k] = true;
+                    Tile::Food(k) if (k as usize) < kit.n_foods => {
+                        let k = k as usize;
+                        if !foods[k] {
+                            self.foods[k] = Food {
+                                at: c,
+                                start: c,
+                                chopped: fresh_chopped,
+                                chops: 0,
+                            };
                         }
+                        foods[k] = true;
                     }
+                    _ => {}
                 }
             }
         }
-        for (k, name) in FOOD_NAMES.iter().enumerate() {
-            if !foods[k] {
-                return Err(MissingItem(name));
-            }
+        if foods[..kit.n_foods].iter().any(|&f| !f) {
+            return Err(MissingItem("food"));
         }
-        if n_plates != 2 {
-            return Err(MissingItem("two plates"));
+        if n_plates != kit.n_plates {
+            return Err(MissingItem("plate of its count"));
         }
-        if n_knives != 2 {
-            return Err(MissingItem("two knives"));
+        if n_knives != kit.n_knives {
+            return Err(MissingItem("knife of its count"));
         }
         self.delivery = Station {
             at: delivery.ok_or(MissingItem("delivery"))?,
@@ -297,7 +336,7 @@ impl World {
             Held::Food(k) => self.foods[k].at = to,
             Held::Plate(p) => {
                 self.plates[p].at = to;
-                for k in 0..3 {
+                for k in 0..self.kit.n_foods {
                     if self.plates[p].holds[k] {
                         self.foods[k].at = to;
                     }
@@ -354,10 +393,16 @@ impl World {
         }
     }
 
-    /// The first object of the kind the map shows as `tile` at `c` (`_findItem`).
-    pub fn food_at(&self, c: Cell, tile: Tile) -> Option<usize> {
-        let k = FOOD_TILES.iter().position(|&f| f == tile)?;
-        (self.foods[k].at == c).then_some(k)
+    /// The food `_findItem(c, name)` finds where the map shows food `k`: `Overcooked_V1` looks
+    /// in `k`'s own list; ACAC's `Overcooked_V0` maps every one-letter name to the list of all
+    /// foods, so it finds the first food (in item order) at `c`, of any kind.
+    pub fn food_at(&self, c: Cell, k: usize) -> Option<usize> {
+        match self.kit.rules {
+            Rules::V1 => (self.foods.get(k)?.at == c).then_some(k),
+            Rules::V0 => self.foods[..self.kit.n_foods]
+                .iter()
+                .position(|f| f.at == c),
+        }
     }
 
     /// The first plate at `c`.
@@ -377,29 +422,48 @@ impl World {
 
     /// Number of entries of the reference's `itemList`: foods, plates, knives, delivery, agents.
     pub fn n_items(&self) -> usize {
-        3 + 2 + 2 + 1 + self.cooks.len()
+        let k = &self.kit;
+        k.n_foods + k.n_plates + k.n_knives + 1 + self.cooks.len()
+    }
+
+    /// What `itemList[k]` is: a food, plate, knife, the delivery or an agent, with its index.
+    fn item_kind(&self, k: usize) -> (Tile, usize) {
+        let kit = &self.kit;
+        let plates = kit.n_foods;
+        let knives = plates + kit.n_plates;
+        let delivery = knives + kit.n_knives;
+        if k < plates {
+            (Tile::Food(k as u8), k)
+        } else if k < knives {
+            (Tile::Plate, k - plates)
+        } else if k < delivery {
+            (Tile::Knife, k - knives)
+        } else if k == delivery {
+            (Tile::Delivery, 0)
+        } else {
+            (Tile::Agent, k - delivery - 1)
+        }
     }
 
     /// Where `itemList[k]` is now, and where it started (fixed items never move).
     pub fn item(&self, k: usize) -> (Cell, Cell) {
-        match k {
-            0..=2 => (self.foods[k].at, self.foods[k].start),
-            3..=4 => (self.plates[k - 3].at, self.plates[k - 3].start),
-            5..=6 => (self.knives[k - 5].at, self.knives[k - 5].at),
-            7 => (self.delivery.at, self.delivery.at),
-            _ => (self.cooks[k - 8].at, self.cooks[k - 8].start),
+        match self.item_kind(k) {
+            (Tile::Food(_), i) => (self.foods[i].at, self.foods[i].start),
+            (Tile::Plate, i) => (self.plates[i].at, self.plates[i].start),
+            (Tile::Knife, i) => (self.knives[i].at, self.knives[i].at),
+            (Tile::Delivery, _) => (self.delivery.at, self.delivery.at),
+            (_, i) => (self.cooks[i].at, self.cooks[i].start),
         }
     }
 
     /// The tile of `itemList[k]`'s `rawName`.
     pub fn item_tile(&self, k: usize) -> Tile {
-        match k {
-            0..=2 => FOOD_TILES[k],
-            3..=4 => Tile::Plate,
-            5..=6 => Tile::Knife,
-            7 => Tile::Delivery,
-            _ => Tile::Agent,
-        }
+        self.item_kind(k).0
+    }
+
+    /// Food `k` of `itemList[k]`, when it is one (the observation's chop progress).
+    pub fn item_food(&self, k: usize) -> Option<usize> {
+        (k < self.kit.n_foods).then_some(k)
     }
 }
 
@@ -424,8 +488,13 @@ mod tests {
 
     #[test]
     fn items_are_found_in_map_scan_order() {
-        let w =
-            World::from_map(start_map(7, MapType::A, 3).unwrap(), 7, Numbering::RowMajor).unwrap();
+        let w = World::from_map(
+            start_map(7, MapType::A, 3).unwrap(),
+            7,
+            Numbering::RowMajor,
+            Kit::V1,
+        )
+        .unwrap();
         assert_eq!(w.foods[0].at, Cell::new(0, 5));
         assert_eq!(w.foods[1].at, Cell::new(1, 6));
         assert_eq!(w.foods[2].at, Cell::new(2, 6));
@@ -445,6 +514,7 @@ mod tests {
             start_map(7, MapType::A, 3).unwrap(),
             7,
             Numbering::ColumnMajor,
+            Kit::V1,
         )
         .unwrap();
         let cooks: Vec<Cell> = w.cooks.iter().map(|c| c.at).collect();
@@ -457,8 +527,13 @@ mod tests {
 
     #[test]
     fn a_plate_carries_its_foods() {
-        let mut w =
-            World::from_map(start_map(7, MapType::A, 2).unwrap(), 7, Numbering::RowMajor).unwrap();
+        let mut w = World::from_map(
+            start_map(7, MapType::A, 2).unwrap(),
+            7,
+            Numbering::RowMajor,
+            Kit::V1,
+        )
+        .unwrap();
         w.plate_contain(0, 2);
         assert_eq!(w.foods[2].at, w.plates[0].at);
         w.pickup(0, Held::Plate(0));

@@ -19,8 +19,9 @@ pub const REPLAY_KEYS: [&str; 2] = ["np_seed", "start_map"];
 pub struct OvercookedAcacDomain;
 
 /// The parameters of checked keys: gym-macro-overcooked's keys read the same way, ACAC's
-/// numbering and state, and the random-start keys.
-fn acac_params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
+/// numbering and state, and the random-start keys (which ACAC's Large kitchen reads the same
+/// way, `crate::envs::overcooked_large`).
+pub(crate) fn acac_params(keys: &toml::Table) -> Result<OvercookedParams, KeyError> {
     let mut p = params(keys)?;
     p.numbering = Numbering::ColumnMajor;
     p.vector_state = true;
@@ -58,7 +59,7 @@ fn start_map_rows(v: &toml::Value) -> Result<Vec<Vec<u8>>, KeyError> {
     let bad = || {
         KeyError::new(
             "start_map",
-            format!("expected a list of rows of codes 0..=8, got {v}"),
+            format!("expected a list of rows of the reference's codes, got {v}"),
         )
     };
     let rows = v.as_array().ok_or_else(bad)?;

@@ -5,8 +5,8 @@
 
 use super::{Warehouse, WarehouseParams};
 use crate::envs::domain::{
-    fill_keys, key_f64, key_table, key_usize, refuse_unknown_fields, tagged_count, Domain,
-    KeyError, HORIZON_KEY,
+    fill_keys, fixed_key, key_f64, key_table, key_usize, refuse_unknown_fields, tagged_count,
+    Domain, KeyError, HORIZON_KEY,
 };
 use crate::envs::EnvError;
 
@@ -65,7 +65,12 @@ impl Domain for WarehouseDomain {
                 ("tb_m_noisy", p.tb_move_noisy.into()),
             ]),
         )?;
-        keys.insert("grid_dim".into(), RECORDED_GRID_DIM.into());
+        fixed_key(
+            &mut keys,
+            "grid_dim",
+            RECORDED_GRID_DIM.into(),
+            "the ICRA Warehouse",
+        )?;
         params(&keys)?.validate().map_err(key_of)?;
         Ok(keys)
     }
@@ -136,8 +141,12 @@ mod tests {
         }
         assert_eq!(spec(150, 0.3).horizon(), 150);
         assert_eq!(paper_spec().paper_discount(), Some(1.0));
-        // The unused grid is recorded as the reference's default whatever a file says.
-        let keys = Domain::keys(&d, &key_table([("grid_dim", 30.into())])).unwrap();
+        // The unused grid is recorded as the reference's default; another value is refused,
+        // not dropped.
+        let keys = Domain::keys(&d, &key_table([("grid_dim", 10.into())])).unwrap();
         assert_eq!(keys["grid_dim"].as_integer(), Some(10));
+        let err = Domain::keys(&d, &key_table([("grid_dim", 30.into())])).unwrap_err();
+        assert_eq!(err.key, "grid_dim");
+        assert!(err.message.contains("does not read this key"), "{err:?}");
     }
 }

@@ -7,6 +7,7 @@
 //! setting. A key given as a list is a sweep axis; the grid's points become named variants.
 
 use crate::algos::families::{Family, Method, RunConfig};
+use crate::envs::domain::NOT_A_KEY;
 use crate::envs::{EnvShape, EnvSpec};
 use crate::experiment::definition::limits;
 use crate::experiment::definition::names::{check_curve_name, check_experiment_name, NameError};
@@ -512,9 +513,18 @@ fn parse_set(item: &str) -> Result<(String, toml::Value), ConfigError> {
         return Err(ConfigError::BadSet(item.to_string()));
     }
     // Read the value as TOML (numbers, booleans, lists); a bare word is a string.
-    let parsed = toml::from_str::<toml::Table>(&format!("v = {raw}"))
-        .ok()
-        .and_then(|mut t| t.remove("v"));
+    let parsed = toml::from_str::<toml::Table>(&format!("v = {raw}")).ok();
+    // A newline in the value would start another key (`total_epi=3\ngamma=0.5` parses as two);
+    // one --set is one key, so that is refused rather than half applied.
+    if parsed.as_ref().is_some_and(|t| t.len() > 1)
+        || (parsed.is_none() && raw.contains(['\n', '\r']))
+    {
+        return Err(ConfigError::BadSetValue {
+            item: item.to_string(),
+            message: "the value holds a line break; give one key per --set".into(),
+        });
+    }
+    let parsed = parsed.and_then(|mut t| t.remove("v"));
     let word = raw.trim();
     let value = match parsed {
         Some(v) => v,
@@ -685,13 +695,12 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
     let mut table = toml::Table::try_from(&defaults).expect("RunSettings serializes to a table");
     for (key, value) in point {
         if !table.contains_key(key) {
-            // A key the domain accepts and drops (MacroMARL's script passes every BP/OSD
-            // keyword argument to every such environment) is not an error.
-            if domain
-                .keys(&toml::Table::from_iter([(key.clone(), value.clone())]))
-                .is_ok()
-            {
-                continue;
+            // A key the domain knows and refuses (a MacroMARL kwarg its env does not read) is
+            // refused with the domain's reason; any other is unknown.
+            if let Err(e) = domain.keys(&toml::Table::from_iter([(key.clone(), value.clone())])) {
+                if e.key == *key && e.message != NOT_A_KEY {
+                    return Err(bad(key, format!("{}: {}", domain.name(), e.message)));
+                }
             }
             return Err(ConfigError::UnknownKey {
                 path: p(),
@@ -723,21 +732,6 @@ fn resolve(path: &Path, method: Method, point: &toml::Table) -> Result<RunSettin
     let config = RunSettings::from_table(method, table.clone()).map_err(|e| bad("config", e))?;
     // Bad values first, so `l_rate = nan` is named as a bad value, not as an unused key.
     validate(&config.config, method, &config.env).map_err(|(key, message)| bad(key, message))?;
-    // A domain key the chosen domain does not use (`grid_dim` for OSD_S_4, `tb_m_noisy` for
-    // BP_MA) would be dropped and recorded as its default: refuse it instead of ignoring it.
-    // (`env_name` itself is recorded by its reference name even when written as an alias.)
-    let recorded = toml::Table::try_from(&config).expect("RunSettings serializes to a table");
-    for (key, value) in &table {
-        if key != "env_name" && !recorded.get(key).is_some_and(|r| same_value(r, value)) {
-            return Err(bad(
-                key,
-                format!(
-                    "env_name = {} does not use this key; leave it out (got {value})",
-                    table["env_name"]
-                ),
-            ));
-        }
-    }
     Ok(config)
 }
 
@@ -809,15 +803,6 @@ fn edit_distance(a: &str, b: &str) -> usize {
         }
     }
     row[b.len()]
-}
-
-/// Whether a recorded value is the one given: equal, or both the same NaN (which `==` never
-/// calls equal, so a NaN would read as a key the domain drops).
-fn same_value(recorded: &toml::Value, given: &toml::Value) -> bool {
-    match (recorded, given) {
-        (toml::Value::Float(a), toml::Value::Float(b)) => a.to_bits() == b.to_bits() || a == b,
-        _ => recorded == given,
-    }
 }
 
 /// Range checks that types cannot express, for the sizes of `env`'s environment (built once to
@@ -894,6 +879,21 @@ mod tests {
             .clone();
         assert_eq!(c.total_epi, 300);
         assert_eq!(c.l_rate, 0.01);
+    }
+
+    #[test]
+    fn a_set_value_with_a_line_break_is_refused_not_half_applied() {
+        for set in [
+            "total_epi=3\ngamma=0.5",
+            "total_epi=3\r\nl_rate=0.1",
+            "env_name=BP\nx",
+        ] {
+            let err = parse("", &[set]).unwrap_err().to_string();
+            assert!(err.contains("line break"), "{set:?}: {err}");
+        }
+        // A TOML list written over two lines is still one value.
+        let e = parse("methods = [\"our1\"]", &["grid_dim=[\n10]"]).unwrap();
+        assert_eq!(e.runs().unwrap().len(), 1);
     }
 
     #[test]
@@ -1142,12 +1142,15 @@ mod tests {
         // Box Pushing's grid_dim is a number, so a list of numbers sweeps it.
         let icra = "methods = [\"our1\"]\n[params]\ngrid_dim = [8, 10]";
         assert_eq!(variants(icra).len(), 2);
-        // A key MacroMARL's script passes to every BP/OSD env is accepted and not recorded.
-        let e = parse(&format!("{head}TB_move_speed = 0.6"), &[]).unwrap();
-        assert!(!e.runs().unwrap()[0]
-            .env
-            .keys()
-            .contains_key("TB_move_speed"));
+        // A key MacroMARL's script passes to every BP/OSD env, which Box Pushing does not
+        // read, is refused with the reason, not dropped.
+        let err = parse(&format!("{head}TB_move_speed = 0.6"), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("`TB_move_speed`") && err.contains("does not read it"),
+            "{err}"
+        );
         let err = parse(&format!("{head}grid_size = 6"), &[]).unwrap_err();
         assert!(err.to_string().contains("unknown key `grid_size`"), "{err}");
     }

@@ -96,7 +96,7 @@ mod tests {
     }
 
     #[test]
-    fn unknown_keys_are_refused_and_unused_domain_keys_are_not_read() {
+    fn unknown_keys_and_values_of_keys_the_domain_does_not_read_are_refused() {
         let c = paper(crate::envs::box_pushing::paper_spec(10), "our1");
         let text = toml::to_string(&c).unwrap();
         let err = read("our1", &format!("{text}trace_lenn = 3\n")).unwrap_err();
@@ -106,10 +106,15 @@ mod tests {
         // The method's family reads the keys: an ICRA config is not an actor-critic one.
         let err = read("mac-iac", &text).unwrap_err();
         assert!(err.contains("unknown field"), "{err}");
-        // A Box Pushing config's tb_m_noisy is not part of its domain.
+        // A Box Pushing config's tb_m_noisy is recorded as 0, which Box Pushing does not read:
+        // a hand-edited other value is refused, not dropped.
         let noisy = text.replace("tb_m_noisy = 0.0", "tb_m_noisy = 0.3");
         assert_ne!(noisy, text);
-        assert_eq!(read("our1", &noisy).unwrap().env, c.env);
+        let err = read("our1", &noisy).unwrap_err();
+        assert!(
+            err.contains("`tb_m_noisy`") && err.contains("leave it out"),
+            "{err}"
+        );
         // A hyperparameter table refuses the domain's keys: the learner's config names none.
         let err = method("our1")
             .config_from_table(toml::from_str(&text).unwrap())
