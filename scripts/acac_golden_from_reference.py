@@ -842,7 +842,7 @@ def main():
     os.chmod(base + ".safetensors.tmp", 0o644)
     os.replace(base + ".safetensors.tmp", base + ".safetensors")
     with open(base + ".json.tmp", "w") as f:
-        json.dump(doc, f, separators=(",", ":"))
+        json.dump(doc, f, separators=(",", ":"), allow_nan=False)  # serde_json reads no NaN
         f.write("\n")
     os.replace(base + ".json.tmp", base + ".json")
     print(base, os.path.getsize(base + ".json"), os.path.getsize(base + ".safetensors"))
