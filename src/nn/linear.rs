@@ -1,11 +1,13 @@
 //! The fully connected layer: initialization, binding to a tape, and the single-row forward used
 //! when acting.
 
-use ndarray::Axis;
+use ndarray::{ArrayViewD, Axis};
 use rand_chacha::ChaCha8Rng;
 
 use super::init::xavier_uniform;
 use super::params::{copy_grad, flat, flat_mut, LinearParams};
+use super::state_dict::StateDict;
+use super::WeightsError;
 use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::{Activation, Tape, Var};
 
@@ -15,6 +17,25 @@ impl LinearParams {
         let mut p = LinearParams::zeros(input, output);
         p.weight = xavier_uniform(output, input, gain, rng);
         p
+    }
+
+    /// `nn.Linear` under `prefix` in a state_dict (`weight` [out, in], `bias` [out]), its
+    /// sizes read from the file.
+    pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
+        let name = format!("{prefix}weight");
+        let (out, input) = sd.shape2(&name)?;
+        Ok(LinearParams {
+            weight: sd.array2(&name, out, input)?,
+            bias: sd.array1(&format!("{prefix}bias"), out)?,
+        })
+    }
+
+    /// The tensors under `prefix`: `weight`, `bias`.
+    pub fn named(&self, prefix: &str) -> Vec<(String, ArrayViewD<'_, f32>)> {
+        vec![
+            (format!("{prefix}weight"), self.weight.view().into_dyn()),
+            (format!("{prefix}bias"), self.bias.view().into_dyn()),
+        ]
     }
 
     /// Input size.

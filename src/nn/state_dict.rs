@@ -140,7 +140,9 @@ impl<'a> StateDict<'a> {
         names.sort();
         for name in names {
             let is_known = known.iter().any(|k| k == name);
-            if !is_known && !ignored.iter().any(|s| ends_with_segments(name, s)) {
+            // Segments count from the prefix: `time_embedding.weight` under `init/actor0/`.
+            let within = &name[prefix.len()..];
+            if !is_known && !ignored.iter().any(|s| ends_with_segments(within, s)) {
                 let mut expected: Vec<&str> = known
                     .iter()
                     .filter_map(|k| k.strip_prefix(prefix))

@@ -114,7 +114,11 @@ fn agent_obs<'e>(e: &'e Episode, row: usize, offsets: &[usize], agent: usize) ->
 impl SqueezedEpisode {
     /// Squeeze one recorded episode (`index` names it in errors); `obs_sizes` are the agents'
     /// observation lengths.
-    pub fn from_episode(e: &Episode, index: usize, obs_sizes: &[usize]) -> Result<Self, BatchError> {
+    pub fn from_episode(
+        e: &Episode,
+        index: usize,
+        obs_sizes: &[usize],
+    ) -> Result<Self, BatchError> {
         let n = e.n_agents;
         let mut offsets = vec![0];
         for &s in obs_sizes {
@@ -201,7 +205,10 @@ impl SqueezedEpisode {
         let mut bootstrap_time = vec![1];
         bootstrap_time.extend(ends.iter().map(|&t| t + 2));
         let mut bootstrap_steps = vec![vec![true; n]];
-        bootstrap_steps.extend(ends.iter().map(|&t| (0..n).map(|i| e.valid(t, i)).collect()));
+        bootstrap_steps.extend(
+            ends.iter()
+                .map(|&t| (0..n).map(|i| e.valid(t, i)).collect()),
+        );
         Ok(SqueezedEpisode {
             joint_steps: l,
             critic_obs,
@@ -260,8 +267,20 @@ mod tests {
         for t in 0..=steps {
             e.obs.extend([t as f32, 10.0 * t as f32]);
         }
-        let starts = [[true, true], [false, false], [true, false], [true, true], [false, false]];
-        let ends = [[false, false], [true, false], [true, true], [false, false], [false, true]];
+        let starts = [
+            [true, true],
+            [false, false],
+            [true, false],
+            [true, true],
+            [false, false],
+        ];
+        let ends = [
+            [false, false],
+            [true, false],
+            [true, true],
+            [false, false],
+            [false, true],
+        ];
         for t in 0..steps {
             for i in 0..n {
                 e.mac_start.push(starts[t][i]);
@@ -288,7 +307,10 @@ mod tests {
         // jobs: the observations before each end step.
         assert_eq!(s.critic_obs[1].column(0).to_vec(), vec![10.0, 20.0, 40.0]);
         // Bootstrap: before e_0, then after each end; agents stepping where they ended.
-        assert_eq!(s.bootstrap_obs[0].column(0).to_vec(), vec![1.0, 2.0, 3.0, 5.0]);
+        assert_eq!(
+            s.bootstrap_obs[0].column(0).to_vec(),
+            vec![1.0, 2.0, 3.0, 5.0]
+        );
         assert_eq!(s.bootstrap_time, vec![1, 3, 4, 6]);
         assert_eq!(
             s.bootstrap_steps,
@@ -320,6 +342,9 @@ mod tests {
         // Agent 1 "ends" at step 1 too without a start in between: three ends, two starts.
         e.valid[2 + 1] = true;
         let err = SqueezedEpisode::from_episode(&e, 3, &[1, 1]).unwrap_err();
-        assert!(matches!(err, BatchError::Unpaired { episode: 3, .. }), "{err}");
+        assert!(
+            matches!(err, BatchError::Unpaired { episode: 3, .. }),
+            "{err}"
+        );
     }
 }

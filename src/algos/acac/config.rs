@@ -202,19 +202,26 @@ pub const ENV_KEYS: [&str; 17] = [
 
 /// Keys of ACAC's parameter files that only its Python runner reads; refused here.
 pub const RUNNER_KEYS: [&str; 7] = [
-    "alg_name",
-    "env_name",
-    "exp_name",
-    "seed",
-    "resume",
-    "device",
-    "parallel",
+    "alg_name", "env_name", "exp_name", "seed", "resume", "device", "parallel",
 ];
 
 /// ACAC's 15 published settings, by its `--env_name`.
 pub const ENV_NAMES: [&str; 15] = [
-    "bp6", "bp8", "bp10", "ovcA7", "ovcB7", "ovcC7", "ovcAR7", "ovcBR7", "ovcCR7", "ovcA11_N6",
-    "ovcB11_N6", "ovcC11_N6", "ovcAR11_N6", "ovcBR11_N6", "ovcCR11_N6",
+    "bp6",
+    "bp8",
+    "bp10",
+    "ovcA7",
+    "ovcB7",
+    "ovcC7",
+    "ovcAR7",
+    "ovcBR7",
+    "ovcCR7",
+    "ovcA11_N6",
+    "ovcB11_N6",
+    "ovcC11_N6",
+    "ovcAR11_N6",
+    "ovcBR11_N6",
+    "ovcCR11_N6",
 ];
 
 /// Training episodes between checkpoints when nobody says (ACAC saves ten per run).
@@ -558,7 +565,9 @@ pub fn check(
         NetWidths {
             // Per agent: its actor, its critic encoder, and the attention's 4 x n_embd MLP.
             hidden: widest.saturating_mul(6).saturating_mul(n_agents.max(1)),
-            input: shape.joint_obs_size().saturating_add(emb.saturating_mul(n_agents)),
+            input: shape
+                .joint_obs_size()
+                .saturating_add(emb.saturating_mul(n_agents)),
             output: shape.widest_actions().saturating_mul(n_agents),
         },
     )

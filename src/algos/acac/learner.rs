@@ -537,8 +537,18 @@ mod tests {
             assert_eq!(a.evals().len(), b.evals().len(), "{method:?}");
             for (x, y) in a.evals().iter().zip(b.evals()) {
                 assert_eq!(
-                    (x.eval_return, x.eval_return_undiscounted, &x.family, x.env_steps),
-                    (y.eval_return, y.eval_return_undiscounted, &y.family, y.env_steps),
+                    (
+                        x.eval_return,
+                        x.eval_return_undiscounted,
+                        &x.family,
+                        x.env_steps
+                    ),
+                    (
+                        y.eval_return,
+                        y.eval_return_undiscounted,
+                        &y.family,
+                        y.env_steps
+                    ),
                     "{method:?}"
                 );
             }
@@ -565,7 +575,9 @@ mod tests {
         assert!(*steps.last().unwrap() >= budget as f64, "{steps:?}");
         assert!(steps[steps.len() - 2] < budget as f64, "{steps:?}");
         // Steps of completed episodes only: at most the loop's count of every lane step.
-        assert!(evals.iter().all(|e| e.family[0].unwrap() <= e.env_steps as f64));
+        assert!(evals
+            .iter()
+            .all(|e| e.family[0].unwrap() <= e.env_steps as f64));
         // Box Pushing's undiscounted return is at least its discounted one when positive.
         for e in evals {
             let u = e.eval_return_undiscounted.unwrap();

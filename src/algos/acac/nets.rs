@@ -13,17 +13,21 @@
 //! fc4 and the value layer gain 1, zero biases; the GRU PyTorch's default. The time embedding
 //! is the fixed sinusoidal table (`time_emb_alg` sinu) of `env_terminate_step + 5` rows.
 
-use ndarray::{Array1, Array2};
+use ndarray::{Array1, Array2, ArrayViewD};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::autograd::{Activation, GruVars, SeqPacking, Tape, Var};
 use crate::nn::init::LEAKY_RELU_GAIN;
 use crate::nn::{
-    AcacJointValue, AcacJointValueVars, GruParams, GruState, Gpt2, Gpt2Config, Gpt2Dropout,
-    LayerNormParams, LayerNormVars, LinearParams, LinearVars, Params, PopArt, ValueLayer,
-    LAYER_NORM_EPS,
+    AcacJointValue, AcacJointValueVars, Gpt2, Gpt2Config, Gpt2Dropout, GruParams, GruState,
+    LayerNormParams, LayerNormVars, LinearParams, LinearVars, Params, PopArt, StateDict, ValueHead,
+    ValueLayer, WeightsError, GPT2_BLOCK_BUFFERS, LAYER_NORM_EPS,
 };
+
+/// The time table ACAC registers in every actor and critic (`time_embedding.weight`): one
+/// fixed table, held once by [`super::update::AcacNets`], so the nets' own loaders skip it.
+pub const TIME_TABLE: &str = "time_embedding.weight";
 
 const LEAKY: Activation = Activation::LEAKY_001;
 
@@ -65,6 +69,28 @@ impl AcacEncoder {
             fc2: LinearParams::xavier(m0, m0, LEAKY_RELU_GAIN, rng),
             gru: GruParams::pytorch_default(m0, hidden, rng),
         }
+    }
+
+    /// The encoder under `prefix` in a state_dict (`encoder.` of an actor, `encoders.<i>.`
+    /// of the critic), sizes from the file.
+    pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
+        Ok(AcacEncoder {
+            fc1: LinearParams::from_state_dict(sd, &format!("{prefix}fc1."))?,
+            fc2: LinearParams::from_state_dict(sd, &format!("{prefix}fc2."))?,
+            gru: GruParams::from_state_dict(sd, &format!("{prefix}gru."))?,
+        })
+    }
+
+    /// Every tensor under `prefix`, by ACAC's names, in `state_dict` order.
+    pub fn named(&self, prefix: &str) -> Vec<(String, ArrayViewD<'_, f32>)> {
+        let mut out = self.fc1.named(&format!("{prefix}fc1."));
+        out.extend(self.fc2.named(&format!("{prefix}fc2.")));
+        out.extend(
+            self.gru
+                .named()
+                .map(|(n, v)| (format!("{prefix}gru.{n}"), v)),
+        );
+        out
     }
 
     fn zeros_like(&self) -> Self {
@@ -180,6 +206,45 @@ impl AcacActor {
             ln,
             fc4,
         }
+    }
+
+    /// An actor's `state_dict` under `prefix` (`AgentCentricGRUActor`: `encoder.*`, `fc3.*`,
+    /// `ln.*` when `use_actor_ln`, `fc4.*`; its `time_embedding.weight` is skipped, see
+    /// [`TIME_TABLE`]). Any other tensor under the prefix is an error.
+    pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
+        let fc3 = LinearParams::from_state_dict(sd, &format!("{prefix}fc3."))?;
+        let ln_prefix = format!("{prefix}ln.");
+        let ln = if sd.has(&format!("{ln_prefix}weight")) {
+            Some(LayerNormParams::from_state_dict(
+                sd,
+                &ln_prefix,
+                fc3.output(),
+                LAYER_NORM_EPS,
+            )?)
+        } else {
+            None
+        };
+        let actor = AcacActor {
+            encoder: AcacEncoder::from_state_dict(sd, &format!("{prefix}encoder."))?,
+            fc3,
+            ln,
+            fc4: LinearParams::from_state_dict(sd, &format!("{prefix}fc4."))?,
+        };
+        let known: Vec<String> = actor.named(prefix).into_iter().map(|(n, _)| n).collect();
+        sd.check_names_under(prefix, &known, &[TIME_TABLE], "ACAC actor")?;
+        Ok(actor)
+    }
+
+    /// Every tensor under `prefix`, by ACAC's names, in `state_dict` order (without the time
+    /// table).
+    pub fn named(&self, prefix: &str) -> Vec<(String, ArrayViewD<'_, f32>)> {
+        let mut out = self.encoder.named(&format!("{prefix}encoder."));
+        out.extend(self.fc3.named(&format!("{prefix}fc3.")));
+        if let Some(ln) = &self.ln {
+            out.extend(ln.named(&format!("{prefix}ln.")));
+        }
+        out.extend(self.fc4.named(&format!("{prefix}fc4.")));
+        out
     }
 
     /// All-zero tensors of the same sizes (a gradient buffer).
@@ -360,6 +425,47 @@ impl AcacCritic {
                 value,
             },
         }
+    }
+
+    /// The critic's `state_dict` under `prefix` (`AgentCentricGRUCritic` with `use_attention`:
+    /// `encoders.<i>.*` for every agent, `centralized_transformer.*`, `value.*`; the time
+    /// table and GPT-2's causal-mask buffers are skipped), with ACAC's `value_head` and
+    /// `cc_n_head`, which the file does not record. Any other tensor under the prefix is an
+    /// error. Panics if n_head does not divide the encoders' width.
+    pub fn from_state_dict(
+        sd: &StateDict,
+        prefix: &str,
+        head: ValueHead,
+        n_head: usize,
+    ) -> Result<Self, WeightsError> {
+        let mut encoders = Vec::new();
+        while sd.has(&format!("{prefix}encoders.{}.fc1.weight", encoders.len())) {
+            let i = encoders.len();
+            encoders.push(AcacEncoder::from_state_dict(
+                sd,
+                &format!("{prefix}encoders.{i}."),
+            )?);
+        }
+        let critic = AcacCritic {
+            encoders,
+            top: AcacJointValue::from_state_dict(sd, prefix, head, n_head)?,
+        };
+        let known: Vec<String> = critic.named(prefix).into_iter().map(|(n, _)| n).collect();
+        let mut ignored = vec![TIME_TABLE];
+        ignored.extend(GPT2_BLOCK_BUFFERS);
+        sd.check_names_under(prefix, &known, &ignored, "ACAC critic")?;
+        Ok(critic)
+    }
+
+    /// Every tensor under `prefix`, by ACAC's names, in `state_dict` order (without the time
+    /// table).
+    pub fn named(&self, prefix: &str) -> Vec<(String, ArrayViewD<'_, f32>)> {
+        let mut out = Vec::new();
+        for (i, e) in self.encoders.iter().enumerate() {
+            out.extend(e.named(&format!("{prefix}encoders.{i}.")));
+        }
+        out.extend(self.top.named(prefix));
+        out
     }
 
     /// All-zero tensors of the same sizes (a gradient buffer).

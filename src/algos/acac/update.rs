@@ -137,7 +137,11 @@ pub enum DropoutSource<'a> {
 }
 
 impl DropoutSource<'_> {
-    fn next(&mut self, rows: usize, critic: &AcacCritic) -> Result<Option<Gpt2Dropout>, UpdateError> {
+    fn next(
+        &mut self,
+        rows: usize,
+        critic: &AcacCritic,
+    ) -> Result<Option<Gpt2Dropout>, UpdateError> {
         let cfg = critic.top.transformer.config();
         let n = critic.encoders.len();
         match self {
@@ -158,7 +162,9 @@ impl DropoutSource<'_> {
                     m.embd.nrows(),
                     rows
                 ))),
-                None => Err(UpdateError::Masks("fewer masks than critic forwards".into())),
+                None => Err(UpdateError::Masks(
+                    "fewer masks than critic forwards".into(),
+                )),
             },
         }
     }
@@ -238,7 +244,13 @@ fn critic_input<'e>(
         input.rows_per_episode.push(steps.len());
         for i in 0..n {
             let rows: Vec<usize> = (0..steps.len())
-                .filter(|&k| if duplicate { steps[k].iter().any(|&s| s) } else { steps[k][i] })
+                .filter(|&k| {
+                    if duplicate {
+                        steps[k].iter().any(|&s| s)
+                    } else {
+                        steps[k][i]
+                    }
+                })
                 .collect();
             let picked = obs[i].select(ndarray::Axis(0), &rows);
             let t: Vec<usize> = rows.iter().map(|&k| time[k]).collect();
@@ -247,7 +259,11 @@ fn critic_input<'e>(
             // recover_joint_feature: the latest encoding at or before each row.
             let mut seen = 0usize;
             for step in steps {
-                let stepped = if duplicate { step.iter().any(|&s| s) } else { step[i] };
+                let stepped = if duplicate {
+                    step.iter().any(|&s| s)
+                } else {
+                    step[i]
+                };
                 seen += usize::from(stepped);
                 // Row 0 always steps every agent (checked when squeezing).
                 input.latest[i].push(taken[i] + seen.max(1) - 1);
@@ -257,7 +273,9 @@ fn critic_input<'e>(
     }
     for p in parts {
         let views: Vec<_> = p.iter().map(|a| a.view()).collect();
-        input.x.push(ndarray::concatenate(ndarray::Axis(0), &views).expect("same widths"));
+        input
+            .x
+            .push(ndarray::concatenate(ndarray::Axis(0), &views).expect("same widths"));
     }
     input
 }
@@ -401,10 +419,7 @@ fn advantages(
             p.gamma,
             &lambdas,
         )
-        .map_err(|source| UpdateError::Gae {
-            episode: k,
-            source,
-        })?;
+        .map_err(|source| UpdateError::Gae { episode: k, source })?;
         adv.extend(g.advantages);
         ret.extend(g.returns);
     }
@@ -672,7 +687,10 @@ mod tests {
                 nonzero += usize::from(an.abs() > 1e-3);
             }
         }
-        assert!(nonzero >= 20, "only {nonzero} of {checked} gradients are non-zero");
+        assert!(
+            nonzero >= 20,
+            "only {nonzero} of {checked} gradients are non-zero"
+        );
         checked
     }
 
@@ -691,7 +709,9 @@ mod tests {
         let targets = Array2::from_shape_fn((rows, 1), |(r, _)| (r as f32 * 0.7).sin());
         // Dropout on, with the same masks in every evaluation.
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let masks = DropoutSource::Draw(&mut rng).next(rows, &nets.critic).unwrap();
+        let masks = DropoutSource::Draw(&mut rng)
+            .next(rows, &nets.critic)
+            .unwrap();
         let (_, grads) = critic_loss(&nets.critic, &input, &targets, masks.as_ref());
         let checked = check_fd(&nets.critic, &grads, 7, |c| {
             critic_loss(c, &input, &targets, masks.as_ref()).0
@@ -747,11 +767,19 @@ mod tests {
         let now = mixture_log_prob(&mut tape, lp, &input.actions, p.eps);
         let old: Vec<f32> = tape.value(now).column(0).iter().map(|v| v - 0.5).collect();
         let up = actor_loss(&nets.actors[1], &input, &old, &vec![2.0; m], &p);
-        assert!(up.grads.slices().iter().all(|s| s.iter().all(|&g| g == 0.0)));
+        assert!(up
+            .grads
+            .slices()
+            .iter()
+            .all(|s| s.iter().all(|&g| g == 0.0)));
         // loss = -mean(clip(r) A) = -(1.2 * 2).
         assert!((up.loss + 2.4).abs() < 1e-5, "{}", up.loss);
         let down = actor_loss(&nets.actors[1], &input, &old, &vec![-2.0; m], &p);
-        assert!(down.grads.slices().iter().any(|s| s.iter().any(|&g| g != 0.0)));
+        assert!(down
+            .grads
+            .slices()
+            .iter()
+            .any(|s| s.iter().any(|&g| g != 0.0)));
         // loss = -mean(r A) = 2 e^0.5.
         let want = 2.0 * 0.5f32.exp();
         assert!((down.loss - want).abs() < 1e-4, "{} vs {want}", down.loss);
@@ -765,7 +793,9 @@ mod tests {
         let before = nets.actors.clone();
         let trace = update(&mut nets, &batch, &params(1.0), DropoutSource::Off).unwrap();
         let uniform = -(acts[0] as f32).ln();
-        assert!(trace.old_log_pi[0].iter().all(|&l| (l - uniform).abs() < 1e-6));
+        assert!(trace.old_log_pi[0]
+            .iter()
+            .all(|&l| (l - uniform).abs() < 1e-6));
         assert_eq!(nets.actors, before);
         // The critic did move, twice (n_train_repeat 2).
         assert_eq!(trace.critic_losses.len(), 2);
@@ -782,14 +812,23 @@ mod tests {
         let (mean, var) = pa.debiased_mean_var();
         for (g, t) in trace.returns.iter().zip(&trace.targets) {
             let want = (g - mean[0]) / var[0].sqrt();
-            assert!((t - want).abs() < 1e-4 * (1.0 + want.abs()), "{t} vs {want}");
+            assert!(
+                (t - want).abs() < 1e-4 * (1.0 + want.abs()),
+                "{t} vs {want}"
+            );
         }
         // The statistics moved from their initial (0, 1) toward the returns' mean.
         let ret_mean = trace.returns.iter().sum::<f32>() / trace.returns.len() as f32;
-        assert!((mean[0] - ret_mean).abs() < 1e-3 * (1.0 + ret_mean.abs()), "{mean} {ret_mean}");
+        assert!(
+            (mean[0] - ret_mean).abs() < 1e-3 * (1.0 + ret_mean.abs()),
+            "{mean} {ret_mean}"
+        );
         // One advantage and return per joint macro-step of the batch.
         let steps: usize = batch.episodes.iter().map(|e| e.joint_steps).sum();
-        assert_eq!((trace.advantages.len(), trace.targets.len()), (steps, steps));
+        assert_eq!(
+            (trace.advantages.len(), trace.targets.len()),
+            (steps, steps)
+        );
     }
 
     #[test]
@@ -802,17 +841,36 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(9);
         let boot_rows: usize = batch.episodes.iter().map(|e| e.joint_steps + 1).sum();
         let rows: usize = batch.episodes.iter().map(|e| e.joint_steps).sum();
-        let mut masks = vec![DropoutSource::Draw(&mut rng).next(boot_rows, &a.critic).unwrap().unwrap()];
+        let mut masks = vec![DropoutSource::Draw(&mut rng)
+            .next(boot_rows, &a.critic)
+            .unwrap()
+            .unwrap()];
         for _ in 0..2 {
-            masks.push(DropoutSource::Draw(&mut rng).next(rows, &a.critic).unwrap().unwrap());
+            masks.push(
+                DropoutSource::Draw(&mut rng)
+                    .next(rows, &a.critic)
+                    .unwrap()
+                    .unwrap(),
+            );
         }
         let mut rng = ChaCha8Rng::seed_from_u64(9);
         let ta = update(&mut a, &batch, &params(0.5), DropoutSource::Draw(&mut rng)).unwrap();
-        let tb = update(&mut b, &batch, &params(0.5), DropoutSource::Replay(masks.iter())).unwrap();
+        let tb = update(
+            &mut b,
+            &batch,
+            &params(0.5),
+            DropoutSource::Replay(masks.iter()),
+        )
+        .unwrap();
         assert_eq!(ta, tb);
         assert_eq!(a, b);
         // Too few masks is an error, not a panic.
-        let err = update(&mut b, &batch, &params(0.5), DropoutSource::Replay(masks[..2].iter()));
+        let err = update(
+            &mut b,
+            &batch,
+            &params(0.5),
+            DropoutSource::Replay(masks[..2].iter()),
+        );
         assert!(matches!(err, Err(UpdateError::Masks(_))));
     }
 }
