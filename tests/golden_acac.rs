@@ -1,17 +1,20 @@
-//! ACAC's learners (`acac`, `acac-micro-gae`) against one `train` call recorded from ACAC's own
-//! code (`tests/golden_acac/README.md`, written by `scripts/acac_golden_from_reference.py`).
+//! ACAC's three learners (`acac`, `acac-micro-gae`, `acac-vanilla`) against one `train` call
+//! each, recorded from ACAC's own code (`tests/golden_acac/README.md`, written by `scripts/acac_golden_from_reference.py`).
 //!
 //! From each case's batch (the runner's padded episodes) we build our recorded episodes and
 //! squeeze them; from its `init` weights (ACAC's `state_dict` names) our nets; with its dropout
-//! masks replayed, our update must give the squeezed batch exactly, the target critic's
-//! advantages, returns and PopArt statistics, the actors' log pi_old, each epoch's critic and
-//! actor losses, and every weight after the last epoch, to the tolerances below. No torch.
+//! masks replayed, our update must give the squeezed batch exactly, the returns (GAE with
+//! PopArt, or acac-vanilla's n-step returns) and advantages, the actors' log pi_old (PPO) or
+//! entropies (vanilla), each epoch's critic and actor losses, and every weight after the last
+//! epoch, to the tolerances below. No torch.
 
 use std::path::{Path, PathBuf};
 
 use macdec::algos::acac::batch::{AcacBatch, SqueezedEpisode};
 use macdec::algos::acac::nets::{AcacActor, AcacCritic, TIME_TABLE};
-use macdec::algos::acac::update::{update, AcacNets, DropoutSource, GaeLambda, UpdateParams};
+use macdec::algos::acac::update::{
+    update, AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
+};
 use macdec::algos::actor_critic::episode::Episode;
 use macdec::nn::{BlockDropout, Gpt2Dropout, StateDict, TimeEmbedding, ValueHead};
 use ndarray::{Array2, ArrayViewD};
@@ -233,13 +236,24 @@ fn dropout(case: &Value) -> Vec<Gpt2Dropout> {
         .collect()
 }
 
-fn params(case: &Value, gae_lambda: GaeLambda) -> UpdateParams {
+/// The case's settings; `vanilla` takes acac-vanilla's objective from them, else PPO with
+/// `gae_lambda`.
+fn params(case: &Value, vanilla: bool, gae_lambda: GaeLambda) -> UpdateParams {
     let s = &case["settings"];
     let f = |k: &str| s[k].as_f64().unwrap();
+    let objective = if vanilla {
+        Objective::Vanilla {
+            n_step: usize_of(&s["n_step_TD"]),
+            critic_iterations: usize_of(&s["c_train_iteration"]),
+            entropy_weight: case["etrpy_w"].as_f64().unwrap(),
+        }
+    } else {
+        Objective::Ppo(gae_lambda)
+    };
     UpdateParams {
         gamma: f("gamma"),
         lambda: f("GAE_lambda"),
-        gae_lambda,
+        objective,
         clip_ratio: f("clip_ratio"),
         n_train_repeat: usize_of(&s["n_train_repeat"]),
         eps: case["eps"].as_f64().unwrap(),
@@ -270,6 +284,12 @@ fn compare_weights(what: &str, ours: Vec<(String, ArrayViewD<'_, f32>)>, sd: &St
 fn replay(case_name: &str, gae_lambda: GaeLambda) {
     let case = load(case_name);
     let j = &case.json;
+    let vanilla = j["alg"] == "acac_vanilla";
+    let (reward_key, terminal_key) = if vanilla {
+        ("reward", "terminate")
+    } else {
+        ("jr", "j_terminate")
+    };
     let obs_sizes: Vec<usize> = list(&j["obs_size"]).iter().map(usize_of).collect();
     let n = obs_sizes.len();
 
@@ -298,10 +318,15 @@ fn replay(case_name: &str, gae_lambda: GaeLambda) {
         .iter()
         .flat_map(|e| f64s(&e.rewards))
         .collect();
-    assert_all_close("jr", &rewards, &valid_rows(&sq["jr"], &joint), 1e-6);
+    assert_all_close(
+        reward_key,
+        &rewards,
+        &valid_rows(&sq[reward_key], &joint),
+        1e-6,
+    );
     for (e, ep) in batch.episodes.iter().enumerate() {
         let last = joint[e] - 1;
-        let terminal = sq["j_terminate"][e][last][0].as_f64().unwrap() != 0.0;
+        let terminal = sq[terminal_key][e][last][0].as_f64().unwrap() != 0.0;
         assert_eq!(ep.terminated, terminal, "episode {e}: terminal");
     }
     for i in 0..n {
@@ -328,38 +353,12 @@ fn replay(case_name: &str, gae_lambda: GaeLambda) {
     // The update.
     let mut nets = nets(&case);
     let masks = dropout(j);
-    let p = params(j, gae_lambda);
+    let p = params(j, vanilla, gae_lambda);
     let trace = update(&mut nets, &batch, &p, DropoutSource::Replay(masks.iter())).unwrap();
-    let gae = &j["gae"];
-    assert_all_close(
-        "advantage",
-        &f64s(&trace.advantages),
-        &valid_rows(&gae["advantage"], &joint),
-        VALUE_TOL,
-    );
-    assert_all_close(
-        "returns_raw",
-        &f64s(&trace.returns),
-        &valid_rows(&gae["returns_raw"], &joint),
-        VALUE_TOL,
-    );
-    assert_all_close(
-        "returns (PopArt-normalized)",
-        &f64s(&trace.targets),
-        &valid_rows(&gae["returns"], &joint),
-        VALUE_TOL,
-    );
-    for i in 0..n {
-        let lens: Vec<usize> = list(&sq["agents"][i]["epi_len"])
-            .iter()
-            .map(usize_of)
-            .collect();
-        assert_all_close(
-            &format!("old_log_pi[{i}]"),
-            &f64s(&trace.old_log_pi[i]),
-            &valid_rows(&j["old_log_pi"][i], &lens),
-            VALUE_TOL,
-        );
+    if vanilla {
+        check_vanilla(j, &trace, &joint);
+    } else {
+        check_ppo(j, &trace, &joint);
     }
     let epochs = list(&j["epochs"]);
     assert_eq!(trace.critic_losses.len(), epochs.len(), "epochs");
@@ -402,6 +401,71 @@ fn replay(case_name: &str, gae_lambda: GaeLambda) {
     compare_weights("critic", nets.critic.named(&format!("{last}critic/")), &sd);
 }
 
+/// Each agent's macro-actions per episode.
+fn agent_lens(j: &Value, i: usize) -> Vec<usize> {
+    list(&j["squeezed"]["agents"][i]["epi_len"])
+        .iter()
+        .map(usize_of)
+        .collect()
+}
+
+/// acac and acac-micro-gae: GAE, PopArt's targets, log pi_old.
+fn check_ppo(j: &Value, trace: &UpdateTrace, joint: &[usize]) {
+    let gae = &j["gae"];
+    assert_all_close(
+        "advantage",
+        &f64s(&trace.advantages),
+        &valid_rows(&gae["advantage"], joint),
+        VALUE_TOL,
+    );
+    assert_all_close(
+        "returns_raw",
+        &f64s(&trace.returns),
+        &valid_rows(&gae["returns_raw"], joint),
+        VALUE_TOL,
+    );
+    assert_all_close(
+        "returns (PopArt-normalized)",
+        &f64s(&trace.targets),
+        &valid_rows(&gae["returns"], joint),
+        VALUE_TOL,
+    );
+    for i in 0..trace.old_log_pi.len() {
+        let lens = agent_lens(j, i);
+        assert_all_close(
+            &format!("old_log_pi[{i}]"),
+            &f64s(&trace.old_log_pi[i]),
+            &valid_rows(&j["old_log_pi"][i], &lens),
+            VALUE_TOL,
+        );
+    }
+}
+
+/// acac-vanilla: n-step returns, advantages from the updated critic, the actors' entropies.
+fn check_vanilla(j: &Value, trace: &UpdateTrace, joint: &[usize]) {
+    let mb = &j["epochs"][0]["minibatches"][0];
+    let returns = valid_rows(&j["returns"]["returns"], joint);
+    assert_all_close("n-step returns", &f64s(&trace.returns), &returns, VALUE_TOL);
+    let after = valid_rows(&mb["values_for_advantage"], joint);
+    let adv: Vec<f64> = returns.iter().zip(&after).map(|(g, v)| g - v).collect();
+    assert_all_close(
+        "advantages G - V",
+        &f64s(&trace.advantages),
+        &adv,
+        VALUE_TOL,
+    );
+    for a in &trace.actors[0] {
+        let lens = agent_lens(j, a.agent);
+        assert_all_close(
+            &format!("agent {}: entropies", a.agent),
+            &f64s(&a.entropies),
+            &valid_rows(&mb["actors"][a.agent]["pi_entropy"], &lens),
+            VALUE_TOL,
+        );
+    }
+    assert!(trace.old_log_pi.iter().all(Vec::is_empty));
+}
+
 #[test]
 fn acac_on_box_pushing_6x6_matches_acacs_learner() {
     replay("acac_bp6", GaeLambda::PerMacroStep);
@@ -428,4 +492,15 @@ fn the_goldens_tell_macro_step_lambda_from_lambda_per_primitive_step() {
     // acac's case replayed with acac-micro-gae's lambda^duration: the advantages must differ
     // (guards against goldens too loose or too uniform to separate the two methods).
     replay("acac_bp6", GaeLambda::PerPrimitiveStep);
+}
+
+#[test]
+fn acac_vanilla_on_box_pushing_6x6_matches_acacs_learner() {
+    // The GAE variant is not read: acac-vanilla takes n-step returns.
+    replay("acac_vanilla_bp6", GaeLambda::PerMacroStep);
+}
+
+#[test]
+fn acac_vanilla_on_overcooked_a_matches_acacs_learner() {
+    replay("acac_vanilla_ovcA7", GaeLambda::PerMacroStep);
 }

@@ -89,6 +89,9 @@ pub struct AgentSteps {
     pub time: Vec<usize>,
     /// The joint macro-step k at which each started.
     pub joint_step: Vec<usize>,
+    /// The primitive step at which each ended (`acac-vanilla` weighs its policy gradient by
+    /// gamma to it).
+    pub end_step: Vec<usize>,
 }
 
 /// A training batch: its episodes, squeezed.
@@ -180,6 +183,7 @@ impl SqueezedEpisode {
                 actions: a_ends.iter().map(|&t| e.action(t, i)).collect(),
                 time: a_starts.iter().map(|&s| s + 1).collect(),
                 joint_step,
+                end_step: a_ends,
             });
             agent_starts.push(a_starts);
         }

@@ -54,7 +54,8 @@ pub struct AcacConfig {
     pub a_lr: f64,
     /// The critic's Adam learning rate.
     pub c_lr: f64,
-    /// *No effect* (the critic trains once per PPO epoch).
+    /// Critic steps per update in `acac-vanilla`; *no effect* in `acac` and `acac-micro-gae`
+    /// (the critic trains once per PPO epoch).
     pub c_train_iteration: usize,
     /// Exploration rate at episode 0 (`Linear_Decay` over episodes).
     pub eps_start: f64,
@@ -92,10 +93,11 @@ pub struct AcacConfig {
     pub c_target_soft_update: bool,
     /// The soft update's rate (*no effect* without `c_target_soft_update`).
     pub tau: f64,
-    /// *No effect* (a baseline's n-step TD).
+    /// `acac-vanilla`'s n-step returns (0 or 1: one-step TD); *no effect* in the PPO methods.
     #[serde(rename = "n_step_TD")]
     pub n_step_td: usize,
-    /// *No effect* (a baseline's TD(lambda)).
+    /// *No effect* in the PPO methods; must be 0 for `acac-vanilla` (ACAC's TD(lambda) path
+    /// calls its n-step helper with a missing argument and fails).
     #[serde(rename = "TD_lambda")]
     pub td_lambda: f64,
     /// GAE's lambda.
@@ -127,7 +129,7 @@ pub struct AcacConfig {
     pub sample_epi: bool,
     /// *No effect* (whole episodes are trained on).
     pub trace_len: usize,
-    /// PPO epochs over each batch.
+    /// PPO epochs over each batch; *no effect* in `acac-vanilla` (ACAC passes 1 to its learner).
     pub n_train_repeat: usize,
     /// PPO's ratio clip.
     pub clip_ratio: f64,
@@ -417,6 +419,29 @@ pub fn check(
                 ),
             ));
         }
+    }
+    if method == AcacMethod::AcacVanilla {
+        // learner_acac_vanilla.py builds its critics without `use_popart` (a plain Linear
+        // value layer) and never reads TD_lambda's broken path: refuse what it would ignore
+        // or crash on.
+        if c.use_popart {
+            return Err((
+                "use_popart",
+                "must be false for acac-vanilla: ACAC's vanilla learner has no PopArt".into(),
+            ));
+        }
+        if c.td_lambda != 0.0 {
+            return Err((
+                "TD_lambda",
+                format!(
+                    "must be 0 for acac-vanilla (ACAC's TD(lambda) returns fail with a \
+                     TypeError), got {}",
+                    c.td_lambda
+                ),
+            ));
+        }
+        check_positive(&[("c_train_iteration", c.c_train_iteration)])?;
+        check_at_most(&[("c_train_iteration", c.c_train_iteration, MAX_TRAIN_REPEAT)])?;
     }
     // ACAC's learner feeds the actors' time embedding only when the critic's is on
     // (`if not self.controller.time_emb: obs_seq_agent = None`): unequal flags crash its

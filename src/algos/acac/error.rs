@@ -3,15 +3,6 @@
 /// Why an ACAC run cannot proceed.
 #[derive(Debug, thiserror::Error)]
 pub enum AcacError {
-    /// The method's learner is not in macdec yet (README "ACAC": what exists and what does not).
-    #[error(
-        "{method}: this ACAC method's learner is not implemented in macdec yet (`acac` and \
-         `acac-micro-gae` are; README \"ACAC\")"
-    )]
-    LearnerMissing {
-        /// The method asked for (its command-line name).
-        method: &'static str,
-    },
     /// An update could not run on the batch collected (named by the reference's check).
     #[error("{method} seed {seed}, after {episodes} episodes: {reason}")]
     Update {

@@ -6,9 +6,7 @@
 //! `env_terminate_step x total_epi` primitive steps of completed training episodes, counted at
 //! evaluations as ACAC counts them (`total_timesteps` grows in `log_diagnostics`).
 //!
-//! `acac` and `acac-micro-gae` are implemented; `acac-vanilla` (n-step returns, a vanilla
-//! policy gradient with entropy, no PPO) is not yet and is refused with
-//! [`AcacError::LearnerMissing`].
+//! The three methods differ only in the update's [`Objective`] ([`AcacLearner::update_params`]).
 
 use std::collections::VecDeque;
 
@@ -20,7 +18,9 @@ use super::config::AcacConfig;
 use super::error::AcacError;
 use super::method::AcacMethod;
 use super::nets::{AcacActor, AcacActorState, AcacCritic};
-use super::update::{update, AcacNets, DropoutSource, GaeLambda, UpdateParams, UpdateTrace};
+use super::update::{
+    update, AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
+};
 use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
@@ -62,6 +62,8 @@ pub struct AcacLearner {
     /// The critic's dropout masks.
     dropout_rng: ChaCha8Rng,
     eps: f64,
+    /// The entropy weight of the batch (`etrpy_w`, read by `acac-vanilla`).
+    entropy_weight: f64,
     /// The last `train_freq` completed training episodes (`Memory_epi`).
     memory: VecDeque<Episode>,
     /// ACAC's `total_timesteps`: steps of completed training episodes, counted at evaluations.
@@ -84,15 +86,21 @@ impl AcacLearner {
         &self.config
     }
 
-    /// The update's settings with exploration weight `eps`.
-    pub fn update_params(&self, eps: f64) -> UpdateParams {
+    /// The update's settings with exploration weight `eps` and entropy weight
+    /// `entropy_weight`: where the three methods differ.
+    pub fn update_params(&self, eps: f64, entropy_weight: f64) -> UpdateParams {
         let c = self.c();
         UpdateParams {
             gamma: c.gamma,
             lambda: c.gae_lambda,
-            gae_lambda: match self.method {
-                AcacMethod::AcacMicroGae => GaeLambda::PerPrimitiveStep,
-                AcacMethod::Acac | AcacMethod::AcacVanilla => GaeLambda::PerMacroStep,
+            objective: match self.method {
+                AcacMethod::Acac => Objective::Ppo(GaeLambda::PerMacroStep),
+                AcacMethod::AcacMicroGae => Objective::Ppo(GaeLambda::PerPrimitiveStep),
+                AcacMethod::AcacVanilla => Objective::Vanilla {
+                    n_step: c.n_step_td,
+                    critic_iterations: c.c_train_iteration,
+                    entropy_weight,
+                },
             },
             clip_ratio: c.clip_ratio,
             n_train_repeat: c.n_train_repeat,
@@ -174,7 +182,7 @@ impl AcacLearner {
     pub fn update_traced(&mut self, episodes: u64) -> Result<UpdateTrace, TrainError> {
         let batch = AcacBatch::from_episodes(self.memory.iter(), &self.obs_sizes)
             .map_err(|e| self.family_error(e, episodes))?;
-        let p = self.update_params(self.eps);
+        let p = self.update_params(self.eps, self.entropy_weight);
         update(
             &mut self.nets,
             &batch,
@@ -197,11 +205,6 @@ impl Learner for AcacLearner {
         env: &E,
         mut rngs: LearnerRngs,
     ) -> Result<Self, TrainError> {
-        if method == AcacMethod::AcacVanilla {
-            return Err(TrainError::Family(Box::new(AcacError::LearnerMissing {
-                method: method.name(),
-            })));
-        }
         let c = config;
         let horizon = env.horizon();
         let time = if c.time_emb {
@@ -251,6 +254,7 @@ impl Learner for AcacLearner {
             explore_rng: rngs.explore,
             dropout_rng: rngs.replay,
             eps: config.eps_start,
+            entropy_weight: config.etrpy_w_start,
             memory: VecDeque::new(),
             timesteps: 0,
             pending_steps: 0,
@@ -309,6 +313,7 @@ impl Learner for AcacLearner {
 
     fn begin_batch(&mut self, episodes: u64) {
         self.eps = self.c().epsilon_at(episodes);
+        self.entropy_weight = self.c().entropy_weight_at(episodes);
     }
 
     fn act<E: MacroEnv>(&mut self, lane: &mut AcacLane, env: &E, actions: &mut [usize]) {
@@ -522,7 +527,7 @@ mod tests {
 
     #[test]
     fn the_same_seed_and_a_checkpoint_halfway_give_the_same_numbers() {
-        for method in [AcacMethod::Acac, AcacMethod::AcacMicroGae] {
+        for &method in <AcacMethod as crate::algos::family::FamilyMethod>::ALL {
             let mut a = short_run(method, 3);
             finish(&mut a);
             assert!(a.updates() > 2, "{method:?}: {} updates", a.updates());
@@ -583,20 +588,5 @@ mod tests {
             let u = e.eval_return_undiscounted.unwrap();
             assert!(u.is_finite() && e.eval_return.is_finite());
         }
-    }
-
-    #[test]
-    fn acac_vanilla_is_refused_with_a_message_naming_it() {
-        let spec = crate::envs::bp_ma_v0::spec(6, 30);
-        let c = AcacMethod::AcacVanilla.defaults(&spec);
-        let err = TrainingLoop::<AcacLearner, AnyEnv>::new(
-            &c,
-            AcacMethod::AcacVanilla,
-            0,
-            run_rngs(0),
-            || spec.build(),
-        )
-        .unwrap_err();
-        assert!(err.to_string().contains("acac-vanilla"), "{err}");
     }
 }

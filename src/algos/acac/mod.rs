@@ -8,8 +8,9 @@
 //! ([`config`]). The nets are in `crate::nn` (`gpt2*`, `layer_norm`, `popart`,
 //! `time_embedding`, `value_head`, `acac_joint_value`).
 //!
-//! State (README "ACAC"): `acac` and `acac-micro-gae` train ([`learner`], [`update`]);
-//! `acac-vanilla` is refused until its learner is written.
+//! The learner ([`learner`]) drives one update per batch: [`update`] for `acac` and
+//! `acac-micro-gae` (PPO), [`vanilla`] for `acac-vanilla`; each is replayed against ACAC's own
+//! `train()` by `tests/golden_acac.rs`.
 
 pub mod batch;
 pub mod config;
@@ -19,4 +20,6 @@ pub mod gae;
 pub mod learner;
 pub mod method;
 pub mod nets;
+pub mod nstep;
 pub mod update;
+pub mod vanilla;

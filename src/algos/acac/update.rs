@@ -14,6 +14,8 @@
 //! Each PPO epoch uses the whole batch (ACAC stores `n_minibatch` and never reads it); no
 //! entropy term enters `acac`'s loss (it is computed for the logs only).
 
+use std::borrow::Cow;
+
 use ndarray::{Array1, Array2};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -26,6 +28,25 @@ use crate::nn::{Adam, AdamConfig, Gpt2Dropout, Params, TimeEmbedding};
 
 /// HuggingFace GPT-2's default dropout rate, live in ACAC's critic.
 pub const GPT2_DROPOUT: f32 = 0.1;
+
+/// What an update fits and how: the one place the three methods differ.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Objective {
+    /// `acac`, `acac-micro-gae`: macro-level GAE from the target critic with `lambda` applied
+    /// as given, PopArt-normalized targets, `n_train_repeat` PPO epochs.
+    Ppo(GaeLambda),
+    /// `acac-vanilla` (`learner_acac_vanilla.py`, [`super::vanilla`]): n-step returns from the
+    /// target critic, `critic_iterations` critic steps, then advantages G - V from the updated
+    /// critic and one policy-gradient step per actor weighted by gamma^t, with an entropy bonus.
+    Vanilla {
+        /// `n_step_TD` (0 or 1: one-step TD).
+        n_step: usize,
+        /// `c_train_iteration`.
+        critic_iterations: usize,
+        /// `etrpy_w` of this update.
+        entropy_weight: f64,
+    },
+}
 
 /// How GAE's lambda enters each joint macro-step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -43,8 +64,8 @@ pub struct UpdateParams {
     pub gamma: f64,
     /// GAE's lambda.
     pub lambda: f64,
-    /// How lambda applies.
-    pub gae_lambda: GaeLambda,
+    /// The method's objective.
+    pub objective: Objective,
     /// PPO's clip.
     pub clip_ratio: f64,
     /// PPO epochs.
@@ -137,7 +158,7 @@ pub enum DropoutSource<'a> {
 }
 
 impl DropoutSource<'_> {
-    fn next(
+    pub(super) fn next(
         &mut self,
         rows: usize,
         critic: &AcacCritic,
@@ -201,20 +222,24 @@ pub struct ActorTrace {
     pub agent: usize,
     /// Its loss.
     pub loss: f32,
-    /// r = pi / pi_old per macro-action.
+    /// r = pi / pi_old per macro-action (PPO; empty for `acac-vanilla`).
     pub ratios: Vec<f32>,
+    /// The entropy of the eps-mixture per macro-action (`acac-vanilla`, whose loss weighs it;
+    /// empty for PPO, whose loss does not).
+    pub entropies: Vec<f32>,
 }
 
 /// Everything an update computed, for tests, goldens and metrics.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UpdateTrace {
-    /// A_k of every joint macro-step, episode by episode.
+    /// A_k of every joint macro-step, episode by episode (`acac-vanilla`: G_k - V_k with the
+    /// critic after its step).
     pub advantages: Vec<f32>,
-    /// G_k before PopArt.
+    /// G_k before PopArt (`acac-vanilla`: its n-step returns).
     pub returns: Vec<f32>,
     /// The critic's regression targets (G_k normalized with PopArt, else G_k).
     pub targets: Vec<f32>,
-    /// log pi_old of each agent's macro-actions.
+    /// log pi_old of each agent's macro-actions (empty for `acac-vanilla`).
     pub old_log_pi: Vec<Vec<f32>>,
     /// The critic loss of each epoch.
     pub critic_losses: Vec<f32>,
@@ -222,12 +247,16 @@ pub struct UpdateTrace {
     pub actors: Vec<Vec<ActorTrace>>,
 }
 
+/// One episode's critic rows: per agent its observations, each row's time index, and per row
+/// which agents' encoders step.
+pub(super) type CriticRows<'e> = (&'e [Array2<f32>], Cow<'e, [usize]>, &'e [Vec<bool>]);
+
 /// The critic's input rows for `episodes`: per episode its rows, per agent its observations,
 /// its times and which rows step agent i.
-fn critic_input<'e>(
+pub(super) fn critic_input<'e>(
     nets: &AcacNets,
     episodes: &'e [SqueezedEpisode],
-    rows_of: impl Fn(&'e SqueezedEpisode) -> (&'e [Array2<f32>], &'e [usize], &'e [Vec<bool>]),
+    rows_of: impl Fn(usize, &'e SqueezedEpisode) -> CriticRows<'e>,
     duplicate: bool,
 ) -> CriticInput {
     let n = nets.actors.len();
@@ -239,8 +268,8 @@ fn critic_input<'e>(
     };
     let mut parts: Vec<Vec<Array2<f32>>> = vec![Vec::new(); n];
     let mut taken = vec![0usize; n];
-    for e in episodes {
-        let (obs, time, steps) = rows_of(e);
+    for (k, e) in episodes.iter().enumerate() {
+        let (obs, time, steps) = rows_of(k, e);
         input.rows_per_episode.push(steps.len());
         for i in 0..n {
             let rows: Vec<usize> = (0..steps.len())
@@ -282,7 +311,7 @@ fn critic_input<'e>(
 
 /// log pi of the taken macro-actions under the eps-mixture, on `tape`:
 /// logsumexp(log pi + ln(1 - eps), ln(eps) - ln |A|) as ACAC's actor forward computes it.
-fn mixture_log_prob(
+pub(super) fn mixture_log_prob(
     tape: &mut Tape,
     log_pi: crate::autograd::Var,
     actions: &[usize],
@@ -301,21 +330,24 @@ fn mixture_log_prob(
 }
 
 /// One actor's inputs over the batch: rows, per-episode lengths, actions and joint steps.
-struct ActorInput {
-    x: Array2<f32>,
-    lengths: Vec<usize>,
-    actions: Vec<usize>,
+pub(super) struct ActorInput {
+    pub(super) x: Array2<f32>,
+    pub(super) lengths: Vec<usize>,
+    pub(super) actions: Vec<usize>,
     /// Index into the batch's joint macro-steps (all episodes).
-    joint: Vec<usize>,
+    pub(super) joint: Vec<usize>,
+    /// The primitive step at which each macro-action ended.
+    pub(super) end_steps: Vec<usize>,
 }
 
-fn actor_input(nets: &AcacNets, batch: &AcacBatch, agent: usize) -> ActorInput {
+pub(super) fn actor_input(nets: &AcacNets, batch: &AcacBatch, agent: usize) -> ActorInput {
     let mut parts = Vec::new();
     let mut input = ActorInput {
         x: Array2::zeros((0, 0)),
         lengths: Vec::new(),
         actions: Vec::new(),
         joint: Vec::new(),
+        end_steps: Vec::new(),
     };
     let mut offset = 0;
     for e in &batch.episodes {
@@ -323,6 +355,7 @@ fn actor_input(nets: &AcacNets, batch: &AcacBatch, agent: usize) -> ActorInput {
         parts.push(nets.with_time(&a.obs, &a.time));
         input.lengths.push(a.actions.len());
         input.actions.extend(&a.actions);
+        input.end_steps.extend(&a.end_step);
         input.joint.extend(a.joint_step.iter().map(|k| offset + k));
         offset += e.joint_steps;
     }
@@ -333,7 +366,7 @@ fn actor_input(nets: &AcacNets, batch: &AcacBatch, agent: usize) -> ActorInput {
 
 /// Element-wise then norm clipping of a gradient set, as `clip_grad_value_` and
 /// `clip_grad_norm_` (max_norm / (norm + 1e-6) when the norm exceeds it).
-fn clip<P: Params>(grads: &mut P, value: f64, norm: f64) {
+pub(super) fn clip<P: Params>(grads: &mut P, value: f64, norm: f64) {
     if value > 0.0 {
         let v = value as f32;
         for s in grads.slices_mut() {
@@ -367,12 +400,19 @@ fn advantages(
     nets: &mut AcacNets,
     batch: &AcacBatch,
     p: &UpdateParams,
+    gae_lambda: GaeLambda,
     dropout: &mut DropoutSource<'_>,
 ) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>), UpdateError> {
     let input = critic_input(
         nets,
         &batch.episodes,
-        |e| (&e.bootstrap_obs, &e.bootstrap_time, &e.bootstrap_steps),
+        |_, e| {
+            (
+                &e.bootstrap_obs,
+                Cow::Borrowed(&e.bootstrap_time),
+                &e.bootstrap_steps,
+            )
+        },
         p.duplicate,
     );
     let rows: usize = input.rows_per_episode.iter().sum();
@@ -389,12 +429,8 @@ fn advantages(
     for (k, e) in batch.episodes.iter().enumerate() {
         let v = &values.as_slice().expect("contiguous")[at..at + e.joint_steps + 1];
         at += e.joint_steps + 1;
-        let discounts: Vec<f32> = e
-            .end_steps
-            .iter()
-            .map(|&t| (p.gamma as f32).powf(t as f32))
-            .collect();
-        let lambdas: Vec<f32> = match p.gae_lambda {
+        let discounts = end_discounts(&e.end_steps, p.gamma);
+        let lambdas: Vec<f32> = match gae_lambda {
             GaeLambda::PerMacroStep => vec![p.lambda as f32; e.joint_steps],
             GaeLambda::PerPrimitiveStep => {
                 let pows: Vec<f32> = e
@@ -432,6 +468,14 @@ fn advantages(
         None => ret.clone(),
     };
     Ok((adv, ret, targets))
+}
+
+/// gamma^t of each primitive step t, in f32 as `torch.pow` computes ACAC's `discount`.
+pub(super) fn end_discounts(steps: &[usize], gamma: f64) -> Vec<f32> {
+    steps
+        .iter()
+        .map(|&t| (gamma as f32).powf(t as f32))
+        .collect()
 }
 
 /// The critic's loss sum((G - V)^2) / R on `input` against `targets` [R, 1], and its gradient.
@@ -533,7 +577,22 @@ pub fn update(
             nets: n,
         });
     }
-    let (adv, returns, targets) = advantages(nets, batch, p, &mut dropout)?;
+    let gae_lambda = match p.objective {
+        Objective::Ppo(gae_lambda) => gae_lambda,
+        Objective::Vanilla {
+            n_step,
+            critic_iterations,
+            entropy_weight,
+        } => {
+            let v = super::vanilla::VanillaParams {
+                n_step,
+                critic_iterations,
+                entropy_weight,
+            };
+            return super::vanilla::update(nets, batch, p, &v, dropout);
+        }
+    };
+    let (adv, returns, targets) = advantages(nets, batch, p, gae_lambda, &mut dropout)?;
     let inputs: Vec<ActorInput> = (0..n).map(|i| actor_input(nets, batch, i)).collect();
     // log pi_old under the batch's eps-mixture.
     let mut old_log_pi = Vec::with_capacity(n);
@@ -552,7 +611,13 @@ pub fn update(
     let critic_in = critic_input(
         nets,
         &batch.episodes,
-        |e| (&e.critic_obs, &e.critic_time, &e.critic_starts),
+        |_, e| {
+            (
+                &e.critic_obs,
+                Cow::Borrowed(&e.critic_time),
+                &e.critic_starts,
+            )
+        },
         p.duplicate,
     );
     let rows = targets.len();
@@ -585,6 +650,7 @@ pub fn update(
                 agent: i,
                 loss: step.loss,
                 ratios: step.ratios,
+                entropies: Vec::new(),
             });
         }
         trace.actors.push(steps);
@@ -593,7 +659,7 @@ pub fn update(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
     use crate::envs::MacroEnv;
@@ -602,7 +668,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     /// `n` Box Pushing 6x6 episodes of horizon 20 under uniformly random macro-actions.
-    fn episodes(n: usize) -> (Vec<Episode>, Vec<usize>, Vec<usize>) {
+    pub(crate) fn episodes(n: usize) -> (Vec<Episode>, Vec<usize>, Vec<usize>) {
         let spec = crate::envs::bp_ma_v0::spec(6, 20);
         let mut env = spec.build().unwrap();
         let mut env_rng = run_rngs(0).env;
@@ -630,7 +696,7 @@ mod tests {
         (out, env.obs_sizes().to_vec(), env.n_actions().to_vec())
     }
 
-    fn small_nets(obs: &[usize], actions: &[usize], popart: bool) -> AcacNets {
+    pub(crate) fn small_nets(obs: &[usize], actions: &[usize], popart: bool) -> AcacNets {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let time = TimeEmbedding::sinusoidal(20, 2).unwrap();
         let actors = obs
@@ -647,7 +713,7 @@ mod tests {
         UpdateParams {
             gamma: 0.95,
             lambda: 0.9,
-            gae_lambda: GaeLambda::PerMacroStep,
+            objective: Objective::Ppo(GaeLambda::PerMacroStep),
             clip_ratio: 0.2,
             n_train_repeat: 2,
             eps,
@@ -658,7 +724,7 @@ mod tests {
     }
 
     /// Central differences of `loss` over every `stride`-th element of `net`, against `grads`.
-    fn check_fd<P: Params + Clone>(
+    pub(crate) fn check_fd<P: Params + Clone>(
         net: &P,
         grads: &P,
         stride: usize,
@@ -702,7 +768,13 @@ mod tests {
         let input = critic_input(
             &nets,
             &batch.episodes,
-            |e| (&e.critic_obs, &e.critic_time, &e.critic_starts),
+            |_, e| {
+                (
+                    &e.critic_obs,
+                    Cow::Borrowed(&e.critic_time[..]),
+                    &e.critic_starts,
+                )
+            },
             false,
         );
         let rows: usize = input.rows_per_episode.iter().sum();
