@@ -144,7 +144,7 @@ impl SqueezedEpisode {
         // Each agent's starts and ends.
         let mut agents = Vec::with_capacity(n);
         let mut agent_starts = Vec::with_capacity(n);
-        for i in 0..n {
+        for (i, &obs_size) in obs_sizes.iter().enumerate().take(n) {
             let a_ends: Vec<usize> = (0..e.steps).filter(|&t| e.valid(t, i)).collect();
             let all: Vec<usize> = (0..e.steps).filter(|&t| e.mac_start(t, i)).collect();
             let a_starts = filtered_starts(&all, a_ends.len()).to_vec();
@@ -175,7 +175,7 @@ impl SqueezedEpisode {
                     ends: a_ends.len(),
                 });
             }
-            let obs = Array2::from_shape_fn((a_ends.len(), obs_sizes[i]), |(m, c)| {
+            let obs = Array2::from_shape_fn((a_ends.len(), obs_size), |(m, c)| {
                 agent_obs(e, a_ends[m], &offsets, i)[c]
             });
             agents.push(AgentSteps {

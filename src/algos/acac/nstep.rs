@@ -107,7 +107,7 @@ mod tests {
         let r = [1.0, -2.0, 0.5, 4.0, -1.0, 3.0];
         let b = [5.0, 6.0, 7.0, 8.0, 9.0, 10.0];
         let g = episode_n_step_returns(&r, &b, &disc, false, GAMMA, 3);
-        let dur = |k: usize| if k == 0 { 1 } else { ends[k] - ends[k - 1] } as i32;
+        let dur = |k: usize| if k == 0 { 1 } else { ends[k] - ends[k - 1] };
         let mut want = [0f32; 6];
         want[5] = r[5] + pow(dur(5)) * b[5];
         // end - n = 2: k = 4, 3 recurse with their own duration.
@@ -115,8 +115,8 @@ mod tests {
         want[3] = r[3] + pow(dur(3)) * want[4];
         // k = 2, 1, 0: three terms from step k's start (D_(k-1), D_(-1) = 1 / gamma).
         for k in [2usize, 1, 0] {
-            let start = if k == 0 { -1 } else { ends[k - 1] as i32 };
-            let w = |j: usize| pow(ends[j] as i32 - start);
+            let start = if k == 0 { -1 } else { ends[k - 1] };
+            let w = |j: usize| pow(ends[j] - start);
             want[k] = r[k] + w(k) * r[k + 1] + w(k + 1) * r[k + 2] + w(k + 2) * b[k + 2];
         }
         for (k, (a, w)) in g.iter().zip(want).enumerate() {

@@ -394,6 +394,16 @@ pub(super) fn clip<P: Params>(grads: &mut P, value: f64, norm: f64) {
     }
 }
 
+/// Step 1's results: per joint macro-step, episode by episode.
+struct Targets {
+    /// A_k.
+    advantages: Vec<f32>,
+    /// G_k before PopArt.
+    returns: Vec<f32>,
+    /// G_k normalized with PopArt (the critic's regression targets), else G_k.
+    targets: Vec<f32>,
+}
+
 /// The advantages and critic targets of `batch` (step 1 of the module docs). Updates the online
 /// critic's PopArt statistics.
 fn advantages(
@@ -402,7 +412,7 @@ fn advantages(
     p: &UpdateParams,
     gae_lambda: GaeLambda,
     dropout: &mut DropoutSource<'_>,
-) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>), UpdateError> {
+) -> Result<Targets, UpdateError> {
     let input = critic_input(
         nets,
         &batch.episodes,
@@ -467,7 +477,11 @@ fn advantages(
         }
         None => ret.clone(),
     };
-    Ok((adv, ret, targets))
+    Ok(Targets {
+        advantages: adv,
+        returns: ret,
+        targets,
+    })
 }
 
 /// gamma^t of each primitive step t, in f32 as `torch.pow` computes ACAC's `discount`.
@@ -592,7 +606,11 @@ pub fn update(
             return super::vanilla::update(nets, batch, p, &v, dropout);
         }
     };
-    let (adv, returns, targets) = advantages(nets, batch, p, gae_lambda, &mut dropout)?;
+    let Targets {
+        advantages: adv,
+        returns,
+        targets,
+    } = advantages(nets, batch, p, gae_lambda, &mut dropout)?;
     let inputs: Vec<ActorInput> = (0..n).map(|i| actor_input(nets, batch, i)).collect();
     // log pi_old under the batch's eps-mixture.
     let mut old_log_pi = Vec::with_capacity(n);
