@@ -12,8 +12,9 @@ use std::path::{Path, PathBuf};
 
 use macdec::algos::acac::batch::{AcacBatch, SqueezedEpisode};
 use macdec::algos::acac::nets::{AcacActor, AcacCritic, TIME_TABLE};
+use macdec::algos::acac::train_step::update;
 use macdec::algos::acac::update::{
-    update, AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
+    AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
 };
 use macdec::algos::actor_critic::episode::Episode;
 use macdec::nn::{BlockDropout, Gpt2Dropout, StateDict, TimeEmbedding, ValueHead};

@@ -22,4 +22,5 @@ pub mod learner;
 pub mod mac_value;
 pub mod train_error;
 pub mod training_loop;
+pub mod update_means;
 pub mod value;

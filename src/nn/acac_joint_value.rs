@@ -49,9 +49,7 @@ impl ValueLayer {
         if sd.has(&format!("{prefix}stddev")) {
             return Ok(ValueLayer::PopArt(PopArt::from_state_dict(sd, prefix)?));
         }
-        Ok(ValueLayer::Linear(LinearParams::from_state_dict(
-            sd, prefix,
-        )?))
+        Ok(ValueLayer::Linear(sd.linear(prefix)?))
     }
 
     /// Every tensor under `prefix`, in `state_dict` order.

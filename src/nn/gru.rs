@@ -13,8 +13,6 @@ use ndarray::ArrayViewD;
 use serde::{Deserialize, Serialize};
 
 use super::params::{flat, GruParams};
-use super::state_dict::StateDict;
-use super::WeightsError;
 use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::kernels::gru::forward_cells;
 use crate::autograd::{GruVars, SeqPacking, Tape, Var};
@@ -34,20 +32,6 @@ impl GruParams {
             (n[2], self.bias_ih.view().into_dyn()),
             (n[3], self.bias_hh.view().into_dyn()),
         ]
-    }
-
-    /// `nn.GRU` under `prefix` in a state_dict (e.g. `encoder.gru.`), its sizes read from
-    /// `weight_ih_l0` [3H, in].
-    pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
-        let n = GRU_TENSOR_NAMES.map(|t| format!("{prefix}{t}"));
-        let (gates, input) = sd.shape2(&n[0])?;
-        let hidden = gates / 3;
-        Ok(GruParams {
-            weight_ih: sd.array2(&n[0], 3 * hidden, input)?,
-            weight_hh: sd.array2(&n[1], 3 * hidden, hidden)?,
-            bias_ih: sd.array1(&n[2], 3 * hidden)?,
-            bias_hh: sd.array1(&n[3], 3 * hidden)?,
-        })
     }
 
     /// Put the parameters on a tape as trainable leaves (biases as [1, 3H] rows).

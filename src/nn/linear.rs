@@ -6,8 +6,6 @@ use rand_chacha::ChaCha8Rng;
 
 use super::init::xavier_uniform;
 use super::params::{copy_grad, flat, flat_mut, LinearParams};
-use super::state_dict::StateDict;
-use super::WeightsError;
 use crate::autograd::kernels::dense::matvec_act;
 use crate::autograd::{Activation, Tape, Var};
 
@@ -17,17 +15,6 @@ impl LinearParams {
         let mut p = LinearParams::zeros(input, output);
         p.weight = xavier_uniform(output, input, gain, rng);
         p
-    }
-
-    /// `nn.Linear` under `prefix` in a state_dict (`weight` [out, in], `bias` [out]), its
-    /// sizes read from the file.
-    pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
-        let name = format!("{prefix}weight");
-        let (out, input) = sd.shape2(&name)?;
-        Ok(LinearParams {
-            weight: sd.array2(&name, out, input)?,
-            bias: sd.array1(&format!("{prefix}bias"), out)?,
-        })
     }
 
     /// The tensors under `prefix`: `weight`, `bias`.

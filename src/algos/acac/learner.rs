@@ -18,14 +18,14 @@ use super::config::AcacConfig;
 use super::error::AcacError;
 use super::method::AcacMethod;
 use super::nets::{AcacActor, AcacActorState, AcacCritic};
-use super::update::{
-    update, AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
-};
+use super::train_step::update;
+use super::update::{AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace};
 use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
 use crate::algos::train_error::TrainError;
+use crate::algos::update_means::UpdateMeans;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::sampling::{mixture, sample_weighted};
 use crate::nn::TimeEmbedding;
@@ -70,11 +70,8 @@ pub struct AcacLearner {
     timesteps: u64,
     /// Steps of training episodes completed since the last evaluation.
     pending_steps: u64,
-    critic_loss_sum: f64,
-    actor_loss_sum: f64,
-    loss_count: u64,
-    return_sum: f64,
-    return_count: u64,
+    /// Losses and training returns since the last metrics row.
+    means: UpdateMeans,
     #[serde(skip, default)]
     scratch: Vec<f32>,
     #[serde(skip, default)]
@@ -258,11 +255,7 @@ impl Learner for AcacLearner {
             memory: VecDeque::new(),
             timesteps: 0,
             pending_steps: 0,
-            critic_loss_sum: 0.0,
-            actor_loss_sum: 0.0,
-            loss_count: 0,
-            return_sum: 0.0,
-            return_count: 0,
+            means: UpdateMeans::default(),
             scratch: Vec::new(),
             probs: Vec::new(),
         })
@@ -342,8 +335,8 @@ impl Learner for AcacLearner {
         if !outcome.done {
             return Ok(false);
         }
-        self.return_sum += lane.recorder.returns().undiscounted;
-        self.return_count += 1;
+        self.means
+            .record_return(lane.recorder.returns().undiscounted);
         self.pending_steps += lane.recorder.episode().steps as u64;
         self.memory.push_back(lane.recorder.episode().clone());
         while self.memory.len() > self.c().train_freq {
@@ -369,16 +362,11 @@ impl Learner for AcacLearner {
             .flatten()
             .map(|a| f64::from(a.loss))
             .collect();
-        if critic.iter().chain(&actor).any(|l| !l.is_finite()) {
+        if self.means.record_update(&critic, &actor).is_err() {
             return Err(self.non_finite("loss", episodes));
         }
         if !self.nets.is_finite() {
             return Err(self.non_finite("parameter", episodes));
-        }
-        if !critic.is_empty() && !actor.is_empty() {
-            self.critic_loss_sum += critic.iter().sum::<f64>() / critic.len() as f64;
-            self.actor_loss_sum += actor.iter().sum::<f64>() / actor.len() as f64;
-            self.loss_count += 1;
         }
         Ok(())
     }
@@ -461,20 +449,14 @@ impl Learner for AcacLearner {
     fn metric_values(&mut self) -> Vec<Option<f64>> {
         self.timesteps += self.pending_steps;
         self.pending_steps = 0;
-        let mean = |sum: f64, n: u64| (n > 0).then(|| sum / n as f64);
-        let row = vec![
+        let [critic, actor, ret] = self.means.take_row();
+        vec![
             Some(self.timesteps as f64),
             Some(self.eps),
-            mean(self.critic_loss_sum, self.loss_count),
-            mean(self.actor_loss_sum, self.loss_count),
-            mean(self.return_sum, self.return_count),
-        ];
-        self.critic_loss_sum = 0.0;
-        self.actor_loss_sum = 0.0;
-        self.loss_count = 0;
-        self.return_sum = 0.0;
-        self.return_count = 0;
-        row
+            critic,
+            actor,
+            ret,
+        ]
     }
 
     fn progress(&self) -> String {

@@ -8,8 +8,8 @@
 //! ([`config`]). The nets are in `crate::nn` (`gpt2*`, `layer_norm`, `popart`,
 //! `time_embedding`, `value_head`, `acac_joint_value`).
 //!
-//! The learner ([`learner`]) drives one update per batch: [`update`] for `acac` and
-//! `acac-micro-gae` (PPO), [`vanilla`] for `acac-vanilla`; each is replayed against ACAC's own
+//! The learner ([`learner`]) drives one update per batch ([`train_step`]): [`update`] for `acac`
+//! and `acac-micro-gae` (PPO), [`vanilla`] for `acac-vanilla`; each is replayed against ACAC's own
 //! `train()` by `tests/golden_acac.rs`.
 
 pub mod batch;
@@ -21,5 +21,6 @@ pub mod learner;
 pub mod method;
 pub mod nets;
 pub mod nstep;
+pub mod train_step;
 pub mod update;
 pub mod vanilla;

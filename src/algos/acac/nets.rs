@@ -75,9 +75,9 @@ impl AcacEncoder {
     /// of the critic), sizes from the file.
     pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
         Ok(AcacEncoder {
-            fc1: LinearParams::from_state_dict(sd, &format!("{prefix}fc1."))?,
-            fc2: LinearParams::from_state_dict(sd, &format!("{prefix}fc2."))?,
-            gru: GruParams::from_state_dict(sd, &format!("{prefix}gru."))?,
+            fc1: sd.linear(&format!("{prefix}fc1."))?,
+            fc2: sd.linear(&format!("{prefix}fc2."))?,
+            gru: sd.gru(&format!("{prefix}gru."))?,
         })
     }
 
@@ -212,7 +212,7 @@ impl AcacActor {
     /// `ln.*` when `use_actor_ln`, `fc4.*`; its `time_embedding.weight` is skipped, see
     /// [`TIME_TABLE`]). Any other tensor under the prefix is an error.
     pub fn from_state_dict(sd: &StateDict, prefix: &str) -> Result<Self, WeightsError> {
-        let fc3 = LinearParams::from_state_dict(sd, &format!("{prefix}fc3."))?;
+        let fc3 = sd.linear(&format!("{prefix}fc3."))?;
         let ln_prefix = format!("{prefix}ln.");
         let ln = if sd.has(&format!("{ln_prefix}weight")) {
             Some(LayerNormParams::from_state_dict(
@@ -228,7 +228,7 @@ impl AcacActor {
             encoder: AcacEncoder::from_state_dict(sd, &format!("{prefix}encoder."))?,
             fc3,
             ln,
-            fc4: LinearParams::from_state_dict(sd, &format!("{prefix}fc4."))?,
+            fc4: sd.linear(&format!("{prefix}fc4."))?,
         };
         let known: Vec<String> = actor.named(prefix).into_iter().map(|(n, _)| n).collect();
         sd.check_names_under(prefix, &known, &[TIME_TABLE], "ACAC actor")?;

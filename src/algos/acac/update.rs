@@ -1,4 +1,4 @@
-//! One ACAC update (`learner_acac.py: train`, `learner_acac_micro_gae.py: train`) as a pure
+//! One PPO update (`learner_acac.py: train`, `learner_acac_micro_gae.py: train`) as a pure
 //! function of the nets and their Adam states, a squeezed batch, the exploration weight and a
 //! source of dropout masks:
 //!
@@ -577,35 +577,16 @@ fn actor_loss(
     }
 }
 
-/// One update of `nets` on `batch` (see the module docs).
-pub fn update(
+/// One `acac` or `acac-micro-gae` update of `nets` on `batch` with GAE's lambda applied as
+/// `gae_lambda` (see the module docs; [`super::train_step::update`] picks the method's).
+pub(super) fn ppo_update(
     nets: &mut AcacNets,
     batch: &AcacBatch,
     p: &UpdateParams,
+    gae_lambda: GaeLambda,
     mut dropout: DropoutSource<'_>,
 ) -> Result<UpdateTrace, UpdateError> {
     let n = nets.actors.len();
-    if batch.n_agents() != n {
-        return Err(UpdateError::Agents {
-            batch: batch.n_agents(),
-            nets: n,
-        });
-    }
-    let gae_lambda = match p.objective {
-        Objective::Ppo(gae_lambda) => gae_lambda,
-        Objective::Vanilla {
-            n_step,
-            critic_iterations,
-            entropy_weight,
-        } => {
-            let v = super::vanilla::VanillaParams {
-                n_step,
-                critic_iterations,
-                entropy_weight,
-            };
-            return super::vanilla::update(nets, batch, p, &v, dropout);
-        }
-    };
     let Targets {
         advantages: adv,
         returns,
@@ -725,6 +706,16 @@ pub(crate) mod tests {
         let inputs: Vec<usize> = obs.iter().map(|&o| o + 2).collect();
         let critic = AcacCritic::new(&inputs, 6, 4, 2, ValueHead::MeanLinear, popart, &mut rng);
         AcacNets::new(actors, critic, Some(time), 3e-4, 3e-4)
+    }
+
+    /// `acac`'s update (these tests' params are PPO's).
+    fn update(
+        nets: &mut AcacNets,
+        batch: &AcacBatch,
+        p: &UpdateParams,
+        dropout: DropoutSource<'_>,
+    ) -> Result<UpdateTrace, UpdateError> {
+        ppo_update(nets, batch, p, GaeLambda::PerMacroStep, dropout)
     }
 
     fn params(eps: f64) -> UpdateParams {

@@ -52,8 +52,8 @@ fn bootstrap_times(end_steps: &[usize]) -> Vec<usize> {
     t
 }
 
-/// One update (see the module docs).
-pub fn update(
+/// One update (see the module docs); [`super::train_step::update`] checks the batch first.
+pub(super) fn update(
     nets: &mut AcacNets,
     batch: &AcacBatch,
     p: &UpdateParams,
@@ -299,19 +299,23 @@ mod tests {
             entropy_weight: 0.0,
         });
         let mut a = small_nets(&obs, &acts, false);
-        let trace =
-            crate::algos::acac::update::update(&mut a, &batch, &vanilla, DropoutSource::Off)
-                .unwrap();
+        let v = VanillaParams {
+            n_step: 5,
+            critic_iterations: 2,
+            entropy_weight: 0.0,
+        };
+        let trace = update(&mut a, &batch, &vanilla, &v, DropoutSource::Off).unwrap();
         // n_train_repeat is not read: two critic steps, one actor pass.
         assert_eq!(trace.critic_losses.len(), 2);
         assert_eq!(trace.actors.len(), 1);
         assert_eq!(trace.actors[0].len(), obs.len());
         assert!(trace.critic_losses[1] < trace.critic_losses[0]);
         let mut b = small_nets(&obs, &acts, false);
-        crate::algos::acac::update::update(
+        crate::algos::acac::update::ppo_update(
             &mut b,
             &batch,
             &params(Objective::Ppo(GaeLambda::PerMacroStep)),
+            GaeLambda::PerMacroStep,
             DropoutSource::Off,
         )
         .unwrap();
