@@ -17,6 +17,7 @@ use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
+use crate::algos::scratch::Scratch;
 use crate::algos::training_loop::TrainError;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -52,21 +53,12 @@ pub struct AcLearner {
     loss_count: u64,
     return_sum: f64,
     return_count: u64,
+    /// The updates' tape, reset after every pass.
     #[serde(skip, default)]
-    tape: TapeCell,
+    tape: Scratch<Tape>,
     /// The acting path's scratch.
     #[serde(skip, default)]
     buffers: ActBuffers,
-}
-
-/// The learner's tape: scratch, rebuilt empty after a resume.
-#[derive(Debug, Default)]
-struct TapeCell(Tape);
-
-impl Clone for TapeCell {
-    fn clone(&self) -> Self {
-        TapeCell::default()
-    }
 }
 
 impl AcLearner {
@@ -209,7 +201,7 @@ impl Learner for AcLearner {
             loss_count: 0,
             return_sum: 0.0,
             return_count: 0,
-            tape: TapeCell::default(),
+            tape: Scratch::default(),
             buffers: ActBuffers::default(),
         })
     }

@@ -202,6 +202,30 @@ impl Squeezed {
     }
 }
 
+/// Memory the TD steps reuse from one update to the next (the learner keeps it as
+/// [`crate::algos::scratch::Scratch`]): the autodiff tape, reset after every pass, one gradient
+/// buffer per net shape, and the next values. Every buffer is overwritten before it is read, so
+/// a fresh one gives the same numbers.
+#[derive(Debug, Default)]
+pub struct UpdateScratch {
+    tape: Tape,
+    grads: Vec<GruActor>,
+    online_next: Vec<f32>,
+    target_next: Vec<f32>,
+}
+
+/// The gradient buffer for nets of `cfg`'s shape (made on first use).
+fn grads_for(grads: &mut Vec<GruActor>, cfg: GruActorConfig) -> &mut GruActor {
+    let at = match grads.iter().position(|g| g.config() == cfg) {
+        Some(at) => at,
+        None => {
+            grads.push(GruActor::zeros(cfg));
+            grads.len() - 1
+        }
+    };
+    &mut grads[at]
+}
+
 /// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`), in flat order.
 fn outputs(
     tape: &mut Tape,
@@ -223,13 +247,17 @@ fn outputs(
     (tape.gather_rows(out, packing.flat_to_packed()), vars)
 }
 
-/// Values (no gradient) of `net` over the continuation sequences, at each record's next row.
-fn next_values(net: &GruActor, s: &Squeezed) -> Vec<Vec<f32>> {
-    let mut tape = Tape::new();
+/// Values (no gradient) of `net` over the continuation sequences at each record's next row, into
+/// `into` as [records, n_out] row-major; the tape is left empty.
+fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32>) {
     let lengths: Vec<usize> = s.lengths.iter().map(|l| l + 1).collect();
-    let (out, _) = outputs(&mut tape, net, &s.x_next, s.width, &lengths);
+    let (out, _) = outputs(tape, net, &s.x_next, s.width, &lengths);
     let v = tape.value(out);
-    s.next_rows().iter().map(|&r| v.row(r).to_vec()).collect()
+    into.clear();
+    for r in s.next_rows() {
+        into.extend(v.row(r).iter());
+    }
+    tape.reset();
 }
 
 /// What one net's TD step computed.
@@ -250,33 +278,41 @@ pub struct TdTrace {
 fn td_step(
     q: &mut QNet,
     s: &Squeezed,
-    pick: impl Fn(usize, &[f32]) -> usize,
+    mut pick: impl FnMut(usize, &[f32]) -> usize,
     hysteresis: f64,
     discount: f64,
+    scratch: &mut UpdateScratch,
 ) -> TdTrace {
-    let online_next = next_values(&q.net, s);
-    let target_next = next_values(&q.target, s);
+    let UpdateScratch {
+        tape,
+        grads,
+        online_next,
+        target_next,
+    } = scratch;
+    let n_out = q.net.config().output;
+    next_values(tape, &q.net, s, online_next);
+    next_values(tape, &q.target, s, target_next);
     let next_actions: Vec<usize> = online_next
-        .iter()
+        .chunks_exact(n_out)
         .enumerate()
         .map(|(k, row)| pick(k, row))
         .collect();
     let d = discount as f32;
     let targets: Vec<f32> = (0..s.total())
         .map(|k| {
-            let boot = target_next[k][next_actions[k]];
+            let boot = target_next[k * n_out + next_actions[k]];
             s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
         })
         .collect();
-    let mut tape = Tape::new();
-    let (values, vars) = outputs(&mut tape, &q.net, &s.x, s.width, &s.lengths);
-    let y = ndarray::Array1::from(targets.clone());
-    let loss = hysteretic_td_loss(&mut tape, values, &s.actions, y.view(), hysteresis as f32);
+    let (values, vars) = outputs(tape, &q.net, &s.x, s.width, &s.lengths);
+    let y = ArrayView1::from(&targets[..]);
+    let loss = hysteretic_td_loss(tape, values, &s.actions, y, hysteresis as f32);
     let loss_value = tape.scalar(loss);
     tape.backward(loss);
-    let mut grads = GruActor::zeros(q.net.config());
-    vars.grads_into(&tape, &mut grads);
-    q.adam.step(&mut q.net, &grads);
+    let grads = grads_for(grads, q.net.config());
+    vars.grads_into(tape, grads);
+    tape.reset();
+    q.adam.step(&mut q.net, grads);
     TdTrace {
         lengths: s.lengths.clone(),
         next_actions,
@@ -286,7 +322,7 @@ fn td_step(
 }
 
 /// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
-/// (then no net changes).
+/// (then no net changes). `scratch` is reused memory (see [`UpdateScratch`]).
 pub fn update_dec(
     nets: &mut [QNet],
     batch: &[&[Step]],
@@ -294,6 +330,7 @@ pub fn update_dec(
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
+    scratch: &mut UpdateScratch,
 ) -> Option<Vec<TdTrace>> {
     let squeezed: Vec<_> = (0..nets.len())
         .map(|i| {
@@ -324,13 +361,15 @@ pub fn update_dec(
                     |k, row| masked_argmax(row, &records[k].next_avail[masks.clone()]),
                     hysteresis,
                     discount,
+                    scratch,
                 )
             })
             .collect(),
     )
 }
 
-/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing.
+/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing. `scratch`
+/// is reused memory (see [`UpdateScratch`]).
 pub fn update_cen(
     q: &mut QNet,
     batch: &[&[Step]],
@@ -338,6 +377,7 @@ pub fn update_cen(
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
+    scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
     let width = dims.obs_sizes.iter().sum();
     let (s, kept) = Squeezed::of(
@@ -368,6 +408,7 @@ pub fn update_cen(
         },
         hysteresis,
         discount,
+        scratch,
     ))
 }
 
@@ -376,7 +417,8 @@ pub fn update_cen(
 /// `cen_batch`, then every agent's net in `decs` steps on `dec_batch` with the centralized net's
 /// choices there. `None` when `cen_batch`'s joint squeeze kept nothing; the decentralized traces
 /// are empty when `dec_batch`'s joint squeeze or some agent's squeeze kept nothing (the reference
-/// returns before their optimizer steps, after the centralized one).
+/// returns before their optimizer steps, after the centralized one). `scratch` is reused memory
+/// (see [`UpdateScratch`]).
 #[allow(clippy::too_many_arguments)]
 pub fn update_dec_cen(
     cen: &mut QNet,
@@ -387,6 +429,7 @@ pub fn update_dec_cen(
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
+    scratch: &mut UpdateScratch,
 ) -> Option<(TdTrace, Vec<TdTrace>)> {
     let width = dims.obs_sizes.iter().sum();
     let joint = |batch: &[&'_ [Step]]| {
@@ -416,13 +459,22 @@ pub fn update_dec_cen(
         return None;
     }
     // The centralized step is plain double Q (no hysteresis in `QLearn_squ_dec_cen_0`).
-    let cen_trace = td_step(cen, &s, |k, row| choose(&records, k, row), 1.0, discount);
+    let cen_trace = td_step(
+        cen,
+        &s,
+        |k, row| choose(&records, k, row),
+        1.0,
+        discount,
+        scratch,
+    );
     let (s, records) = joint(dec_batch);
     if s.lengths.is_empty() {
         return Some((cen_trace, Vec::new()));
     }
-    let joint_next: Vec<usize> = next_values(&cen.net, &s)
-        .iter()
+    next_values(&mut scratch.tape, &cen.net, &s, &mut scratch.online_next);
+    let joint_next: Vec<usize> = scratch
+        .online_next
+        .chunks_exact(cen.net.config().output)
         .enumerate()
         .map(|(k, row)| choose(&records, k, row))
         .collect();
@@ -455,7 +507,7 @@ pub fn update_dec_cen(
                 .filter(|(r, _)| r.valid[i])
                 .map(|(_, &j)| dims.unravel(j)[i])
                 .collect();
-            td_step(q, s, |k, _| a_next[k], hysteresis, discount)
+            td_step(q, s, |k, _| a_next[k], hysteresis, discount, scratch)
         })
         .collect();
     Some((cen_trace, dec_traces))
