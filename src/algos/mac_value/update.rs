@@ -115,12 +115,34 @@ pub fn conditional_argmax(
     avail: &[f32],
     dims: &Dims,
 ) -> usize {
-    let allowed = |j: usize| {
-        dims.unravel(j).iter().enumerate().all(|(i, &a)| {
-            avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
-        })
+    let n_masks: usize = dims.n_actions.iter().sum();
+    // Joint index j's components, last agent first (j's least significant digit), each checked
+    // against its agent's mask and running macro-action; no allocation per j.
+    let allowed = |mut j: usize| {
+        let mut lo = n_masks;
+        for (&n, run) in dims.n_actions.iter().zip(running).rev() {
+            let a = j % n;
+            j /= n;
+            lo -= n;
+            if avail[lo + a] == 0.0 || run.is_some_and(|r| r != a) {
+                return false;
+            }
+        }
+        true
     };
     first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j))).unwrap_or(0)
+}
+
+/// Into `running`: each agent's macro-action in `r` where it did not end there (it keeps running),
+/// `None` where it ended.
+fn running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
+    running.clear();
+    running.extend(
+        r.valid
+            .iter()
+            .zip(&r.actions)
+            .map(|(&v, &a)| (!v).then_some(a)),
+    );
 }
 
 /// The available macro-action with the largest value (`get_masked_Q` then `max`); 0 when none is.
@@ -151,7 +173,8 @@ struct Squeezed {
 
 impl Squeezed {
     /// Keep the records `keep` accepts, reading each with `obs`/`next_obs` (the net's input
-    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go.
+    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go. Also
+    /// gives the kept records, in the same (flat) order.
     fn of<'a>(
         batch: &[&'a [Step]],
         sub_trace_len: usize,
@@ -159,20 +182,30 @@ impl Squeezed {
         keep: impl Fn(&Step) -> bool,
         input: impl Fn(&'a [f32]) -> &'a [f32],
         fields: impl Fn(&Step) -> (usize, f32, f32),
-    ) -> (Squeezed, Vec<Vec<&'a Step>>) {
+    ) -> (Squeezed, Vec<&'a Step>) {
         let mut s = Squeezed {
             width,
             ..Squeezed::default()
         };
-        let mut kept_records = Vec::new();
+        // At most every record is kept: room for all of them up front.
+        let most: usize = batch.iter().map(|seq| seq.len()).sum();
+        let mut records: Vec<&'a Step> = Vec::with_capacity(most);
+        s.x.reserve(most * width);
+        s.x_next.reserve((most + batch.len()) * width);
+        for v in [&mut s.rewards, &mut s.gammas, &mut s.terminals] {
+            v.reserve(most);
+        }
+        s.actions.reserve(most);
         for seq in batch {
-            let kept: Vec<&Step> = seq.iter().filter(|r| keep(r)).collect();
-            if kept.is_empty() || kept.len() < sub_trace_len {
+            let n = seq.iter().filter(|r| keep(r)).count();
+            if n == 0 || n < sub_trace_len {
                 continue;
             }
-            s.lengths.push(kept.len());
-            s.x_next.extend_from_slice(input(&kept[0].obs));
-            for r in &kept {
+            s.lengths.push(n);
+            let first = records.len();
+            records.extend(seq.iter().filter(|r| keep(r)));
+            s.x_next.extend_from_slice(input(&records[first].obs));
+            for r in &records[first..] {
                 s.x.extend_from_slice(input(&r.obs));
                 s.x_next.extend_from_slice(input(&r.next_obs));
                 let (a, rew, g) = fields(r);
@@ -181,24 +214,29 @@ impl Squeezed {
                 s.gammas.push(g);
                 s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
             }
-            kept_records.push(kept);
         }
-        (s, kept_records)
+        (s, records)
+    }
+
+    /// The joint squeeze (the centralized net's): records where any agent's macro-action ended,
+    /// the joint observation, joint macro-action, reward and gamma.
+    fn joint<'a>(
+        batch: &[&'a [Step]],
+        sub_trace_len: usize,
+        dims: &Dims,
+    ) -> (Squeezed, Vec<&'a Step>) {
+        Squeezed::of(
+            batch,
+            sub_trace_len,
+            dims.obs_sizes.iter().sum(),
+            Step::any_valid,
+            |o| o,
+            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+        )
     }
 
     fn total(&self) -> usize {
         self.actions.len()
-    }
-
-    /// Row index of each record's next value in the continuation's flat layout.
-    fn next_rows(&self) -> Vec<usize> {
-        let mut rows = Vec::with_capacity(self.total());
-        let mut start = 0;
-        for &l in &self.lengths {
-            rows.extend(start + 1..start + 1 + l);
-            start += l + 1;
-        }
-        rows
     }
 }
 
@@ -226,36 +264,43 @@ fn grads_for(grads: &mut Vec<GruActor>, cfg: GruActorConfig) -> &mut GruActor {
     &mut grads[at]
 }
 
-/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`), in flat order.
-fn outputs(
+/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`), in packed order (see
+/// [`SeqPacking`]).
+fn packed_outputs(
     tape: &mut Tape,
     net: &GruActor,
     x: &[f32],
     width: usize,
-    lengths: &[usize],
+    packing: &SeqPacking,
 ) -> (Var, crate::nn::GruActorVars) {
     let vars = net.bind(tape);
-    let packing = SeqPacking::new(lengths);
     let mut packed = tape.pool().array(packing.total(), width);
-    for (p, &f) in packing.packed_to_flat().iter().enumerate() {
-        packed
-            .row_mut(p)
-            .assign(&ArrayView1::from(&x[f * width..(f + 1) * width]));
+    let rows = packed
+        .as_slice_mut()
+        .expect("pool arrays are contiguous")
+        .chunks_exact_mut(width);
+    for (row, &f) in rows.zip(packing.packed_to_flat()) {
+        row.copy_from_slice(&x[f * width..(f + 1) * width]);
     }
     let packed = tape.constant_owned(packed);
-    let out = net.forward(tape, &vars, packed, &packing);
-    (tape.gather_rows(out, packing.flat_to_packed()), vars)
+    (net.forward(tape, &vars, packed, packing), vars)
 }
 
 /// Values (no gradient) of `net` over the continuation sequences at each record's next row, into
 /// `into` as [records, n_out] row-major; the tape is left empty.
 fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32>) {
     let lengths: Vec<usize> = s.lengths.iter().map(|l| l + 1).collect();
-    let (out, _) = outputs(tape, net, &s.x_next, s.width, &lengths);
+    let packing = SeqPacking::new(&lengths);
+    let (out, _) = packed_outputs(tape, net, &s.x_next, s.width, &packing);
     let v = tape.value(out);
     into.clear();
-    for r in s.next_rows() {
-        into.extend(v.row(r).iter());
+    let mut start = 0;
+    for &l in &s.lengths {
+        // Record k of the sequence is continuation position k + 1.
+        for f in start + 1..start + 1 + l {
+            into.extend(v.row(packing.flat_to_packed()[f]).iter());
+        }
+        start += l + 1;
     }
     tape.reset();
 }
@@ -304,7 +349,9 @@ fn td_step(
             s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
         })
         .collect();
-    let (values, vars) = outputs(tape, &q.net, &s.x, s.width, &s.lengths);
+    let packing = SeqPacking::new(&s.lengths);
+    let (values, vars) = packed_outputs(tape, &q.net, &s.x, s.width, &packing);
+    let values = tape.gather_rows(values, packing.flat_to_packed());
     let y = ArrayView1::from(&targets[..]);
     let loss = hysteretic_td_loss(tape, values, &s.actions, y, hysteresis as f32);
     let loss_value = tape.scalar(loss);
@@ -352,8 +399,7 @@ pub fn update_dec(
         nets.iter_mut()
             .zip(&squeezed)
             .enumerate()
-            .map(|(i, (q, (s, kept)))| {
-                let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+            .map(|(i, (q, (s, records)))| {
                 let masks = dims.action_range(i);
                 td_step(
                     q,
@@ -379,31 +425,18 @@ pub fn update_cen(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
-    let width = dims.obs_sizes.iter().sum();
-    let (s, kept) = Squeezed::of(
-        batch,
-        sub_trace_len,
-        width,
-        Step::any_valid,
-        |o| o,
-        |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-    );
+    let (s, records) = Squeezed::joint(batch, sub_trace_len, dims);
     if s.lengths.is_empty() {
         return None;
     }
-    let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+    let mut running = Vec::with_capacity(dims.n_actions.len());
     Some(td_step(
         q,
         &s,
         |k, row| {
             let r = records[k];
             // Agents whose macro-action did not end keep it (`get_conditional_action`).
-            let running: Vec<Option<usize>> = r
-                .valid
-                .iter()
-                .zip(&r.actions)
-                .map(|(&v, &a)| (!v).then_some(a))
-                .collect();
+            running_actions(r, &mut running);
             conditional_argmax(row, &running, &r.next_avail, dims)
         },
         hysteresis,
@@ -431,27 +464,11 @@ pub fn update_dec_cen(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<(TdTrace, Vec<TdTrace>)> {
-    let width = dims.obs_sizes.iter().sum();
-    let joint = |batch: &[&'_ [Step]]| {
-        let (s, kept) = Squeezed::of(
-            batch,
-            sub_trace_len,
-            width,
-            Step::any_valid,
-            |o| o,
-            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-        );
-        let records: Vec<Step> = kept.iter().flatten().map(|&r| r.clone()).collect();
-        (s, records)
-    };
-    let choose = |records: &[Step], k: usize, row: &[f32]| {
-        let r = &records[k];
-        let running: Vec<Option<usize>> = r
-            .valid
-            .iter()
-            .zip(&r.actions)
-            .map(|(&v, &a)| (!v).then_some(a))
-            .collect();
+    let joint = |batch| Squeezed::joint(batch, sub_trace_len, dims);
+    let choose = |records: &[&Step], k: usize, row: &[f32]| {
+        let r = records[k];
+        let mut running = Vec::with_capacity(dims.n_actions.len());
+        running_actions(r, &mut running);
         conditional_argmax(row, &running, &r.next_avail, dims)
     };
     let (s, records) = joint(cen_batch);
