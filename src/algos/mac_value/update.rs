@@ -5,7 +5,10 @@
 //!    for MacDec-Q, any agent's for MacCen-Q), dropping sequences with fewer than
 //!    `sub_trace_len`;
 //! 2. Q(h, a) from one unroll over the squeezed observations; the next-history values from the
-//!    continuation [o_0, o'_0, o'_1, ...] of the same unroll, its outputs from position 1 on;
+//!    continuation [o_0, o'_0, o'_1, ...] of the same unroll, its outputs from position 1 on
+//!    (for the online net, when the continuation repeats the observations bit for bit, those
+//!    outputs are the first unroll's from position 1 plus one step past each end, which is how
+//!    they are computed then);
 //! 3. double Q: a' = argmax of the online net's next values among the available macro-actions
 //!    (MacCen-Q: the conditional argmax, keeping the running macro-actions of agents that did not
 //!    finish), valued by the target net;
@@ -24,7 +27,7 @@
 //! centralized net's batch from the memory its own exploration filled and the agents' batch from
 //! the memory the agents' exploration filled.
 
-use ndarray::ArrayView1;
+use ndarray::{Array2, ArrayView1, ArrayView2};
 use serde::{Deserialize, Serialize};
 
 use super::episode::Step;
@@ -235,6 +238,30 @@ impl Squeezed {
         )
     }
 
+    /// Whether every sequence's continuation starts with its observations, bit for bit
+    /// ([o_0, o'_0, ..., o'_{L-2}] = [o_0, o_1, ..., o_{L-1}]: a record's next observation is the
+    /// following record's, as when observations are held between an agent's decisions). Then the
+    /// online net's next values are its training unroll's outputs one position on, and one step
+    /// past each sequence's end.
+    fn continues(&self) -> bool {
+        let w = self.width;
+        let mut at = 0;
+        for (seq, &l) in self.lengths.iter().enumerate() {
+            // The continuation of sequence `seq` starts at row at + seq of x_next.
+            let observed = &self.x[at * w..(at + l) * w];
+            let continued = &self.x_next[(at + seq) * w..(at + seq + l) * w];
+            if observed
+                .iter()
+                .zip(continued)
+                .any(|(a, b)| a.to_bits() != b.to_bits())
+            {
+                return false;
+            }
+            at += l;
+        }
+        true
+    }
+
     fn total(&self) -> usize {
         self.actions.len()
     }
@@ -264,15 +291,15 @@ fn grads_for(grads: &mut Vec<GruActor>, cfg: GruActorConfig) -> &mut GruActor {
     &mut grads[at]
 }
 
-/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`), in packed order (see
-/// [`SeqPacking`]).
+/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`) and its GRU's outputs
+/// h, both in packed order (see [`SeqPacking`]).
 fn packed_outputs(
     tape: &mut Tape,
     net: &GruActor,
     x: &[f32],
     width: usize,
     packing: &SeqPacking,
-) -> (Var, crate::nn::GruActorVars) {
+) -> (Var, Var, crate::nn::GruActorVars) {
     let vars = net.bind(tape);
     let mut packed = tape.pool().array(packing.total(), width);
     let rows = packed
@@ -283,7 +310,8 @@ fn packed_outputs(
         row.copy_from_slice(&x[f * width..(f + 1) * width]);
     }
     let packed = tape.constant_owned(packed);
-    (net.forward(tape, &vars, packed, packing), vars)
+    let (out, h) = net.forward_with_hidden(tape, &vars, packed, packing);
+    (out, h, vars)
 }
 
 /// Values (no gradient) of `net` over the continuation sequences at each record's next row, into
@@ -291,7 +319,7 @@ fn packed_outputs(
 fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32>) {
     let lengths: Vec<usize> = s.lengths.iter().map(|l| l + 1).collect();
     let packing = SeqPacking::new(&lengths);
-    let (out, _) = packed_outputs(tape, net, &s.x_next, s.width, &packing);
+    let (out, _, _) = packed_outputs(tape, net, &s.x_next, s.width, &packing);
     let v = tape.value(out);
     into.clear();
     let mut start = 0;
@@ -303,6 +331,45 @@ fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32
         start += l + 1;
     }
     tape.reset();
+}
+
+/// The online net's next values when `s` [`Squeezed::continues`], into `into` as [records,
+/// n_out]: from its training unroll's outputs `out` and GRU outputs `h` (packed by `packing`),
+/// record k's is the output at its sequence's next position, and a sequence's last record's is one
+/// step past the end from h there with input o'_{L-1} ([`GruActor::continue_rows`]): the bits a
+/// separate unroll over the continuation gives.
+fn next_values_from_unroll(
+    net: &GruActor,
+    out: ArrayView2<f32>,
+    h: ArrayView2<f32>,
+    packing: &SeqPacking,
+    s: &Squeezed,
+    into: &mut Vec<f32>,
+) {
+    let (w, n_seq) = (s.width, s.lengths.len());
+    let to_packed = packing.flat_to_packed();
+    let mut last_x = Array2::zeros((n_seq, w));
+    let mut last_h = Array2::zeros((n_seq, h.ncols()));
+    let mut at = 0;
+    for (seq, &l) in s.lengths.iter().enumerate() {
+        // o'_{L-1}: the last row of the sequence's continuation (L + 1 rows from at + seq).
+        let c = at + seq + l;
+        last_x
+            .row_mut(seq)
+            .assign(&ArrayView1::from(&s.x_next[c * w..(c + 1) * w]));
+        last_h.row_mut(seq).assign(&h.row(to_packed[at + l - 1]));
+        at += l;
+    }
+    let past = net.continue_rows(last_x.view(), last_h.view());
+    into.clear();
+    let mut at = 0;
+    for (seq, &l) in s.lengths.iter().enumerate() {
+        for f in at + 1..at + l {
+            into.extend(out.row(to_packed[f]).iter());
+        }
+        into.extend(past.row(seq).iter());
+        at += l;
+    }
 }
 
 /// What one net's TD step computed.
@@ -335,8 +402,19 @@ fn td_step(
         target_next,
     } = scratch;
     let n_out = q.net.config().output;
-    next_values(tape, &q.net, s, online_next);
+    // One online unroll gives both Q(h, a) and the next values when the continuation repeats
+    // the observations (checked, bit for bit); otherwise the continuation is unrolled apart.
+    let continues = s.continues();
+    if !continues {
+        next_values(tape, &q.net, s, online_next);
+    }
     next_values(tape, &q.target, s, target_next);
+    let packing = SeqPacking::new(&s.lengths);
+    let (values, h, vars) = packed_outputs(tape, &q.net, &s.x, s.width, &packing);
+    if continues {
+        let (out, h) = (tape.value(values), tape.value(h));
+        next_values_from_unroll(&q.net, out, h, &packing, s, online_next);
+    }
     let next_actions: Vec<usize> = online_next
         .chunks_exact(n_out)
         .enumerate()
@@ -349,8 +427,6 @@ fn td_step(
             s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
         })
         .collect();
-    let packing = SeqPacking::new(&s.lengths);
-    let (values, vars) = packed_outputs(tape, &q.net, &s.x, s.width, &packing);
     let values = tape.gather_rows(values, packing.flat_to_packed());
     let y = ArrayView1::from(&targets[..]);
     let loss = hysteretic_td_loss(tape, values, &s.actions, y, hysteresis as f32);
@@ -551,5 +627,81 @@ mod tests {
         let avail = [1.0, 1.0, 1.0, 1.0, 0.0];
         assert_eq!(conditional_argmax(&q, &[Some(1), None], &avail, &dims), 4);
         assert_eq!(masked_argmax(&[1.0, 5.0, 3.0], &[1.0, 0.0, 1.0]), 2);
+    }
+
+    fn dims() -> Dims {
+        Dims {
+            obs_sizes: vec![1, 1],
+            n_actions: vec![2, 3],
+        }
+    }
+
+    /// Records of one episode whose observations are held between decisions: record t+1's
+    /// observation is record t's next one. Agent 0 finishes every other step, agent 1 always.
+    fn held_episode(len: usize) -> Vec<Step> {
+        let obs = |t: usize| vec![(t / 2) as f32 * 0.3 - 0.5, (t as f32 * 0.7).sin()];
+        (0..len)
+            .map(|t| Step {
+                obs: obs(t),
+                actions: vec![t % 2, (t + 1) % 3],
+                rewards: vec![0.1 * t as f32, -0.2],
+                gammas: vec![1.0, 1.0],
+                joint_reward: 0.05,
+                joint_gamma: 1.0,
+                next_obs: obs(t + 1),
+                next_avail: vec![1.0; 5],
+                terminal: t + 1 == len,
+                valid: vec![t % 2 == 1, true],
+            })
+            .collect()
+    }
+
+    #[test]
+    fn next_values_from_the_training_unroll_are_the_separate_unrolls_bits() {
+        use rand::SeedableRng;
+        let episode = held_episode(9);
+        let batch: Vec<&[Step]> = vec![&episode[..], &episode[2..7], &episode[5..6]];
+        let agent = |i: usize| {
+            Squeezed::of(
+                &batch,
+                1,
+                1,
+                |r| r.valid[i],
+                move |o| &o[i..i + 1],
+                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+            )
+            .0
+        };
+        // Agent 0's squeeze (every other record), agent 1's (every record), the joint one.
+        let squeezes = [agent(0), agent(1), Squeezed::joint(&batch, 1, &dims()).0];
+        for (k, s) in squeezes.iter().enumerate() {
+            assert!(s.continues(), "squeeze {k}");
+            let cfg = GruActorConfig {
+                input: s.width,
+                mlp: [17, 9],
+                hidden: 21,
+                output: 6,
+            };
+            let net = GruActor::new(cfg, &mut rand_chacha::ChaCha8Rng::seed_from_u64(k as u64));
+            let mut tape = Tape::new();
+            let mut apart = Vec::new();
+            next_values(&mut tape, &net, s, &mut apart);
+            let packing = SeqPacking::new(&s.lengths);
+            let (out, h, _) = packed_outputs(&mut tape, &net, &s.x, s.width, &packing);
+            let mut shared = Vec::new();
+            let (out, h) = (tape.value(out), tape.value(h));
+            next_values_from_unroll(&net, out, h, &packing, s, &mut shared);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(apart.len(), s.total() * cfg.output, "squeeze {k}");
+            assert_eq!(bits(&shared), bits(&apart), "squeeze {k}");
+        }
+    }
+
+    #[test]
+    fn a_next_observation_that_is_not_the_following_one_is_unrolled_apart() {
+        let mut episode = held_episode(6);
+        assert!(Squeezed::joint(&[&episode[..]], 1, &dims()).0.continues());
+        episode[2].next_obs[1] += 1.0;
+        assert!(!Squeezed::joint(&[&episode[..]], 1, &dims()).0.continues());
     }
 }
