@@ -32,7 +32,7 @@ use serde::{Deserialize, Serialize};
 
 use super::episode::Step;
 use crate::autograd::{SeqPacking, Tape, Var};
-use crate::nn::argmax::first_argmax;
+use crate::nn::argmax::{first_argmax, FirstArgmax};
 use crate::nn::loss::hysteretic_td_loss;
 use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig};
 
@@ -118,22 +118,58 @@ pub fn conditional_argmax(
     avail: &[f32],
     dims: &Dims,
 ) -> usize {
-    let n_masks: usize = dims.n_actions.iter().sum();
-    // Joint index j's components, last agent first (j's least significant digit), each checked
-    // against its agent's mask and running macro-action; no allocation per j.
-    let allowed = |mut j: usize| {
-        let mut lo = n_masks;
-        for (&n, run) in dims.n_actions.iter().zip(running).rev() {
-            let a = j % n;
-            j /= n;
-            lo -= n;
-            if avail[lo + a] == 0.0 || run.is_some_and(|r| r != a) {
-                return false;
+    let mut best = FirstArgmax::default();
+    for_each_allowed_joint(dims, running, avail, &mut |j| best.offer(j, q[j]));
+    best.index().unwrap_or(0)
+}
+
+/// Calls `f` with every joint macro-action index whose every component is available in `avail`
+/// and equals `running[i]` where that is `Some`, in increasing order. The allowed joint actions
+/// are the product of each agent's allowed actions, visited in C order (agent 0 most
+/// significant), which is increasing index order; nothing else is visited or allocated.
+pub fn for_each_allowed_joint(
+    dims: &Dims,
+    running: &[Option<usize>],
+    avail: &[f32],
+    f: &mut impl FnMut(usize),
+) {
+    /// Agent `i` on, its mask at avail[lo..], the components before it giving `prefix`.
+    fn visit(
+        n_actions: &[usize],
+        running: &[Option<usize>],
+        avail: &[f32],
+        (i, lo, prefix): (usize, usize, usize),
+        f: &mut impl FnMut(usize),
+    ) {
+        let n = n_actions[i];
+        let actions = match running[i] {
+            Some(r) => r..(r + 1).min(n),
+            None => 0..n,
+        };
+        let last = i + 1 == n_actions.len();
+        for a in actions {
+            if avail[lo + a] == 0.0 {
+                continue;
+            }
+            if last {
+                f(prefix * n + a);
+            } else {
+                visit(
+                    n_actions,
+                    running,
+                    avail,
+                    (i + 1, lo + n, prefix * n + a),
+                    f,
+                );
             }
         }
-        true
-    };
-    first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j))).unwrap_or(0)
+    }
+    if dims.n_actions.is_empty() {
+        // One joint macro-action, of no components.
+        f(0);
+    } else {
+        visit(&dims.n_actions, running, avail, (0, 0, 0), f);
+    }
 }
 
 /// Into `running`: each agent's macro-action in `r` where it did not end there (it keeps running),
@@ -200,13 +236,14 @@ impl Squeezed {
         }
         s.actions.reserve(most);
         for seq in batch {
-            let n = seq.iter().filter(|r| keep(r)).count();
+            let first = records.len();
+            records.extend(seq.iter().filter(|r| keep(r)));
+            let n = records.len() - first;
             if n == 0 || n < sub_trace_len {
+                records.truncate(first);
                 continue;
             }
             s.lengths.push(n);
-            let first = records.len();
-            records.extend(seq.iter().filter(|r| keep(r)));
             s.x_next.extend_from_slice(input(&records[first].obs));
             for r in &records[first..] {
                 s.x.extend_from_slice(input(&r.obs));
@@ -627,6 +664,40 @@ mod tests {
         let avail = [1.0, 1.0, 1.0, 1.0, 0.0];
         assert_eq!(conditional_argmax(&q, &[Some(1), None], &avail, &dims), 4);
         assert_eq!(masked_argmax(&[1.0, 5.0, 3.0], &[1.0, 0.0, 1.0]), 2);
+    }
+
+    #[test]
+    fn the_conditional_argmax_is_the_first_maximum_over_the_allowed_joint_indices() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let dims = Dims {
+            obs_sizes: vec![1, 1, 1],
+            n_actions: vec![3, 2, 4],
+        };
+        for _ in 0..2000 {
+            // Few distinct values (ties), some NaN, masks and running actions at random.
+            let q: Vec<f32> = (0..dims.n_joint())
+                .map(|_| match rng.gen_range(0..8) {
+                    0 => f32::NAN,
+                    k => k as f32,
+                })
+                .collect();
+            let avail: Vec<f32> = (0..9).map(|_| rng.gen_range(0..4).min(1) as f32).collect();
+            let running: Vec<Option<usize>> = dims
+                .n_actions
+                .iter()
+                .map(|&n| rng.gen_bool(0.3).then(|| rng.gen_range(0..n)))
+                .collect();
+            // The definition: every joint index, filtered, in order.
+            let allowed = |j: usize| {
+                dims.unravel(j).iter().enumerate().all(|(i, &a)| {
+                    avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
+                })
+            };
+            let want = first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j)))
+                .unwrap_or(0);
+            assert_eq!(conditional_argmax(&q, &running, &avail, &dims), want);
+        }
     }
 
     fn dims() -> Dims {
