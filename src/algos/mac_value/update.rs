@@ -401,8 +401,8 @@ fn next_values_from_unroll(
     into.clear();
     let mut at = 0;
     for (seq, &l) in s.lengths.iter().enumerate() {
-        for f in at + 1..at + l {
-            into.extend(out.row(to_packed[f]).iter());
+        for &p in &to_packed[at + 1..at + l] {
+            into.extend(out.row(p).iter());
         }
         into.extend(past.row(seq).iter());
         at += l;
