@@ -20,6 +20,7 @@ pub mod families;
 pub mod family;
 pub mod learner;
 pub mod mac_value;
+pub mod scratch;
 pub mod train_error;
 pub mod training_loop;
 pub mod update_means;

@@ -17,6 +17,7 @@ use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
+use crate::algos::scratch::Scratch;
 use crate::algos::training_loop::TrainError;
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
@@ -50,21 +51,12 @@ pub struct AcLearner {
     memory: VecDeque<Episode>,
     /// Losses and training returns since the last metrics row.
     means: UpdateMeans,
+    /// The updates' tape, reset after every pass.
     #[serde(skip, default)]
-    tape: TapeCell,
+    tape: Scratch<Tape>,
     /// The acting path's scratch.
     #[serde(skip, default)]
     buffers: ActBuffers,
-}
-
-/// The learner's tape: scratch, rebuilt empty after a resume.
-#[derive(Debug, Default)]
-struct TapeCell(Tape);
-
-impl Clone for TapeCell {
-    fn clone(&self) -> Self {
-        TapeCell::default()
-    }
 }
 
 impl AcLearner {
@@ -203,7 +195,7 @@ impl Learner for AcLearner {
             eps: config.eps_start,
             memory: VecDeque::new(),
             means: UpdateMeans::default(),
-            tape: TapeCell::default(),
+            tape: Scratch::default(),
             buffers: ActBuffers::default(),
         })
     }
