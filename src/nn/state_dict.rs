@@ -117,7 +117,7 @@ impl<'a> StateDict<'a> {
         Ok(Array2::from_shape_vec((rows, cols), v).expect("values() checked the shape"))
     }
 
-    /// `nn.Linear` under `prefix` (`weight` [out, in], `bias` [out]), its sizes read from the
+    /// `nn.Linear` under `prefix` (`weight` `[out, in]`, `bias` `[out]`), its sizes read from the
     /// file.
     pub fn linear(&self, prefix: &str) -> Result<LinearParams, WeightsError> {
         let name = format!("{prefix}weight");

@@ -60,13 +60,13 @@ pub struct SqueezedEpisode {
     pub critic_obs: Vec<Array2<f32>>,
     /// s_k + 1 for each k.
     pub critic_time: Vec<usize>,
-    /// [k][i]: agent i started a macro-action at s_k.
+    /// `[k][i]`: agent i started a macro-action at s_k.
     pub critic_starts: Vec<Vec<bool>>,
     /// Per agent, its bootstrap rows [L + 1, obs_i]: before e_0, then after each e_k.
     pub bootstrap_obs: Vec<Array2<f32>>,
     /// 1, then e_k + 2.
     pub bootstrap_time: Vec<usize>,
-    /// [k][i]: row k of the bootstrap input steps agent i (row 0: every agent).
+    /// `[k][i]`: row k of the bootstrap input steps agent i (row 0: every agent).
     pub bootstrap_steps: Vec<Vec<bool>>,
     /// The joint macro-reward at e_k.
     pub rewards: Vec<f32>,
