@@ -17,6 +17,7 @@ use macdec::algos::acac::update::{
     AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
 };
 use macdec::algos::actor_critic::episode::Episode;
+use macdec::autograd::Tape;
 use macdec::nn::{BlockDropout, Gpt2Dropout, StateDict, TimeEmbedding, ValueHead};
 use ndarray::{Array2, ArrayViewD};
 use serde_json::Value;
@@ -355,7 +356,14 @@ fn replay(case_name: &str, gae_lambda: GaeLambda) {
     let mut nets = nets(&case);
     let masks = dropout(j);
     let p = params(j, vanilla, gae_lambda);
-    let trace = update(&mut nets, &batch, &p, DropoutSource::Replay(masks.iter())).unwrap();
+    let trace = update(
+        &mut nets,
+        &batch,
+        &p,
+        DropoutSource::Replay(masks.iter()),
+        &mut Tape::new(),
+    )
+    .unwrap();
     if vanilla {
         check_vanilla(j, &trace, &joint);
     } else {

@@ -24,8 +24,10 @@ use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
+use crate::algos::scratch::Scratch;
 use crate::algos::train_error::TrainError;
 use crate::algos::update_means::UpdateMeans;
+use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::sampling::{mixture, sample_weighted};
 use crate::nn::TimeEmbedding;
@@ -72,6 +74,9 @@ pub struct AcacLearner {
     pending_steps: u64,
     /// Losses and training returns since the last metrics row.
     means: UpdateMeans,
+    /// The updates' tape, reset before every forward.
+    #[serde(skip, default)]
+    tape: Scratch<Tape>,
     #[serde(skip, default)]
     scratch: Vec<f32>,
     #[serde(skip, default)]
@@ -185,6 +190,7 @@ impl AcacLearner {
             &batch,
             &p,
             DropoutSource::Draw(&mut self.dropout_rng),
+            &mut self.tape.0,
         )
         .map_err(|e| self.family_error(e, episodes))
     }
@@ -256,6 +262,7 @@ impl Learner for AcacLearner {
             timesteps: 0,
             pending_steps: 0,
             means: UpdateMeans::default(),
+            tape: Scratch::default(),
             scratch: Vec::new(),
             probs: Vec::new(),
         })

@@ -511,12 +511,17 @@ impl AcacCritic {
         }
     }
 
-    /// The values [R, 1] (normalized with PopArt) of `input`'s joint rows, off the tape's
-    /// gradients (a fresh tape is used and dropped).
-    pub fn values(&self, input: &CriticInput, dropout: Option<&Gpt2Dropout>) -> Array1<f32> {
-        let mut tape = Tape::new();
-        let vars = self.bind(&mut tape);
-        let v = vars.forward(&mut tape, input, dropout);
+    /// The values [R, 1] (normalized with PopArt) of `input`'s joint rows, computed on `tape`
+    /// (reset first, so a learner reuses one tape's buffers) and taken off it.
+    pub fn values(
+        &self,
+        tape: &mut Tape,
+        input: &CriticInput,
+        dropout: Option<&Gpt2Dropout>,
+    ) -> Array1<f32> {
+        tape.reset();
+        let vars = self.bind(tape);
+        let v = vars.forward(tape, input, dropout);
         tape.value(v).column(0).to_owned()
     }
 }

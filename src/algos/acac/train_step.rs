@@ -7,13 +7,16 @@ use super::update::{
     ppo_update, AcacNets, DropoutSource, Objective, UpdateError, UpdateParams, UpdateTrace,
 };
 use super::vanilla::{self, VanillaParams};
+use crate::autograd::Tape;
 
-/// One update of `nets` on `batch` by `p.objective`, dropout masks from `dropout`.
+/// One update of `nets` on `batch` by `p.objective`, dropout masks from `dropout`, every
+/// forward on `tape` (a learner keeps one, so its buffers are reused).
 pub fn update(
     nets: &mut AcacNets,
     batch: &AcacBatch,
     p: &UpdateParams,
     dropout: DropoutSource<'_>,
+    tape: &mut Tape,
 ) -> Result<UpdateTrace, UpdateError> {
     let n = nets.actors.len();
     if batch.n_agents() != n {
@@ -23,7 +26,7 @@ pub fn update(
         });
     }
     match p.objective {
-        Objective::Ppo(gae_lambda) => ppo_update(nets, batch, p, gae_lambda, dropout),
+        Objective::Ppo(gae_lambda) => ppo_update(nets, batch, p, gae_lambda, dropout, tape),
         Objective::Vanilla {
             n_step,
             critic_iterations,
@@ -34,7 +37,7 @@ pub fn update(
                 critic_iterations,
                 entropy_weight,
             };
-            vanilla::update(nets, batch, p, &v, dropout)
+            vanilla::update(nets, batch, p, &v, dropout, tape)
         }
     }
 }

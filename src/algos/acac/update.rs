@@ -412,6 +412,7 @@ fn advantages(
     p: &UpdateParams,
     gae_lambda: GaeLambda,
     dropout: &mut DropoutSource<'_>,
+    tape: &mut Tape,
 ) -> Result<Targets, UpdateError> {
     let input = critic_input(
         nets,
@@ -427,7 +428,7 @@ fn advantages(
     );
     let rows: usize = input.rows_per_episode.iter().sum();
     let masks = dropout.next(rows, &nets.critic_target)?;
-    let mut values = nets.critic_target.values(&input, masks.as_ref());
+    let mut values = nets.critic_target.values(tape, &input, masks.as_ref());
     if let Some(pa) = nets.critic.popart() {
         values = pa
             .denormalize(values.view().insert_axis(ndarray::Axis(1)))
@@ -498,11 +499,12 @@ pub fn critic_loss(
     input: &CriticInput,
     targets: &Array2<f32>,
     masks: Option<&Gpt2Dropout>,
+    tape: &mut Tape,
 ) -> (f32, AcacCritic) {
     let rows = targets.nrows();
-    let mut tape = Tape::new();
-    let vars = critic.bind(&mut tape);
-    let v = vars.forward(&mut tape, input, masks);
+    tape.reset();
+    let vars = critic.bind(tape);
+    let v = vars.forward(tape, input, masks);
     let g = tape.constant(targets.view());
     let td = tape.sub(g, v);
     let sq = tape.square(td);
@@ -511,7 +513,7 @@ pub fn critic_loss(
     let value = tape.scalar(loss);
     tape.backward(loss);
     let mut grads = critic.zeros_like();
-    vars.grads_into(&tape, &mut grads);
+    vars.grads_into(tape, &mut grads);
     (value, grads)
 }
 
@@ -532,14 +534,15 @@ fn actor_loss(
     old: &[f32],
     adv: &[f32],
     p: &UpdateParams,
+    tape: &mut Tape,
 ) -> ActorStep {
     let clip_ratio = p.clip_ratio as f32;
     let m = input.actions.len();
-    let mut tape = Tape::new();
-    let vars = actor.bind(&mut tape);
+    tape.reset();
+    let vars = actor.bind(tape);
     let x = tape.constant(input.x.view());
-    let log_pi = vars.forward(&mut tape, x, &SeqPacking::new(&input.lengths));
-    let mixed = mixture_log_prob(&mut tape, log_pi, &input.actions, p.eps);
+    let log_pi = vars.forward(tape, x, &SeqPacking::new(&input.lengths));
+    let mixed = mixture_log_prob(tape, log_pi, &input.actions, p.eps);
     let old = tape.constant_owned(Array2::from_shape_vec((m, 1), old.to_vec()).expect("a column"));
     let diff = tape.sub(mixed, old);
     let ratio = tape.exp(diff);
@@ -569,7 +572,7 @@ fn actor_loss(
     let loss = tape.scale(total, -1.0 / m as f32);
     tape.backward(loss);
     let mut grads = actor.zeros_like();
-    vars.grads_into(&tape, &mut grads);
+    vars.grads_into(tape, &mut grads);
     ActorStep {
         loss: -loss_value / m as f32,
         grads,
@@ -585,13 +588,14 @@ pub(super) fn ppo_update(
     p: &UpdateParams,
     gae_lambda: GaeLambda,
     mut dropout: DropoutSource<'_>,
+    tape: &mut Tape,
 ) -> Result<UpdateTrace, UpdateError> {
     let n = nets.actors.len();
     let Targets {
         advantages: adv,
         returns,
         targets,
-    } = advantages(nets, batch, p, gae_lambda, &mut dropout)?;
+    } = advantages(nets, batch, p, gae_lambda, &mut dropout, tape)?;
     let inputs: Vec<ActorInput> = (0..n).map(|i| actor_input(nets, batch, i)).collect();
     // log pi_old under the batch's eps-mixture.
     let mut old_log_pi = Vec::with_capacity(n);
@@ -600,11 +604,11 @@ pub(super) fn ppo_update(
             old_log_pi.push(Vec::new());
             continue;
         }
-        let mut tape = Tape::new();
-        let vars = actor.bind(&mut tape);
+        tape.reset();
+        let vars = actor.bind(tape);
         let x = tape.constant(input.x.view());
-        let log_pi = vars.forward(&mut tape, x, &SeqPacking::new(&input.lengths));
-        let mixed = mixture_log_prob(&mut tape, log_pi, &input.actions, p.eps);
+        let log_pi = vars.forward(tape, x, &SeqPacking::new(&input.lengths));
+        let mixed = mixture_log_prob(tape, log_pi, &input.actions, p.eps);
         old_log_pi.push(tape.value(mixed).column(0).to_vec());
     }
     let critic_in = critic_input(
@@ -631,7 +635,8 @@ pub(super) fn ppo_update(
     };
     for _ in 0..p.n_train_repeat {
         let masks = dropout.next(rows, &nets.critic)?;
-        let (loss, mut grads) = critic_loss(&nets.critic, &critic_in, &target_col, masks.as_ref());
+        let (loss, mut grads) =
+            critic_loss(&nets.critic, &critic_in, &target_col, masks.as_ref(), tape);
         trace.critic_losses.push(loss);
         clip(&mut grads, p.grad_clip_value, p.grad_clip_norm);
         nets.critic_adam.step(&mut nets.critic, &grads);
@@ -641,7 +646,7 @@ pub(super) fn ppo_update(
                 continue;
             }
             let a: Vec<f32> = input.joint.iter().map(|&k| adv[k]).collect();
-            let step = actor_loss(&nets.actors[i], input, &old_log_pi[i], &a, p);
+            let step = actor_loss(&nets.actors[i], input, &old_log_pi[i], &a, p, tape);
             let mut grads = step.grads;
             clip(&mut grads, p.grad_clip_value, p.grad_clip_norm);
             nets.actor_adams[i].step(&mut nets.actors[i], &grads);
@@ -715,7 +720,14 @@ pub(crate) mod tests {
         p: &UpdateParams,
         dropout: DropoutSource<'_>,
     ) -> Result<UpdateTrace, UpdateError> {
-        ppo_update(nets, batch, p, GaeLambda::PerMacroStep, dropout)
+        ppo_update(
+            nets,
+            batch,
+            p,
+            GaeLambda::PerMacroStep,
+            dropout,
+            &mut Tape::new(),
+        )
     }
 
     fn params(eps: f64) -> UpdateParams {
@@ -793,9 +805,15 @@ pub(crate) mod tests {
         let masks = DropoutSource::Draw(&mut rng)
             .next(rows, &nets.critic)
             .unwrap();
-        let (_, grads) = critic_loss(&nets.critic, &input, &targets, masks.as_ref());
+        let (_, grads) = critic_loss(
+            &nets.critic,
+            &input,
+            &targets,
+            masks.as_ref(),
+            &mut Tape::new(),
+        );
         let checked = check_fd(&nets.critic, &grads, 7, |c| {
-            critic_loss(c, &input, &targets, masks.as_ref()).0
+            critic_loss(c, &input, &targets, masks.as_ref(), &mut Tape::new()).0
         });
         assert!(checked > 60, "{checked}");
     }
@@ -824,10 +842,10 @@ pub(crate) mod tests {
             .map(|(k, v)| v + offsets[k % offsets.len()])
             .collect();
         let adv: Vec<f32> = (0..m).map(|k| (k as f32 * 1.3).cos()).collect();
-        let step = actor_loss(&nets.actors[0], &input, &old, &adv, &p);
+        let step = actor_loss(&nets.actors[0], &input, &old, &adv, &p, &mut Tape::new());
         assert!(step.ratios.iter().any(|&r| r > 1.2) && step.ratios.iter().any(|&r| r < 0.8));
         check_fd(&nets.actors[0], &step.grads, 3, |a| {
-            actor_loss(a, &input, &old, &adv, &p).loss
+            actor_loss(a, &input, &old, &adv, &p, &mut Tape::new()).loss
         });
     }
 
@@ -847,7 +865,14 @@ pub(crate) mod tests {
         let lp = vars.forward(&mut tape, x, &SeqPacking::new(&input.lengths));
         let now = mixture_log_prob(&mut tape, lp, &input.actions, p.eps);
         let old: Vec<f32> = tape.value(now).column(0).iter().map(|v| v - 0.5).collect();
-        let up = actor_loss(&nets.actors[1], &input, &old, &vec![2.0; m], &p);
+        let up = actor_loss(
+            &nets.actors[1],
+            &input,
+            &old,
+            &vec![2.0; m],
+            &p,
+            &mut Tape::new(),
+        );
         assert!(up
             .grads
             .slices()
@@ -855,7 +880,14 @@ pub(crate) mod tests {
             .all(|s| s.iter().all(|&g| g == 0.0)));
         // loss = -mean(clip(r) A) = -(1.2 * 2).
         assert!((up.loss + 2.4).abs() < 1e-5, "{}", up.loss);
-        let down = actor_loss(&nets.actors[1], &input, &old, &vec![-2.0; m], &p);
+        let down = actor_loss(
+            &nets.actors[1],
+            &input,
+            &old,
+            &vec![-2.0; m],
+            &p,
+            &mut Tape::new(),
+        );
         assert!(down
             .grads
             .slices()

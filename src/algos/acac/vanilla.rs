@@ -59,6 +59,7 @@ pub(super) fn update(
     p: &UpdateParams,
     v: &VanillaParams,
     mut dropout: DropoutSource<'_>,
+    tape: &mut Tape,
 ) -> Result<UpdateTrace, UpdateError> {
     let n = nets.actors.len();
     // 1. Targets.
@@ -81,7 +82,7 @@ pub(super) fn update(
     );
     let boot_rows: usize = boot_in.rows_per_episode.iter().sum();
     let masks = dropout.next(boot_rows, &nets.critic_target)?;
-    let values = nets.critic_target.values(&boot_in, masks.as_ref());
+    let values = nets.critic_target.values(tape, &boot_in, masks.as_ref());
     let values = values.as_slice().expect("contiguous");
     let mut returns = Vec::new();
     let mut at = 0;
@@ -117,7 +118,8 @@ pub(super) fn update(
     let mut critic_losses = Vec::with_capacity(v.critic_iterations);
     for _ in 0..v.critic_iterations {
         let masks = dropout.next(rows, &nets.critic)?;
-        let (loss, mut grads) = critic_loss(&nets.critic, &critic_in, &target_col, masks.as_ref());
+        let (loss, mut grads) =
+            critic_loss(&nets.critic, &critic_in, &target_col, masks.as_ref(), tape);
         critic_losses.push(loss);
         clip(&mut grads, p.grad_clip_value, p.grad_clip_norm);
         nets.critic_adam.step(&mut nets.critic, &grads);
@@ -125,7 +127,7 @@ pub(super) fn update(
 
     // 3. Advantages from the updated critic.
     let masks = dropout.next(rows, &nets.critic)?;
-    let after = nets.critic.values(&critic_in, masks.as_ref());
+    let after = nets.critic.values(tape, &critic_in, masks.as_ref());
     let adv: Vec<f32> = returns
         .iter()
         .zip(after.iter())
@@ -147,6 +149,7 @@ pub(super) fn update(
             p.gamma,
             p.eps,
             v.entropy_weight,
+            tape,
         );
         let mut grads = step.grads;
         clip(&mut grads, p.grad_clip_value, p.grad_clip_norm);
@@ -186,14 +189,15 @@ fn actor_loss(
     gamma: f64,
     eps: f64,
     entropy_weight: f64,
+    tape: &mut Tape,
 ) -> VanillaActorStep {
     let m = input.actions.len();
     let discount = end_discounts(&input.end_steps, gamma);
-    let mut tape = Tape::new();
-    let vars = actor.bind(&mut tape);
+    tape.reset();
+    let vars = actor.bind(tape);
     let x = tape.constant(input.x.view());
-    let log_pi = vars.forward(&mut tape, x, &SeqPacking::new(&input.lengths));
-    let picked = mixture_log_prob(&mut tape, log_pi, &input.actions, eps);
+    let log_pi = vars.forward(tape, x, &SeqPacking::new(&input.lengths));
+    let picked = mixture_log_prob(tape, log_pi, &input.actions, eps);
     let pg_weight: Vec<f32> = discount.iter().zip(adv).map(|(d, a)| d * a).collect();
     let pg_weight =
         tape.constant_owned(Array2::from_shape_vec((m, 1), pg_weight).expect("a column"));
@@ -201,7 +205,7 @@ fn actor_loss(
     let pg = tape.sum(pg);
     // The whole eps-mixture, as `torch.distributions.Categorical(logits=...)` normalizes it:
     // H = -sum_a p_a log p_a.
-    let mixture = full_mixture(&mut tape, log_pi, eps);
+    let mixture = full_mixture(tape, log_pi, eps);
     let normalized = tape.log_softmax(mixture);
     let probs = tape.exp(normalized);
     let plogp = tape.mul(probs, normalized);
@@ -219,7 +223,7 @@ fn actor_loss(
     let value = tape.scalar(loss);
     tape.backward(loss);
     let mut grads = actor.zeros_like();
-    vars.grads_into(&tape, &mut grads);
+    vars.grads_into(tape, &mut grads);
     VanillaActorStep {
         loss: value,
         grads,
@@ -258,7 +262,8 @@ mod tests {
         let adv: Vec<f32> = (0..input.actions.len())
             .map(|k| (k as f32 * 0.7).sin())
             .collect();
-        let loss = |a: &AcacActor, w: f64| actor_loss(a, &input, &adv, 0.95, 0.3, w);
+        let loss =
+            |a: &AcacActor, w: f64| actor_loss(a, &input, &adv, 0.95, 0.3, w, &mut Tape::new());
         let step = loss(&nets.actors[0], 0.5);
         check_fd(&nets.actors[0], &step.grads, 1, |a| loss(a, 0.5).loss);
         // The bonus enters the loss: -(0.5 / M) sum_j gamma^t_j H_j more.
@@ -304,7 +309,15 @@ mod tests {
             critic_iterations: 2,
             entropy_weight: 0.0,
         };
-        let trace = update(&mut a, &batch, &vanilla, &v, DropoutSource::Off).unwrap();
+        let trace = update(
+            &mut a,
+            &batch,
+            &vanilla,
+            &v,
+            DropoutSource::Off,
+            &mut Tape::new(),
+        )
+        .unwrap();
         // n_train_repeat is not read: two critic steps, one actor pass.
         assert_eq!(trace.critic_losses.len(), 2);
         assert_eq!(trace.actors.len(), 1);
@@ -317,6 +330,7 @@ mod tests {
             &params(Objective::Ppo(GaeLambda::PerMacroStep)),
             GaeLambda::PerMacroStep,
             DropoutSource::Off,
+            &mut Tape::new(),
         )
         .unwrap();
         assert_ne!(a.actors[0].slices().concat(), b.actors[0].slices().concat());
