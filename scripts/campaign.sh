@@ -16,6 +16,10 @@
 #                                 # reproduction/macromarl_value: seeds 0..5 of Box Pushing 8, 10,
 #                                 # 12, 20, 30, Warehouse A, B, C and Overcooked A, B, then Box
 #                                 # Pushing's seeds 5..20
+#   scripts/campaign.sh acac      # ACAC's own method on its settings (issue 41) into
+#                                 # reproduction/acac: Box Pushing 6, 8, 10 at 5 seeds, then
+#                                 # Overcooked A, B, C and their random-start variants one seed
+#                                 # at a time, at ACAC's budgets
 #   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
 #                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
@@ -86,6 +90,24 @@ macromarl_value_lane() {
     done
 }
 
+train_acac() {
+    "$MACDEC" train --config "experiments/acac/$1.toml" --out "$OUT/acac" --methods acac \
+        --jobs 1 --quiet --no-plot "${@:2}"
+}
+
+acac_lane() {
+    set -e
+    for env in bp6 bp8 bp10; do
+        train_acac "$env" --seeds 0..5
+    done
+    # Overcooked (20M to 40M primitive steps a run): every setting's seed k before seed k + 1.
+    for seed in 0 1 2 3 4; do
+        for env in ovcA7 ovcB7 ovcC7 ovcAR7 ovcBR7 ovcCR7; do
+            train_acac "$env" --seeds "$seed"
+        done
+    done
+}
+
 lanes() {
     pids=()
     for _ in $(seq "$JOBS"); do
@@ -126,6 +148,9 @@ macromarl-rest)
 macromarl-value)
     lanes macromarl_value_lane
     ;;
+acac)
+    lanes acac_lane
+    ;;
 collect)
     find "$OUT" -name finished -type f | sort | while read -r marker; do
         dir=$(dirname "$marker")
@@ -140,14 +165,14 @@ collect)
     ;;
 status)
     # Curves are <experiment>/<curve>/ and, for MacroMARL, macromarl/<block>/<method>/ and
-    # macromarl_value/<block>/<method>/.
-    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/ "$OUT"/macromarl_value/*/*/; do
+    # macromarl_value/<block>/<method>/, and acac/<env>/<method>/ for ACAC.
+    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/ "$OUT"/macromarl_value/*/*/ "$OUT"/acac/*/*/; do
         n=$(find "$curve" -mindepth 2 -maxdepth 2 -name finished | wc -l)
         [[ $n -gt 0 ]] && echo "${curve#"$OUT"/}: $n finished"
     done
     ;;
 *)
-    echo "usage: $0 run|macromarl|macromarl-rest|macromarl-value|collect|status" >&2
+    echo "usage: $0 run|macromarl|macromarl-rest|macromarl-value|acac|collect|status" >&2
     exit 2
     ;;
 esac

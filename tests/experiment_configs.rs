@@ -304,3 +304,72 @@ fn macromarl_value_blocks_have_twenty_seeds_both_methods_and_their_scripts_rows(
         (5e-4, 1.0, 100_000)
     );
 }
+
+/// A TOML value and a JSON value as the same number, string, boolean or list.
+fn same_value(t: &toml::Value, j: &serde_json::Value) -> bool {
+    match (t, j) {
+        (toml::Value::Array(a), serde_json::Value::Array(b)) => {
+            a.len() == b.len() && a.iter().zip(b).all(|(x, y)| same_value(x, y))
+        }
+        (toml::Value::String(a), serde_json::Value::String(b)) => a == b,
+        (toml::Value::Boolean(a), serde_json::Value::Bool(b)) => a == b,
+        (toml::Value::Integer(a), _) => j.as_f64() == Some(*a as f64),
+        (toml::Value::Float(a), _) => j.as_f64() == Some(*a),
+        _ => false,
+    }
+}
+
+#[test]
+fn acacs_fifteen_settings_resolve_to_what_its_runner_uses() {
+    use macdec::algos::acac::config::{
+        acac_env_name, merged_params, ENV_KEYS, ENV_NAMES, RUNNER_KEYS,
+    };
+    use macdec::algos::acac::method::AcacMethod;
+    for name in ENV_NAMES {
+        let e = load(&format!("acac/{name}.toml"));
+        assert_eq!(
+            e.seeds,
+            (0..5).collect::<Vec<u64>>(),
+            "{name}: ACAC's seeds 0-4"
+        );
+        let large = name.ends_with("_N6");
+        assert_eq!(e.methods.len(), if large { 1 } else { 3 }, "{name}");
+        for run in e.runs().unwrap().iter().filter(|r| r.seed == 0) {
+            let Method::Acac(method) = run.method else {
+                panic!("{name}: {} is not an ACAC method", run.method)
+            };
+            // The family finds ACAC's env file from the domain's keys alone.
+            assert_eq!(acac_env_name(&run.env).as_deref(), Some(name));
+            let ours = serde_json::to_value(run.config.of::<AcacMethod>().unwrap()).unwrap();
+            let keys = run.env.keys();
+            for (key, want) in merged_params(method, Some(name)) {
+                let what = format!("{name} {method:?} `{key}`");
+                if key == "env_id" {
+                    let domain = macdec::envs::acac::domain_of(want.as_str().unwrap());
+                    assert_eq!(domain, Some(run.env.env_name()), "{what}");
+                } else if key == "step_penalty" && !name.starts_with("bp") {
+                    let got = &keys["rewardList"]["step penalty"];
+                    assert!(same_value(got, &want), "{what}: {got} vs {want}");
+                } else if ENV_KEYS.contains(&key.as_str()) {
+                    // Keys another domain's builder takes (map_type of Box Pushing, ...) are
+                    // passed by ACAC's runner and unread by the env: only the domain's own count.
+                    // ACAC's `task` 6 is the full salad, our Overcooked default.
+                    if let Some(got) = keys.get(&key).filter(|_| key != "task") {
+                        assert!(same_value(got, &want), "{what}: {got} vs {want}");
+                    }
+                } else if RUNNER_KEYS.contains(&key.as_str()) {
+                    // Only ACAC's Python runner reads these (seed, device, ...).
+                } else {
+                    let got = ours
+                        .get(&key)
+                        .unwrap_or_else(|| panic!("{what}: not in ours"));
+                    let equal = match (got.as_f64(), want.as_f64()) {
+                        (Some(a), Some(b)) => a == b,
+                        _ => *got == want,
+                    };
+                    assert!(equal, "{what}: ours {got}, ACAC's {want}");
+                }
+            }
+        }
+    }
+}

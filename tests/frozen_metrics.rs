@@ -16,6 +16,10 @@
 //!   recorded at 5060c3c before the family seam of issue 40, which trained the committed
 //!   `reproduction/macromarl` runs' numbers (audited identical). Four lanes, an update every 4
 //!   episodes, a target sync every 8, epsilon decaying over the run: every part of the loop.
+//! - `vbp`, `vwh`: MacroMARL's value-based MacDec-Q and MacCen-Q on Box Pushing 8x8 (windows
+//!   memory) and Warehouse A (episodes memory, 3 agents), recorded at 305770f before the speed-ups
+//!   of issue 44 (`experiments/macromarl_value/{bp8,wh_a}.toml` copied as `value_*.toml`). Updates
+//!   from episode 10 on, a target sync every 50 steps, epsilon and hysteresis moving over the run.
 //!
 //! The files were recorded on the AVX-512 kernel path; every kernel path has its arithmetic
 //! (`autograd::kernels::gemm`), so they are compared on every CPU.
@@ -37,12 +41,23 @@ const AC: [&str; 6] = [
     "eval_freq=8",
 ];
 
+/// The value-based groups' schedule: 13 evaluations.
+const VALUE: [&str; 7] = [
+    "total_epi=60",
+    "start_train=10",
+    "train_freq=5",
+    "target_update_freq=50",
+    "eps_l_d_steps=40",
+    "h_stable_at=40",
+    "eval_freq=5",
+];
+
 /// One group of recorded runs.
 struct Group {
     name: &'static str,
     experiment: &'static str,
     methods: &'static str,
-    /// The group's schedule ([`ICRA`] or [`AC`]).
+    /// The group's schedule ([`ICRA`], [`AC`] or [`VALUE`]).
     schedule: &'static [&'static str],
     /// Overrides beyond the schedule (later ones win).
     extra: &'static [&'static str],
@@ -50,7 +65,7 @@ struct Group {
     evaluations: usize,
 }
 
-const GROUPS: [Group; 7] = [
+const GROUPS: [Group; 9] = [
     Group {
         name: "bp",
         experiment: "fig4a_bp10.toml",
@@ -106,6 +121,22 @@ const GROUPS: [Group; 7] = [
         schedule: &AC,
         extra: &["total_epi=48"],
         evaluations: 6,
+    },
+    Group {
+        name: "vbp",
+        experiment: "value_bp8.toml",
+        methods: "mac-dec-q,mac-cen-q",
+        schedule: &VALUE,
+        extra: &[],
+        evaluations: 13,
+    },
+    Group {
+        name: "vwh",
+        experiment: "value_wh_a.toml",
+        methods: "mac-dec-q,mac-cen-q",
+        schedule: &VALUE,
+        extra: &["batch_size=8", "train_freq=50"],
+        evaluations: 13,
     },
 ];
 
@@ -189,7 +220,7 @@ fn every_method_and_domain_trains_to_the_recorded_metrics() {
             compared += 1;
         }
     }
-    assert_eq!(compared, 13 + 12);
+    assert_eq!(compared, 13 + 12 + 4);
     let _ = std::fs::remove_dir_all(&out);
 }
 

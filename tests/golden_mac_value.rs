@@ -22,7 +22,9 @@ use std::path::Path;
 
 use macdec::algos::mac_value::episode::{Episode, Recorder, Step, StepParts};
 use macdec::algos::mac_value::memory::Memory;
-use macdec::algos::mac_value::update::{update_cen, update_dec, update_dec_cen, Dims, QNet};
+use macdec::algos::mac_value::update::{
+    update_cen, update_dec, update_dec_cen, Dims, QNet, UpdateScratch,
+};
 use macdec::envs::StepOutcome;
 use macdec::nn::{GruActor, GruActorConfig, Params};
 use serde_json::Value;
@@ -248,6 +250,8 @@ fn run_case(name: &str) {
         .map(|(&cfg, w)| QNet::from_net(net_from(cfg, w), lr))
         .collect();
     let discount = case["discount"].as_f64().unwrap();
+    // One scratch for every update, as a learner keeps it.
+    let mut scratch = UpdateScratch::default();
     for (k, u) in case["updates"].as_array().unwrap().iter().enumerate() {
         if u["sync_before"].as_bool().unwrap() {
             for q in &mut nets {
@@ -264,13 +268,27 @@ fn run_case(name: &str) {
             .collect();
         let h = u["hysteresis"].as_f64().unwrap();
         let updated = match alg {
-            "MacCenQ" => update_cen(&mut nets[0], &batch, &dims, h, discount, 1).is_some(),
-            "MacDecQ" => update_dec(&mut nets, &batch, &dims, h, discount, 1).is_some(),
+            "MacCenQ" => {
+                update_cen(&mut nets[0], &batch, &dims, h, discount, 1, &mut scratch).is_some()
+            }
+            "MacDecQ" => {
+                update_dec(&mut nets, &batch, &dims, h, discount, 1, &mut scratch).is_some()
+            }
             _ => {
                 let (decs, cen) = nets.split_at_mut(2);
                 let cen_batch = if parallel { &cen_batch } else { &batch };
-                update_dec_cen(&mut cen[0], decs, cen_batch, &batch, &dims, h, discount, 1)
-                    .is_some_and(|(_, decs)| decs.len() == 2)
+                update_dec_cen(
+                    &mut cen[0],
+                    decs,
+                    cen_batch,
+                    &batch,
+                    &dims,
+                    h,
+                    discount,
+                    1,
+                    &mut scratch,
+                )
+                .is_some_and(|(_, decs)| decs.len() == 2)
             }
         };
         assert!(updated, "{name}: update {k} kept records");

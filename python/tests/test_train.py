@@ -36,6 +36,45 @@ def test_train_equals_macdec_train_byte_for_byte(tmp_path, run_cli):
     assert (dirs[0] / "metrics.csv").read_bytes() == before
 
 
+ACAC = """
+name = "acac_tiny"
+methods = ["acac", "acac-vanilla", "acac-micro-gae"]
+seeds = "0"
+
+[params]
+env_name = "BP-MA-v0"
+grid_dim = [6, 6]
+env_terminate_step = 30
+total_epi = 24
+n_env = 4
+train_freq = 4
+c_target_update_freq = 8
+eval_freq = 8
+eval_num_epi = 2
+"""
+
+
+def test_acacs_three_methods_train_from_python_as_from_the_cli(tmp_path, run_cli):
+    """Issue 41 item 7: macdec.train runs ACAC's methods like the others (metrics equal to the
+    CLI's); their runs have no policy directory yet (README "ACAC")."""
+    config = tmp_path / "acac.toml"
+    config.write_text(ACAC)
+    run_cli("train", "--config", config, "--out", tmp_path / "cli", "--quiet", "--no-plot")
+    as_dict = tomllib.loads(ACAC)
+    dirs = macdec.train(as_dict, out=tmp_path / "py")
+    assert [d.parent.name for d in dirs] == as_dict["methods"]
+    for d in dirs:
+        rel = d.relative_to(tmp_path / "py")
+        ours = metrics_without_time(d / "metrics.csv")
+        assert "acac_timesteps" in ours[0]
+        assert len(ours) > 2
+        assert ours == metrics_without_time(tmp_path / "cli" / rel / "metrics.csv"), rel
+        assert (d / "finished").exists() and not (d / "policy").exists()
+    # The three methods differ (PPO with GAE, with lambda per primitive step, vanilla PG).
+    m = [metrics_without_time(d / "metrics.csv") for d in dirs]
+    assert m[0] != m[1] and m[0] != m[2]
+
+
 def test_a_dict_config_with_methods_seeds_and_overrides(tmp_path, run_cli):
     config = tmp_path / "tiny.toml"
     config.write_text(TINY)

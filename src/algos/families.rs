@@ -25,6 +25,7 @@ macro_rules! method_families {
             Value(crate::algos::value::method::ValueMethod),
             ActorCritic(crate::algos::actor_critic::method::AcMethod),
             MacValue(crate::algos::mac_value::method::MacValueMethod),
+            Acac(crate::algos::acac::method::AcacMethod),
         }
     };
 }
@@ -417,7 +418,7 @@ mod tests {
     #[test]
     fn names_round_trip_through_from_str_and_serde() {
         let all = Method::all();
-        assert_eq!(all.len(), 15);
+        assert_eq!(all.len(), 18);
         for m in all {
             assert_eq!(m.name().parse::<Method>().unwrap(), m);
             let json = serde_json::to_string(&m).unwrap();

@@ -48,6 +48,9 @@ pub enum Schedule {
         target_update_freq: u64,
         /// Episodes between evaluations.
         eval_period: u64,
+        /// Evaluate after the update that brings the count to a multiple of `eval_period` (ACAC's
+        /// `learn()`: never at episode 0) instead of before the next batch (MacroMARL's).
+        eval_after_update: bool,
     },
 }
 
@@ -142,6 +145,11 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
 
     /// When the loop calls [`Self::train_iteration`] and [`Self::sync_targets`].
     fn schedule(&self) -> Schedule;
+    /// Whether the run's budget is spent after `episodes` training episodes. By default
+    /// `total_epi` episodes; a family that budgets otherwise (ACAC: primitive steps) says so.
+    fn is_finished(&self, episodes: u64) -> bool {
+        episodes >= self.config().total_epi() as u64
+    }
     /// The training lanes, in the order the loop steps them within one main-loop step.
     fn lanes(&self) -> Vec<LanePlan>;
     /// The state of lane `lane` at the start of its first episode (`env` just reset).

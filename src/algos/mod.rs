@@ -13,12 +13,15 @@
 //! its quick start and its learner; within a family, methods differ in exhaustive `match`es on its
 //! own enum, and nothing outside the folder matches on one of its methods.
 
+pub mod acac;
 pub mod actor_critic;
 pub mod config_checks;
 pub mod families;
 pub mod family;
 pub mod learner;
 pub mod mac_value;
+pub mod scratch;
 pub mod train_error;
 pub mod training_loop;
+pub mod update_means;
 pub mod value;

@@ -238,7 +238,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 
     /// Whether training is complete.
     pub fn is_finished(&self) -> bool {
-        self.episodes >= self.config().total_epi() as u64
+        self.learner.is_finished(self.episodes)
     }
 
     /// Run until a training episode (an [`Schedule::EpisodeBatches`] batch) finishes or
@@ -267,8 +267,14 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
                     train_freq,
                     target_update_freq,
                     eval_period,
+                    eval_after_update,
                 } => {
-                    self.batch_iteration(train_freq, target_update_freq, eval_period)?;
+                    self.batch_iteration(
+                        train_freq,
+                        target_update_freq,
+                        eval_period,
+                        eval_after_update,
+                    )?;
                     true
                 }
             };
@@ -284,14 +290,15 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
 
     /// One update of MacroMARL's loop (`docs/MACROMARL.md` §2.3): evaluate when due, reset every
     /// lane, step them in lockstep until `train_freq` episodes completed, train, count exactly
-    /// `train_freq` episodes, sync targets when due.
+    /// `train_freq` episodes, sync targets when due (then evaluate when due, for ACAC's order).
     fn batch_iteration(
         &mut self,
         train_freq: u64,
         target_update_freq: u64,
         eval_period: u64,
+        eval_after_update: bool,
     ) -> Result<(), TrainError> {
-        if self.episodes.is_multiple_of(eval_period) {
+        if !eval_after_update && self.episodes.is_multiple_of(eval_period) {
             self.evaluate()?;
         }
         self.learner.begin_batch(self.episodes);
@@ -313,6 +320,9 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         self.step += 1;
         if self.episodes.is_multiple_of(target_update_freq) {
             self.learner.sync_targets();
+        }
+        if eval_after_update && self.episodes.is_multiple_of(eval_period) {
+            self.evaluate()?;
         }
         Ok(())
     }

@@ -12,12 +12,13 @@ use std::path::{Path, PathBuf};
 pub(super) struct Selection {
     /// Experiment TOML (see experiments/); without it, a short built-in run of the methods'
     /// family: Box Pushing 10x10 (ICRA methods), MacroMARL's Box Pushing 6x6 (actor-critic) or
-    /// 8x8 (MacroMARL value-based).
+    /// 8x8 (MacroMARL value-based), ACAC's bp6 (ACAC).
     #[arg(long)]
     pub(super) config: Option<PathBuf>,
     /// Comma-separated methods: dec-hddrqn, cen-ddrqn, our1, our1-r, our2 (ICRA 2020), mac-iac,
     /// mac-cac, naive-mac-iacc, naive-mac-iasc, mac-iaicc, mac-iaisc (MacroMARL actor-critic),
-    /// mac-dec-q, mac-cen-q (MacroMARL value-based).
+    /// mac-dec-q, mac-cen-q (MacroMARL value-based), acac, acac-vanilla, acac-micro-gae (ACAC,
+    /// ICML 2025).
     #[arg(long, value_delimiter = ',')]
     pub(super) methods: Option<Vec<String>>,
     /// Seeds: a range `0..40` (end exclusive) or a list `0,3,7`.

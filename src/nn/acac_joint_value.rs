@@ -49,21 +49,13 @@ impl ValueLayer {
         if sd.has(&format!("{prefix}stddev")) {
             return Ok(ValueLayer::PopArt(PopArt::from_state_dict(sd, prefix)?));
         }
-        let name = format!("{prefix}weight");
-        let (out, input) = sd.shape2(&name)?;
-        Ok(ValueLayer::Linear(LinearParams {
-            weight: sd.array2(&name, out, input)?,
-            bias: sd.array1(&format!("{prefix}bias"), out)?,
-        }))
+        Ok(ValueLayer::Linear(sd.linear(prefix)?))
     }
 
     /// Every tensor under `prefix`, in `state_dict` order.
     pub fn named(&self, prefix: &str) -> Vec<(String, ArrayViewD<'_, f32>)> {
         match self {
-            ValueLayer::Linear(l) => vec![
-                (format!("{prefix}weight"), l.weight.view().into_dyn()),
-                (format!("{prefix}bias"), l.bias.view().into_dyn()),
-            ],
+            ValueLayer::Linear(l) => l.named(prefix),
             ValueLayer::PopArt(p) => p.named(prefix),
         }
     }

@@ -6,15 +6,33 @@
 /// The first index of the maximal value among `(index, value)` pairs, in the order given;
 /// `None` when there are none.
 pub fn first_argmax(items: impl IntoIterator<Item = (usize, f32)>) -> Option<usize> {
-    let mut items = items.into_iter();
-    let (mut best, mut best_q) = items.next()?;
+    let mut best = FirstArgmax::default();
     for (idx, q) in items {
-        if q > best_q || (best_q.is_nan() && !q.is_nan()) {
-            best = idx;
-            best_q = q;
+        best.offer(idx, q);
+    }
+    best.index()
+}
+
+/// [`first_argmax`] fed one pair at a time, for callers that visit their candidates (a
+/// recursion over agents) instead of iterating them.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FirstArgmax {
+    best: Option<(usize, f32)>,
+}
+
+impl FirstArgmax {
+    /// The next candidate, in order.
+    pub fn offer(&mut self, idx: usize, q: f32) {
+        match self.best {
+            Some((_, best_q)) if !(q > best_q || (best_q.is_nan() && !q.is_nan())) => {}
+            _ => self.best = Some((idx, q)),
         }
     }
-    Some(best)
+
+    /// The index chosen so far; `None` before any offer.
+    pub fn index(&self) -> Option<usize> {
+        self.best.map(|(idx, _)| idx)
+    }
 }
 
 /// The index of the first maximal value of `q` (0 for an empty slice).

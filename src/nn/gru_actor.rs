@@ -16,7 +16,7 @@
 
 use std::path::Path;
 
-use ndarray::ArrayViewD;
+use ndarray::{Array2, ArrayView2, ArrayViewD};
 
 use rand_chacha::ChaCha8Rng;
 
@@ -25,6 +25,8 @@ use super::init::LEAKY_RELU_GAIN;
 use super::linear::LinearVars;
 use super::params::{flat, flat_mut, GruParams, LinearParams, Params};
 use super::safetensors_io::{read_exact, tensor_shape, WeightsError};
+use crate::autograd::kernels::dense::linear_forward;
+use crate::autograd::kernels::gru::{gru_step, GruWeights};
 use crate::autograd::{Activation, GruVars, SeqPacking, Tape, Var};
 
 /// The actor's tensors, in its `state_dict` order.
@@ -305,11 +307,50 @@ impl GruActor {
         x: Var,
         packing: &SeqPacking,
     ) -> Var {
+        self.forward_with_hidden(tape, vars, x, packing).0
+    }
+
+    /// [`Self::forward`]'s output and the GRU's output h: [K, H] it came from (packed order),
+    /// from which [`Self::continue_rows`] goes on.
+    pub fn forward_with_hidden(
+        &self,
+        tape: &mut Tape,
+        vars: &GruActorVars,
+        x: Var,
+        packing: &SeqPacking,
+    ) -> (Var, Var) {
         let a1 = vars.fc1.forward(tape, x, LEAKY);
         let a2 = vars.fc2.forward(tape, a1, LEAKY);
         let h = vars.gru.forward_packed(tape, a2, packing);
         let a3 = vars.fc3.forward(tape, h, LEAKY);
-        vars.fc4.forward(tape, a3, Activation::Identity)
+        (vars.fc4.forward(tape, a3, Activation::Identity), h)
+    }
+
+    /// fc4's output [n, out] one step past the ends of n sequences, values only (no tape): x:
+    /// [n, in] each sequence's next input, h: [n, H] the GRU's output at its last position (from
+    /// [`Self::forward_with_hidden`]). It runs the kernels the taped forward runs, each row on
+    /// its own, so row i has the bits [`Self::forward`] gives sequence i made one step longer
+    /// with that input. Panics if the sizes do not match the net.
+    pub fn continue_rows(&self, x: ArrayView2<f32>, h: ArrayView2<f32>) -> Array2<f32> {
+        let n = x.nrows();
+        let layer = |p: &LinearParams, input: ArrayView2<f32>, act| {
+            let mut y = Array2::zeros((n, p.output()));
+            linear_forward(input, p.weight.view(), flat(&p.bias), act, y.view_mut());
+            y
+        };
+        let a1 = layer(&self.fc1, x, LEAKY);
+        let a2 = layer(&self.fc2, a1.view(), LEAKY);
+        let g = &self.gru;
+        let weights = GruWeights {
+            w_ih: g.weight_ih.view(),
+            w_hh: g.weight_hh.view(),
+            b_ih: flat(&g.bias_ih),
+            b_hh: flat(&g.bias_hh),
+        };
+        let mut h_next = Array2::zeros((n, self.config().hidden));
+        gru_step(a2.view(), &weights, h, &mut h_next);
+        let a3 = layer(&self.fc3, h_next.view(), LEAKY);
+        layer(&self.fc4, a3.view(), Activation::Identity)
     }
 }
 
@@ -515,5 +556,72 @@ mod tests {
         ));
         let err = GruActor::from_safetensors_bytes(&q, Path::new("q")).unwrap_err();
         assert!(err.to_string().contains("gru.weight_hh_l0"), "{err}");
+    }
+
+    #[test]
+    fn continuing_from_the_last_h_gives_the_bits_of_a_longer_unroll() {
+        use ndarray::Axis;
+        use rand::SeedableRng;
+        // Widths past one vector of lanes and not a multiple of it, ragged lengths.
+        let cfg = GruActorConfig {
+            input: 7,
+            mlp: [33, 20],
+            hidden: 19,
+            output: 5,
+        };
+        let net = GruActor::new(cfg, &mut ChaCha8Rng::seed_from_u64(5));
+        let short = [4, 1, 3, 4];
+        let long: Vec<usize> = short.iter().map(|l| l + 1).collect();
+        let starts: Vec<usize> = long
+            .iter()
+            .scan(0, |at, &l| {
+                *at += l;
+                Some(*at - l)
+            })
+            .collect();
+        let x = Array2::from_shape_fn((long.iter().sum(), cfg.input), |(i, j)| {
+            ((i * 31 + j * 7) as f32 * 0.37).sin()
+        });
+        // Unroll sequences of `lengths`, sequence s from x's row starts[s]: (out, h) in flat order.
+        let unroll = |lengths: &[usize]| {
+            let mut tape = Tape::new();
+            let vars = net.bind(&mut tape);
+            let packing = SeqPacking::new(lengths);
+            let rows: Vec<usize> = lengths
+                .iter()
+                .zip(&starts)
+                .flat_map(|(&l, &s)| s..s + l)
+                .collect();
+            let packed: Vec<usize> = packing.packed_to_flat().iter().map(|&f| rows[f]).collect();
+            let xv = tape.constant(x.select(Axis(0), &packed).view());
+            let (out, h) = net.forward_with_hidden(&mut tape, &vars, xv, &packing);
+            let out = tape.gather_rows(out, packing.flat_to_packed());
+            let h = tape.gather_rows(h, packing.flat_to_packed());
+            (tape.value(out).to_owned(), tape.value(h).to_owned())
+        };
+        let (out_short, h_short) = unroll(&short);
+        let (out_long, _) = unroll(&long);
+        let bits = |a: ArrayView2<f32>| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        let (mut at_short, mut next_x, mut last_h, mut want) = (0, vec![], vec![], vec![]);
+        for (s, &l) in short.iter().enumerate() {
+            let long_rows = starts[s]..starts[s] + l;
+            assert_eq!(
+                bits(out_short.slice(ndarray::s![at_short..at_short + l, ..])),
+                bits(out_long.slice(ndarray::s![long_rows, ..])),
+                "sequence {s}: the longer unroll's first {l} outputs"
+            );
+            next_x.push(starts[s] + l);
+            last_h.push(at_short + l - 1);
+            want.push(starts[s] + l);
+            at_short += l;
+        }
+        let got = net.continue_rows(
+            x.select(Axis(0), &next_x).view(),
+            h_short.select(Axis(0), &last_h).view(),
+        );
+        assert_eq!(
+            bits(got.view()),
+            bits(out_long.select(Axis(0), &want).view())
+        );
     }
 }

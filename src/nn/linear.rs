@@ -1,7 +1,7 @@
 //! The fully connected layer: initialization, binding to a tape, and the single-row forward used
 //! when acting.
 
-use ndarray::Axis;
+use ndarray::{ArrayViewD, Axis};
 use rand_chacha::ChaCha8Rng;
 
 use super::init::xavier_uniform;
@@ -15,6 +15,14 @@ impl LinearParams {
         let mut p = LinearParams::zeros(input, output);
         p.weight = xavier_uniform(output, input, gain, rng);
         p
+    }
+
+    /// The tensors under `prefix`: `weight`, `bias`.
+    pub fn named(&self, prefix: &str) -> Vec<(String, ArrayViewD<'_, f32>)> {
+        vec![
+            (format!("{prefix}weight"), self.weight.view().into_dyn()),
+            (format!("{prefix}bias"), self.bias.view().into_dyn()),
+        ]
     }
 
     /// Input size.

@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 use ndarray::{Array1, Array2};
 use safetensors::tensor::{Dtype, SafeTensors};
 
+use super::gru::GRU_TENSOR_NAMES;
+use super::params::{GruParams, LinearParams};
 use super::safetensors_io::WeightsError;
 
 /// The tensors of one safetensors file (borrowing its bytes).
@@ -115,6 +117,31 @@ impl<'a> StateDict<'a> {
         Ok(Array2::from_shape_vec((rows, cols), v).expect("values() checked the shape"))
     }
 
+    /// `nn.Linear` under `prefix` (`weight` `[out, in]`, `bias` `[out]`), its sizes read from the
+    /// file.
+    pub fn linear(&self, prefix: &str) -> Result<LinearParams, WeightsError> {
+        let name = format!("{prefix}weight");
+        let (out, input) = self.shape2(&name)?;
+        Ok(LinearParams {
+            weight: self.array2(&name, out, input)?,
+            bias: self.array1(&format!("{prefix}bias"), out)?,
+        })
+    }
+
+    /// A one-layer `nn.GRU` under `prefix` (e.g. `encoder.gru.`), its sizes read from
+    /// `weight_ih_l0` [3H, in].
+    pub fn gru(&self, prefix: &str) -> Result<GruParams, WeightsError> {
+        let n = GRU_TENSOR_NAMES.map(|t| format!("{prefix}{t}"));
+        let (gates, input) = self.shape2(&n[0])?;
+        let hidden = gates / 3;
+        Ok(GruParams {
+            weight_ih: self.array2(&n[0], 3 * hidden, input)?,
+            weight_hh: self.array2(&n[1], 3 * hidden, hidden)?,
+            bias_ih: self.array1(&n[2], 3 * hidden)?,
+            bias_hh: self.array1(&n[3], 3 * hidden)?,
+        })
+    }
+
     /// Tensor `name` as a scalar (shape [], e.g. PopArt's `debiasing_term`).
     pub fn scalar(&self, name: &str) -> Result<f32, WeightsError> {
         Ok(self.values(name, &[])?[0])
@@ -140,7 +167,9 @@ impl<'a> StateDict<'a> {
         names.sort();
         for name in names {
             let is_known = known.iter().any(|k| k == name);
-            if !is_known && !ignored.iter().any(|s| ends_with_segments(name, s)) {
+            // Segments count from the prefix: `time_embedding.weight` under `init/actor0/`.
+            let within = &name[prefix.len()..];
+            if !is_known && !ignored.iter().any(|s| ends_with_segments(within, s)) {
                 let mut expected: Vec<&str> = known
                     .iter()
                     .filter_map(|k| k.strip_prefix(prefix))

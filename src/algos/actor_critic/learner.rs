@@ -17,7 +17,9 @@ use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
+use crate::algos::scratch::Scratch;
 use crate::algos::training_loop::TrainError;
+use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::GruActorState;
@@ -47,26 +49,14 @@ pub struct AcLearner {
     eps: f64,
     /// The last `train_freq` completed training episodes (`Memory_epi`).
     memory: VecDeque<Episode>,
-    critic_loss_sum: f64,
-    actor_loss_sum: f64,
-    loss_count: u64,
-    return_sum: f64,
-    return_count: u64,
+    /// Losses and training returns since the last metrics row.
+    means: UpdateMeans,
+    /// The updates' tape, reset after every pass.
     #[serde(skip, default)]
-    tape: TapeCell,
+    tape: Scratch<Tape>,
     /// The acting path's scratch.
     #[serde(skip, default)]
     buffers: ActBuffers,
-}
-
-/// The learner's tape: scratch, rebuilt empty after a resume.
-#[derive(Debug, Default)]
-struct TapeCell(Tape);
-
-impl Clone for TapeCell {
-    fn clone(&self) -> Self {
-        TapeCell::default()
-    }
 }
 
 impl AcLearner {
@@ -204,12 +194,8 @@ impl Learner for AcLearner {
             explore_rng: rngs.explore,
             eps: config.eps_start,
             memory: VecDeque::new(),
-            critic_loss_sum: 0.0,
-            actor_loss_sum: 0.0,
-            loss_count: 0,
-            return_sum: 0.0,
-            return_count: 0,
-            tape: TapeCell::default(),
+            means: UpdateMeans::default(),
+            tape: Scratch::default(),
             buffers: ActBuffers::default(),
         })
     }
@@ -232,6 +218,7 @@ impl Learner for AcLearner {
             train_freq: c.train_freq as u64,
             target_update_freq: c.c_target_update_freq as u64,
             eval_period: c.eval_period() as u64,
+            eval_after_update: false,
         }
     }
 
@@ -281,8 +268,7 @@ impl Learner for AcLearner {
         if !outcome.done {
             return Ok(false);
         }
-        self.return_sum += lane.recorder.returns().discounted;
-        self.return_count += 1;
+        self.means.record_return(lane.recorder.returns().discounted);
         self.memory.push_back(lane.recorder.episode().clone());
         while self.memory.len() > self.c().train_freq {
             self.memory.pop_front();
@@ -315,16 +301,11 @@ impl Learner for AcLearner {
             .flatten()
             .map(|a| f64::from(a.loss))
             .collect();
-        if critic.iter().chain(&actor).any(|l| !l.is_finite()) {
+        if self.means.record_update(&critic, &actor).is_err() {
             return Err(self.non_finite("loss", episodes));
         }
         if !self.nets.is_finite() {
             return Err(self.non_finite("parameter", episodes));
-        }
-        if !critic.is_empty() && !actor.is_empty() {
-            self.critic_loss_sum += critic.iter().sum::<f64>() / critic.len() as f64;
-            self.actor_loss_sum += actor.iter().sum::<f64>() / actor.len() as f64;
-            self.loss_count += 1;
         }
         Ok(())
     }
@@ -402,19 +383,8 @@ impl Learner for AcLearner {
     }
 
     fn metric_values(&mut self) -> Vec<Option<f64>> {
-        let mean = |sum: f64, n: u64| (n > 0).then(|| sum / n as f64);
-        let row = vec![
-            Some(self.eps),
-            mean(self.critic_loss_sum, self.loss_count),
-            mean(self.actor_loss_sum, self.loss_count),
-            mean(self.return_sum, self.return_count),
-        ];
-        self.critic_loss_sum = 0.0;
-        self.actor_loss_sum = 0.0;
-        self.loss_count = 0;
-        self.return_sum = 0.0;
-        self.return_count = 0;
-        row
+        let [critic, actor, ret] = self.means.take_row();
+        vec![Some(self.eps), critic, actor, ret]
     }
 
     fn progress(&self) -> String {

@@ -9,7 +9,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::episode::{all_available, joint_obs};
-use super::update::{conditional_argmax, masked_argmax, Dims, QNet};
+use super::update::{conditional_argmax, for_each_allowed_joint, masked_argmax, Dims, QNet};
 use crate::envs::MacroEnv;
 use crate::nn::GruActorState;
 
@@ -83,19 +83,8 @@ pub fn act_cen<E: MacroEnv>(
         if e.rng.gen::<f64>() < e.epsilon {
             // Uniform over every available joint macro-action, not conditioned (the reference's
             // exploration; the env then ignores the busy agents' components).
-            let joint_avail: Vec<f32> = (0..dims.n_joint())
-                .map(|j| {
-                    let ok = dims.unravel(j).iter().enumerate().all(|(i, &a)| {
-                        let lo: usize = dims.n_actions[..i].iter().sum();
-                        avail[lo + a] != 0.0
-                    });
-                    if ok {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
+            let mut joint_avail = vec![0.0f32; dims.n_joint()];
+            for_each_allowed_joint(dims, &vec![None; n], &avail, &mut |j| joint_avail[j] = 1.0);
             joint = random_available(&joint_avail, e.rng);
         }
     }

@@ -14,10 +14,11 @@ use super::config::MacValueConfig;
 use super::episode::Recorder;
 use super::memory::Memory;
 use super::method::{MacValueMethod, QNets};
-use super::update::{update_cen, update_dec, update_dec_cen, Dims, QNet};
+use super::update::{update_cen, update_dec, update_dec_cen, Dims, QNet, UpdateScratch};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
+use crate::algos::scratch::Scratch;
 use crate::algos::train_error::TrainError;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::{GruActorConfig, GruActorState, Params};
@@ -54,6 +55,9 @@ pub struct MacValueLearner {
     loss_sum: f64,
     loss_count: u64,
     episodes: u64,
+    /// The updates' tape and buffers.
+    #[serde(skip, default)]
+    scratch: Scratch<UpdateScratch>,
 }
 
 impl MacValueLearner {
@@ -180,6 +184,7 @@ impl Learner for MacValueLearner {
             loss_sum: 0.0,
             loss_count: 0,
             episodes: 0,
+            scratch: Scratch::default(),
         })
     }
 
@@ -302,6 +307,7 @@ impl Learner for MacValueLearner {
                     self.hysteresis,
                     c.discount,
                     c.sub_trace_len,
+                    &mut self.scratch.0,
                 )
                 .map(|t| t.iter().map(|t| t.loss).collect())
                 .unwrap_or_default(),
@@ -312,6 +318,7 @@ impl Learner for MacValueLearner {
                     self.hysteresis,
                     c.discount,
                     c.sub_trace_len,
+                    &mut self.scratch.0,
                 )
                 .map(|t| vec![t.loss])
                 .unwrap_or_default(),
@@ -327,6 +334,7 @@ impl Learner for MacValueLearner {
                         self.hysteresis,
                         c.discount,
                         c.sub_trace_len,
+                        &mut self.scratch.0,
                     )
                     .map(|(cen, decs)| {
                         std::iter::once(cen.loss)

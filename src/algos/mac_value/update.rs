@@ -5,7 +5,10 @@
 //!    for MacDec-Q, any agent's for MacCen-Q), dropping sequences with fewer than
 //!    `sub_trace_len`;
 //! 2. Q(h, a) from one unroll over the squeezed observations; the next-history values from the
-//!    continuation [o_0, o'_0, o'_1, ...] of the same unroll, its outputs from position 1 on;
+//!    continuation [o_0, o'_0, o'_1, ...] of the same unroll, its outputs from position 1 on
+//!    (for the online net, when the continuation repeats the observations bit for bit, those
+//!    outputs are the first unroll's from position 1 plus one step past each end, which is how
+//!    they are computed then);
 //! 3. double Q: a' = argmax of the online net's next values among the available macro-actions
 //!    (MacCen-Q: the conditional argmax, keeping the running macro-actions of agents that did not
 //!    finish), valued by the target net;
@@ -24,12 +27,12 @@
 //! centralized net's batch from the memory its own exploration filled and the agents' batch from
 //! the memory the agents' exploration filled.
 
-use ndarray::ArrayView1;
+use ndarray::{Array2, ArrayView1, ArrayView2};
 use serde::{Deserialize, Serialize};
 
 use super::episode::Step;
 use crate::autograd::{SeqPacking, Tape, Var};
-use crate::nn::argmax::first_argmax;
+use crate::nn::argmax::{first_argmax, FirstArgmax};
 use crate::nn::loss::hysteretic_td_loss;
 use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig};
 
@@ -115,12 +118,70 @@ pub fn conditional_argmax(
     avail: &[f32],
     dims: &Dims,
 ) -> usize {
-    let allowed = |j: usize| {
-        dims.unravel(j).iter().enumerate().all(|(i, &a)| {
-            avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
-        })
-    };
-    first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j))).unwrap_or(0)
+    let mut best = FirstArgmax::default();
+    for_each_allowed_joint(dims, running, avail, &mut |j| best.offer(j, q[j]));
+    best.index().unwrap_or(0)
+}
+
+/// Calls `f` with every joint macro-action index whose every component is available in `avail`
+/// and equals `running[i]` where that is `Some`, in increasing order. The allowed joint actions
+/// are the product of each agent's allowed actions, visited in C order (agent 0 most
+/// significant), which is increasing index order; nothing else is visited or allocated.
+pub fn for_each_allowed_joint(
+    dims: &Dims,
+    running: &[Option<usize>],
+    avail: &[f32],
+    f: &mut impl FnMut(usize),
+) {
+    /// Agent `i` on, its mask at avail[lo..], the components before it giving `prefix`.
+    fn visit(
+        n_actions: &[usize],
+        running: &[Option<usize>],
+        avail: &[f32],
+        (i, lo, prefix): (usize, usize, usize),
+        f: &mut impl FnMut(usize),
+    ) {
+        let n = n_actions[i];
+        let actions = match running[i] {
+            Some(r) => r..(r + 1).min(n),
+            None => 0..n,
+        };
+        let last = i + 1 == n_actions.len();
+        for a in actions {
+            if avail[lo + a] == 0.0 {
+                continue;
+            }
+            if last {
+                f(prefix * n + a);
+            } else {
+                visit(
+                    n_actions,
+                    running,
+                    avail,
+                    (i + 1, lo + n, prefix * n + a),
+                    f,
+                );
+            }
+        }
+    }
+    if dims.n_actions.is_empty() {
+        // One joint macro-action, of no components.
+        f(0);
+    } else {
+        visit(&dims.n_actions, running, avail, (0, 0, 0), f);
+    }
+}
+
+/// Into `running`: each agent's macro-action in `r` where it did not end there (it keeps running),
+/// `None` where it ended.
+fn running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
+    running.clear();
+    running.extend(
+        r.valid
+            .iter()
+            .zip(&r.actions)
+            .map(|(&v, &a)| (!v).then_some(a)),
+    );
 }
 
 /// The available macro-action with the largest value (`get_masked_Q` then `max`); 0 when none is.
@@ -151,7 +212,8 @@ struct Squeezed {
 
 impl Squeezed {
     /// Keep the records `keep` accepts, reading each with `obs`/`next_obs` (the net's input
-    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go.
+    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go. Also
+    /// gives the kept records, in the same (flat) order.
     fn of<'a>(
         batch: &[&'a [Step]],
         sub_trace_len: usize,
@@ -159,20 +221,31 @@ impl Squeezed {
         keep: impl Fn(&Step) -> bool,
         input: impl Fn(&'a [f32]) -> &'a [f32],
         fields: impl Fn(&Step) -> (usize, f32, f32),
-    ) -> (Squeezed, Vec<Vec<&'a Step>>) {
+    ) -> (Squeezed, Vec<&'a Step>) {
         let mut s = Squeezed {
             width,
             ..Squeezed::default()
         };
-        let mut kept_records = Vec::new();
+        // At most every record is kept: room for all of them up front.
+        let most: usize = batch.iter().map(|seq| seq.len()).sum();
+        let mut records: Vec<&'a Step> = Vec::with_capacity(most);
+        s.x.reserve(most * width);
+        s.x_next.reserve((most + batch.len()) * width);
+        for v in [&mut s.rewards, &mut s.gammas, &mut s.terminals] {
+            v.reserve(most);
+        }
+        s.actions.reserve(most);
         for seq in batch {
-            let kept: Vec<&Step> = seq.iter().filter(|r| keep(r)).collect();
-            if kept.is_empty() || kept.len() < sub_trace_len {
+            let first = records.len();
+            records.extend(seq.iter().filter(|r| keep(r)));
+            let n = records.len() - first;
+            if n == 0 || n < sub_trace_len {
+                records.truncate(first);
                 continue;
             }
-            s.lengths.push(kept.len());
-            s.x_next.extend_from_slice(input(&kept[0].obs));
-            for r in &kept {
+            s.lengths.push(n);
+            s.x_next.extend_from_slice(input(&records[first].obs));
+            for r in &records[first..] {
                 s.x.extend_from_slice(input(&r.obs));
                 s.x_next.extend_from_slice(input(&r.next_obs));
                 let (a, rew, g) = fields(r);
@@ -181,55 +254,159 @@ impl Squeezed {
                 s.gammas.push(g);
                 s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
             }
-            kept_records.push(kept);
         }
-        (s, kept_records)
+        (s, records)
+    }
+
+    /// The joint squeeze (the centralized net's): records where any agent's macro-action ended,
+    /// the joint observation, joint macro-action, reward and gamma.
+    fn joint<'a>(
+        batch: &[&'a [Step]],
+        sub_trace_len: usize,
+        dims: &Dims,
+    ) -> (Squeezed, Vec<&'a Step>) {
+        Squeezed::of(
+            batch,
+            sub_trace_len,
+            dims.obs_sizes.iter().sum(),
+            Step::any_valid,
+            |o| o,
+            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+        )
+    }
+
+    /// Whether every sequence's continuation starts with its observations, bit for bit
+    /// ([o_0, o'_0, ..., o'_{L-2}] = [o_0, o_1, ..., o_{L-1}]: a record's next observation is the
+    /// following record's, as when observations are held between an agent's decisions). Then the
+    /// online net's next values are its training unroll's outputs one position on, and one step
+    /// past each sequence's end.
+    fn continues(&self) -> bool {
+        let w = self.width;
+        let mut at = 0;
+        for (seq, &l) in self.lengths.iter().enumerate() {
+            // The continuation of sequence `seq` starts at row at + seq of x_next.
+            let observed = &self.x[at * w..(at + l) * w];
+            let continued = &self.x_next[(at + seq) * w..(at + seq + l) * w];
+            if observed
+                .iter()
+                .zip(continued)
+                .any(|(a, b)| a.to_bits() != b.to_bits())
+            {
+                return false;
+            }
+            at += l;
+        }
+        true
     }
 
     fn total(&self) -> usize {
         self.actions.len()
     }
-
-    /// Row index of each record's next value in the continuation's flat layout.
-    fn next_rows(&self) -> Vec<usize> {
-        let mut rows = Vec::with_capacity(self.total());
-        let mut start = 0;
-        for &l in &self.lengths {
-            rows.extend(start + 1..start + 1 + l);
-            start += l + 1;
-        }
-        rows
-    }
 }
 
-/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`), in flat order.
-fn outputs(
+/// Memory the TD steps reuse from one update to the next (the learner keeps it as
+/// [`crate::algos::scratch::Scratch`]): the autodiff tape, reset after every pass, one gradient
+/// buffer per net shape, and the next values. Every buffer is overwritten before it is read, so
+/// a fresh one gives the same numbers.
+#[derive(Debug, Default)]
+pub struct UpdateScratch {
+    tape: Tape,
+    grads: Vec<GruActor>,
+    online_next: Vec<f32>,
+    target_next: Vec<f32>,
+}
+
+/// The gradient buffer for nets of `cfg`'s shape (made on first use).
+fn grads_for(grads: &mut Vec<GruActor>, cfg: GruActorConfig) -> &mut GruActor {
+    let at = match grads.iter().position(|g| g.config() == cfg) {
+        Some(at) => at,
+        None => {
+            grads.push(GruActor::zeros(cfg));
+            grads.len() - 1
+        }
+    };
+    &mut grads[at]
+}
+
+/// `net`'s outputs over sequences of `lengths` (flat rows `x` of `width`) and its GRU's outputs
+/// h, both in packed order (see [`SeqPacking`]).
+fn packed_outputs(
     tape: &mut Tape,
     net: &GruActor,
     x: &[f32],
     width: usize,
-    lengths: &[usize],
-) -> (Var, crate::nn::GruActorVars) {
+    packing: &SeqPacking,
+) -> (Var, Var, crate::nn::GruActorVars) {
     let vars = net.bind(tape);
-    let packing = SeqPacking::new(lengths);
     let mut packed = tape.pool().array(packing.total(), width);
-    for (p, &f) in packing.packed_to_flat().iter().enumerate() {
-        packed
-            .row_mut(p)
-            .assign(&ArrayView1::from(&x[f * width..(f + 1) * width]));
+    let rows = packed
+        .as_slice_mut()
+        .expect("pool arrays are contiguous")
+        .chunks_exact_mut(width);
+    for (row, &f) in rows.zip(packing.packed_to_flat()) {
+        row.copy_from_slice(&x[f * width..(f + 1) * width]);
     }
     let packed = tape.constant_owned(packed);
-    let out = net.forward(tape, &vars, packed, &packing);
-    (tape.gather_rows(out, packing.flat_to_packed()), vars)
+    let (out, h) = net.forward_with_hidden(tape, &vars, packed, packing);
+    (out, h, vars)
 }
 
-/// Values (no gradient) of `net` over the continuation sequences, at each record's next row.
-fn next_values(net: &GruActor, s: &Squeezed) -> Vec<Vec<f32>> {
-    let mut tape = Tape::new();
+/// Values (no gradient) of `net` over the continuation sequences at each record's next row, into
+/// `into` as [records, n_out] row-major; the tape is left empty.
+fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32>) {
     let lengths: Vec<usize> = s.lengths.iter().map(|l| l + 1).collect();
-    let (out, _) = outputs(&mut tape, net, &s.x_next, s.width, &lengths);
+    let packing = SeqPacking::new(&lengths);
+    let (out, _, _) = packed_outputs(tape, net, &s.x_next, s.width, &packing);
     let v = tape.value(out);
-    s.next_rows().iter().map(|&r| v.row(r).to_vec()).collect()
+    into.clear();
+    let mut start = 0;
+    for &l in &s.lengths {
+        // Record k of the sequence is continuation position k + 1.
+        for f in start + 1..start + 1 + l {
+            into.extend(v.row(packing.flat_to_packed()[f]).iter());
+        }
+        start += l + 1;
+    }
+    tape.reset();
+}
+
+/// The online net's next values when `s` [`Squeezed::continues`], into `into` as [records,
+/// n_out]: from its training unroll's outputs `out` and GRU outputs `h` (packed by `packing`),
+/// record k's is the output at its sequence's next position, and a sequence's last record's is one
+/// step past the end from h there with input o'_{L-1} ([`GruActor::continue_rows`]): the bits a
+/// separate unroll over the continuation gives.
+fn next_values_from_unroll(
+    net: &GruActor,
+    out: ArrayView2<f32>,
+    h: ArrayView2<f32>,
+    packing: &SeqPacking,
+    s: &Squeezed,
+    into: &mut Vec<f32>,
+) {
+    let (w, n_seq) = (s.width, s.lengths.len());
+    let to_packed = packing.flat_to_packed();
+    let mut last_x = Array2::zeros((n_seq, w));
+    let mut last_h = Array2::zeros((n_seq, h.ncols()));
+    let mut at = 0;
+    for (seq, &l) in s.lengths.iter().enumerate() {
+        // o'_{L-1}: the last row of the sequence's continuation (L + 1 rows from at + seq).
+        let c = at + seq + l;
+        last_x
+            .row_mut(seq)
+            .assign(&ArrayView1::from(&s.x_next[c * w..(c + 1) * w]));
+        last_h.row_mut(seq).assign(&h.row(to_packed[at + l - 1]));
+        at += l;
+    }
+    let past = net.continue_rows(last_x.view(), last_h.view());
+    into.clear();
+    let mut at = 0;
+    for (seq, &l) in s.lengths.iter().enumerate() {
+        for &p in &to_packed[at + 1..at + l] {
+            into.extend(out.row(p).iter());
+        }
+        into.extend(past.row(seq).iter());
+        at += l;
+    }
 }
 
 /// What one net's TD step computed.
@@ -250,33 +427,52 @@ pub struct TdTrace {
 fn td_step(
     q: &mut QNet,
     s: &Squeezed,
-    pick: impl Fn(usize, &[f32]) -> usize,
+    mut pick: impl FnMut(usize, &[f32]) -> usize,
     hysteresis: f64,
     discount: f64,
+    scratch: &mut UpdateScratch,
 ) -> TdTrace {
-    let online_next = next_values(&q.net, s);
-    let target_next = next_values(&q.target, s);
+    let UpdateScratch {
+        tape,
+        grads,
+        online_next,
+        target_next,
+    } = scratch;
+    let n_out = q.net.config().output;
+    // One online unroll gives both Q(h, a) and the next values when the continuation repeats
+    // the observations (checked, bit for bit); otherwise the continuation is unrolled apart.
+    let continues = s.continues();
+    if !continues {
+        next_values(tape, &q.net, s, online_next);
+    }
+    next_values(tape, &q.target, s, target_next);
+    let packing = SeqPacking::new(&s.lengths);
+    let (values, h, vars) = packed_outputs(tape, &q.net, &s.x, s.width, &packing);
+    if continues {
+        let (out, h) = (tape.value(values), tape.value(h));
+        next_values_from_unroll(&q.net, out, h, &packing, s, online_next);
+    }
     let next_actions: Vec<usize> = online_next
-        .iter()
+        .chunks_exact(n_out)
         .enumerate()
         .map(|(k, row)| pick(k, row))
         .collect();
     let d = discount as f32;
     let targets: Vec<f32> = (0..s.total())
         .map(|k| {
-            let boot = target_next[k][next_actions[k]];
+            let boot = target_next[k * n_out + next_actions[k]];
             s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
         })
         .collect();
-    let mut tape = Tape::new();
-    let (values, vars) = outputs(&mut tape, &q.net, &s.x, s.width, &s.lengths);
-    let y = ndarray::Array1::from(targets.clone());
-    let loss = hysteretic_td_loss(&mut tape, values, &s.actions, y.view(), hysteresis as f32);
+    let values = tape.gather_rows(values, packing.flat_to_packed());
+    let y = ArrayView1::from(&targets[..]);
+    let loss = hysteretic_td_loss(tape, values, &s.actions, y, hysteresis as f32);
     let loss_value = tape.scalar(loss);
     tape.backward(loss);
-    let mut grads = GruActor::zeros(q.net.config());
-    vars.grads_into(&tape, &mut grads);
-    q.adam.step(&mut q.net, &grads);
+    let grads = grads_for(grads, q.net.config());
+    vars.grads_into(tape, grads);
+    tape.reset();
+    q.adam.step(&mut q.net, grads);
     TdTrace {
         lengths: s.lengths.clone(),
         next_actions,
@@ -286,7 +482,7 @@ fn td_step(
 }
 
 /// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
-/// (then no net changes).
+/// (then no net changes). `scratch` is reused memory (see [`UpdateScratch`]).
 pub fn update_dec(
     nets: &mut [QNet],
     batch: &[&[Step]],
@@ -294,6 +490,7 @@ pub fn update_dec(
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
+    scratch: &mut UpdateScratch,
 ) -> Option<Vec<TdTrace>> {
     let squeezed: Vec<_> = (0..nets.len())
         .map(|i| {
@@ -315,8 +512,7 @@ pub fn update_dec(
         nets.iter_mut()
             .zip(&squeezed)
             .enumerate()
-            .map(|(i, (q, (s, kept)))| {
-                let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+            .map(|(i, (q, (s, records)))| {
                 let masks = dims.action_range(i);
                 td_step(
                     q,
@@ -324,13 +520,15 @@ pub fn update_dec(
                     |k, row| masked_argmax(row, &records[k].next_avail[masks.clone()]),
                     hysteresis,
                     discount,
+                    scratch,
                 )
             })
             .collect(),
     )
 }
 
-/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing.
+/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing. `scratch`
+/// is reused memory (see [`UpdateScratch`]).
 pub fn update_cen(
     q: &mut QNet,
     batch: &[&[Step]],
@@ -338,36 +536,25 @@ pub fn update_cen(
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
+    scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
-    let width = dims.obs_sizes.iter().sum();
-    let (s, kept) = Squeezed::of(
-        batch,
-        sub_trace_len,
-        width,
-        Step::any_valid,
-        |o| o,
-        |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-    );
+    let (s, records) = Squeezed::joint(batch, sub_trace_len, dims);
     if s.lengths.is_empty() {
         return None;
     }
-    let records: Vec<&Step> = kept.iter().flatten().copied().collect();
+    let mut running = Vec::with_capacity(dims.n_actions.len());
     Some(td_step(
         q,
         &s,
         |k, row| {
             let r = records[k];
             // Agents whose macro-action did not end keep it (`get_conditional_action`).
-            let running: Vec<Option<usize>> = r
-                .valid
-                .iter()
-                .zip(&r.actions)
-                .map(|(&v, &a)| (!v).then_some(a))
-                .collect();
+            running_actions(r, &mut running);
             conditional_argmax(row, &running, &r.next_avail, dims)
         },
         hysteresis,
         discount,
+        scratch,
     ))
 }
 
@@ -376,7 +563,8 @@ pub fn update_cen(
 /// `cen_batch`, then every agent's net in `decs` steps on `dec_batch` with the centralized net's
 /// choices there. `None` when `cen_batch`'s joint squeeze kept nothing; the decentralized traces
 /// are empty when `dec_batch`'s joint squeeze or some agent's squeeze kept nothing (the reference
-/// returns before their optimizer steps, after the centralized one).
+/// returns before their optimizer steps, after the centralized one). `scratch` is reused memory
+/// (see [`UpdateScratch`]).
 #[allow(clippy::too_many_arguments)]
 pub fn update_dec_cen(
     cen: &mut QNet,
@@ -387,28 +575,13 @@ pub fn update_dec_cen(
     hysteresis: f64,
     discount: f64,
     sub_trace_len: usize,
+    scratch: &mut UpdateScratch,
 ) -> Option<(TdTrace, Vec<TdTrace>)> {
-    let width = dims.obs_sizes.iter().sum();
-    let joint = |batch: &[&'_ [Step]]| {
-        let (s, kept) = Squeezed::of(
-            batch,
-            sub_trace_len,
-            width,
-            Step::any_valid,
-            |o| o,
-            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-        );
-        let records: Vec<Step> = kept.iter().flatten().map(|&r| r.clone()).collect();
-        (s, records)
-    };
-    let choose = |records: &[Step], k: usize, row: &[f32]| {
-        let r = &records[k];
-        let running: Vec<Option<usize>> = r
-            .valid
-            .iter()
-            .zip(&r.actions)
-            .map(|(&v, &a)| (!v).then_some(a))
-            .collect();
+    let joint = |batch| Squeezed::joint(batch, sub_trace_len, dims);
+    let choose = |records: &[&Step], k: usize, row: &[f32]| {
+        let r = records[k];
+        let mut running = Vec::with_capacity(dims.n_actions.len());
+        running_actions(r, &mut running);
         conditional_argmax(row, &running, &r.next_avail, dims)
     };
     let (s, records) = joint(cen_batch);
@@ -416,13 +589,22 @@ pub fn update_dec_cen(
         return None;
     }
     // The centralized step is plain double Q (no hysteresis in `QLearn_squ_dec_cen_0`).
-    let cen_trace = td_step(cen, &s, |k, row| choose(&records, k, row), 1.0, discount);
+    let cen_trace = td_step(
+        cen,
+        &s,
+        |k, row| choose(&records, k, row),
+        1.0,
+        discount,
+        scratch,
+    );
     let (s, records) = joint(dec_batch);
     if s.lengths.is_empty() {
         return Some((cen_trace, Vec::new()));
     }
-    let joint_next: Vec<usize> = next_values(&cen.net, &s)
-        .iter()
+    next_values(&mut scratch.tape, &cen.net, &s, &mut scratch.online_next);
+    let joint_next: Vec<usize> = scratch
+        .online_next
+        .chunks_exact(cen.net.config().output)
         .enumerate()
         .map(|(k, row)| choose(&records, k, row))
         .collect();
@@ -455,7 +637,7 @@ pub fn update_dec_cen(
                 .filter(|(r, _)| r.valid[i])
                 .map(|(_, &j)| dims.unravel(j)[i])
                 .collect();
-            td_step(q, s, |k, _| a_next[k], hysteresis, discount)
+            td_step(q, s, |k, _| a_next[k], hysteresis, discount, scratch)
         })
         .collect();
     Some((cen_trace, dec_traces))
@@ -482,5 +664,115 @@ mod tests {
         let avail = [1.0, 1.0, 1.0, 1.0, 0.0];
         assert_eq!(conditional_argmax(&q, &[Some(1), None], &avail, &dims), 4);
         assert_eq!(masked_argmax(&[1.0, 5.0, 3.0], &[1.0, 0.0, 1.0]), 2);
+    }
+
+    #[test]
+    fn the_conditional_argmax_is_the_first_maximum_over_the_allowed_joint_indices() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let dims = Dims {
+            obs_sizes: vec![1, 1, 1],
+            n_actions: vec![3, 2, 4],
+        };
+        for _ in 0..2000 {
+            // Few distinct values (ties), some NaN, masks and running actions at random.
+            let q: Vec<f32> = (0..dims.n_joint())
+                .map(|_| match rng.gen_range(0..8) {
+                    0 => f32::NAN,
+                    k => k as f32,
+                })
+                .collect();
+            let avail: Vec<f32> = (0..9).map(|_| rng.gen_range(0..4).min(1) as f32).collect();
+            let running: Vec<Option<usize>> = dims
+                .n_actions
+                .iter()
+                .map(|&n| rng.gen_bool(0.3).then(|| rng.gen_range(0..n)))
+                .collect();
+            // The definition: every joint index, filtered, in order.
+            let allowed = |j: usize| {
+                dims.unravel(j).iter().enumerate().all(|(i, &a)| {
+                    avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
+                })
+            };
+            let want = first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j)))
+                .unwrap_or(0);
+            assert_eq!(conditional_argmax(&q, &running, &avail, &dims), want);
+        }
+    }
+
+    fn dims() -> Dims {
+        Dims {
+            obs_sizes: vec![1, 1],
+            n_actions: vec![2, 3],
+        }
+    }
+
+    /// Records of one episode whose observations are held between decisions: record t+1's
+    /// observation is record t's next one. Agent 0 finishes every other step, agent 1 always.
+    fn held_episode(len: usize) -> Vec<Step> {
+        let obs = |t: usize| vec![(t / 2) as f32 * 0.3 - 0.5, (t as f32 * 0.7).sin()];
+        (0..len)
+            .map(|t| Step {
+                obs: obs(t),
+                actions: vec![t % 2, (t + 1) % 3],
+                rewards: vec![0.1 * t as f32, -0.2],
+                gammas: vec![1.0, 1.0],
+                joint_reward: 0.05,
+                joint_gamma: 1.0,
+                next_obs: obs(t + 1),
+                next_avail: vec![1.0; 5],
+                terminal: t + 1 == len,
+                valid: vec![t % 2 == 1, true],
+            })
+            .collect()
+    }
+
+    #[test]
+    fn next_values_from_the_training_unroll_are_the_separate_unrolls_bits() {
+        use rand::SeedableRng;
+        let episode = held_episode(9);
+        let batch: Vec<&[Step]> = vec![&episode[..], &episode[2..7], &episode[5..6]];
+        let agent = |i: usize| {
+            Squeezed::of(
+                &batch,
+                1,
+                1,
+                |r| r.valid[i],
+                move |o| &o[i..i + 1],
+                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+            )
+            .0
+        };
+        // Agent 0's squeeze (every other record), agent 1's (every record), the joint one.
+        let squeezes = [agent(0), agent(1), Squeezed::joint(&batch, 1, &dims()).0];
+        for (k, s) in squeezes.iter().enumerate() {
+            assert!(s.continues(), "squeeze {k}");
+            let cfg = GruActorConfig {
+                input: s.width,
+                mlp: [17, 9],
+                hidden: 21,
+                output: 6,
+            };
+            let net = GruActor::new(cfg, &mut rand_chacha::ChaCha8Rng::seed_from_u64(k as u64));
+            let mut tape = Tape::new();
+            let mut apart = Vec::new();
+            next_values(&mut tape, &net, s, &mut apart);
+            let packing = SeqPacking::new(&s.lengths);
+            let (out, h, _) = packed_outputs(&mut tape, &net, &s.x, s.width, &packing);
+            let mut shared = Vec::new();
+            let (out, h) = (tape.value(out), tape.value(h));
+            next_values_from_unroll(&net, out, h, &packing, s, &mut shared);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(apart.len(), s.total() * cfg.output, "squeeze {k}");
+            assert_eq!(bits(&shared), bits(&apart), "squeeze {k}");
+        }
+    }
+
+    #[test]
+    fn a_next_observation_that_is_not_the_following_one_is_unrolled_apart() {
+        let mut episode = held_episode(6);
+        assert!(Squeezed::joint(&[&episode[..]], 1, &dims()).0.continues());
+        episode[2].next_obs[1] += 1.0;
+        assert!(!Squeezed::joint(&[&episode[..]], 1, &dims()).0.continues());
     }
 }

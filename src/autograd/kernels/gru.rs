@@ -162,6 +162,54 @@ pub fn gru_forward(
     }
 }
 
+/// One GRU step for n rows from given states, values only (no cache, nothing to differentiate):
+/// x: [n, in], h_prev: [n, H], h_out: [n, H] (overwritten). It makes the products and the cell
+/// pass [`gru_forward`] makes at every step after a sequence's first, and each row's numbers
+/// depend on that row alone, so continuing sequences from their last h with this step gives the
+/// bits of unrolling them one step longer. Panics on inconsistent shapes.
+pub fn gru_step(
+    x: ArrayView2<f32>,
+    w: &GruWeights,
+    h_prev: ArrayView2<f32>,
+    h_out: &mut Array2<f32>,
+) {
+    w.check();
+    let (n, h) = (x.nrows(), w.hidden());
+    assert_eq!(x.ncols(), w.input(), "gru step: x must be [n, in]");
+    assert_eq!(h_prev.dim(), (n, h), "gru step: h_prev must be [n, H]");
+    assert_eq!(h_out.dim(), (n, h), "gru step: h_out must be [n, H]");
+    if n == 0 {
+        return;
+    }
+    let mut gates = Array2::<f32>::zeros((n, 3 * h));
+    gemm(
+        x,
+        transposed(w.w_ih).view(),
+        gates.view_mut(),
+        Mode::Overwrite,
+    );
+    let mut rec = Array2::<f32>::zeros((n, 3 * h));
+    gemm(
+        h_prev,
+        transposed(w.w_hh).view(),
+        rec.view_mut(),
+        Mode::Overwrite,
+    );
+    let h_prev = h_prev.as_standard_layout();
+    let mut hn = vec![0.0f32; n * h];
+    forward_cells(
+        gates.as_slice_mut().expect("fresh arrays are contiguous"),
+        rec.as_slice().expect("fresh arrays are contiguous"),
+        &w.cell_bias(),
+        h_prev.as_slice().expect("standard layout is contiguous"),
+        &mut hn,
+        h_out
+            .as_slice_mut()
+            .expect("gru step: h_out must be contiguous"),
+        h,
+    );
+}
+
 /// The GRU cell for L lanes: input-side pre-activations `a` [r, z, n], recurrent-side ones `b`
 /// (both without biases), the biases [b_ir + b_hr, b_iz + b_hz, b_in, b_hn] and h_prev in;
 /// activated gates [r, z, n], b_n = W_hn h_prev + b_hn and h out.

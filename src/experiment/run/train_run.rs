@@ -445,8 +445,14 @@ fn save_checkpoint(
 }
 
 /// Write the trainer's nets as the run's policy files (see [`crate::policy_files`]): the list its
-/// learner hands over, whatever the family.
+/// learner hands over, whatever the family. A learner that hands over none (ACAC, whose actors
+/// read a time embedding that policy files cannot carry yet; README "ACAC") leaves the run
+/// without a `policy/` directory, and the commands that read one say it is missing.
 fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<(), RunError> {
+    let nets = trainer.saved_nets();
+    if nets.is_empty() {
+        return Ok(());
+    }
     let config = trainer.config();
     let run = RunInfo {
         experiment: spec.experiment.clone(),
@@ -468,7 +474,7 @@ fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<()
         AgentLayout::of_domain(&domain),
         config.discount(),
         run,
-        &trainer.saved_nets(),
+        &nets,
     )
     .map_err(Box::new)?;
     Ok(())
