@@ -418,8 +418,9 @@ fn take_linear(
     p
 }
 
-/// x <- x - max - log(sum(exp(x - max))), as `torch.log_softmax` computes it.
-fn log_softmax_in_place(x: &mut [f32]) {
+/// x <- x - max - log(sum(exp(x - max))), as `torch.log_softmax` computes it (ACAC's acting
+/// actors use it too).
+pub(crate) fn log_softmax_in_place(x: &mut [f32]) {
     let max = x.iter().copied().fold(f32::NEG_INFINITY, f32::max);
     let sum: f32 = x.iter().map(|v| (v - max).exp()).sum();
     let lse = sum.ln();

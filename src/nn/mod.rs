@@ -60,6 +60,7 @@ pub use gpt2::{gpt2_tensor_names, Gpt2, Gpt2Config, Gpt2Vars};
 pub use gpt2_block::{Gpt2Block, Gpt2BlockVars, GPT2_BLOCK_BUFFERS, GPT2_BLOCK_TENSOR_NAMES};
 pub use gpt2_dropout::{dropout_mask, BlockDropout, Gpt2Dropout};
 pub use gru::{GruState, GRU_TENSOR_NAMES};
+pub(crate) use gru_actor::log_softmax_in_place;
 pub use gru_actor::{
     GruActor, GruActorConfig, GruActorState, GruActorVars, GRU_ACTOR_TENSOR_NAMES,
 };

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::autograd::{Activation, GruVars, SeqPacking, Tape, Var};
 use crate::nn::init::LEAKY_RELU_GAIN;
+use crate::nn::log_softmax_in_place;
 use crate::nn::{
     AcacJointValue, AcacJointValueVars, Gpt2, Gpt2Config, Gpt2Dropout, GruParams, GruState,
     LayerNormParams, LayerNormVars, LinearParams, LinearVars, Params, PopArt, StateDict, ValueHead,
@@ -592,16 +593,6 @@ fn layer_norm_row(x: &[f32], ln: &LayerNormParams, out: &mut [f32]) {
     let inv = 1.0 / (var + ln.eps).sqrt();
     for (k, o) in out.iter_mut().enumerate() {
         *o = (x[k] - mean) * inv * ln.weight[k] + ln.bias[k];
-    }
-}
-
-/// x <- x - max - log(sum(exp(x - max))), as `torch.log_softmax` computes it.
-fn log_softmax_in_place(x: &mut [f32]) {
-    let max = x.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-    let sum: f32 = x.iter().map(|v| (v - max).exp()).sum();
-    let lse = sum.ln();
-    for v in x.iter_mut() {
-        *v = *v - max - lse;
     }
 }
 

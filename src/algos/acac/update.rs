@@ -309,6 +309,27 @@ pub(super) fn critic_input<'e>(
     input
 }
 
+/// The critic's input for training on `batch`: each joint macro-step's observations, at its
+/// start's time, each agent's encoder stepping where it started a macro-action.
+pub(super) fn training_critic_input(
+    nets: &AcacNets,
+    batch: &AcacBatch,
+    duplicate: bool,
+) -> CriticInput {
+    critic_input(
+        nets,
+        &batch.episodes,
+        |_, e| {
+            (
+                &e.critic_obs,
+                Cow::Borrowed(&e.critic_time),
+                &e.critic_starts,
+            )
+        },
+        duplicate,
+    )
+}
+
 /// log pi of the taken macro-actions under the eps-mixture, on `tape`:
 /// logsumexp(log pi + ln(1 - eps), ln(eps) - ln |A|) as ACAC's actor forward computes it.
 pub(super) fn mixture_log_prob(
@@ -611,18 +632,7 @@ pub(super) fn ppo_update(
         let mixed = mixture_log_prob(tape, log_pi, &input.actions, p.eps);
         old_log_pi.push(tape.value(mixed).column(0).to_vec());
     }
-    let critic_in = critic_input(
-        nets,
-        &batch.episodes,
-        |_, e| {
-            (
-                &e.critic_obs,
-                Cow::Borrowed(&e.critic_time),
-                &e.critic_starts,
-            )
-        },
-        p.duplicate,
-    );
+    let critic_in = training_critic_input(nets, batch, p.duplicate);
     let rows = targets.len();
     let target_col = Array2::from_shape_vec((rows, 1), targets.clone()).expect("a column");
     let mut trace = UpdateTrace {

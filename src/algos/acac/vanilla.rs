@@ -27,8 +27,9 @@ use super::batch::AcacBatch;
 use super::nets::AcacActor;
 use super::nstep::episode_n_step_returns;
 use super::update::{
-    actor_input, clip, critic_input, critic_loss, end_discounts, mixture_log_prob, AcacNets,
-    ActorInput, ActorTrace, DropoutSource, UpdateError, UpdateParams, UpdateTrace,
+    actor_input, clip, critic_input, critic_loss, end_discounts, mixture_log_prob,
+    training_critic_input, AcacNets, ActorInput, ActorTrace, DropoutSource, UpdateError,
+    UpdateParams, UpdateTrace,
 };
 use crate::autograd::{SeqPacking, Tape};
 
@@ -101,18 +102,7 @@ pub(super) fn update(
     }
 
     // 2. The critic.
-    let critic_in = critic_input(
-        nets,
-        &batch.episodes,
-        |_, e| {
-            (
-                &e.critic_obs,
-                Cow::Borrowed(&e.critic_time),
-                &e.critic_starts,
-            )
-        },
-        p.duplicate,
-    );
+    let critic_in = training_critic_input(nets, batch, p.duplicate);
     let rows = returns.len();
     let target_col = Array2::from_shape_vec((rows, 1), returns.clone()).expect("a column");
     let mut critic_losses = Vec::with_capacity(v.critic_iterations);
