@@ -69,14 +69,14 @@ impl Tape {
     /// A trainable leaf: gradients flow into it. Copies `value` into a recycled buffer.
     pub fn param(&mut self, value: ArrayView2<f32>) -> Var {
         let mut a = self.pool.array(value.nrows(), value.ncols());
-        a.assign(&value);
+        copy_into(&mut a, value);
         self.push(a, Op::Leaf, true)
     }
 
     /// A constant leaf (inputs, targets, masks): no gradient is computed for it.
     pub fn constant(&mut self, value: ArrayView2<f32>) -> Var {
         let mut a = self.pool.array(value.nrows(), value.ncols());
-        a.assign(&value);
+        copy_into(&mut a, value);
         self.push(a, Op::Leaf, false)
     }
 
@@ -208,6 +208,15 @@ impl Tape {
             "Var used after Tape::reset (it belongs to an earlier update)"
         );
         v.index as usize
+    }
+}
+
+/// dst = src for a pool array of src's shape: one memcpy when src is contiguous in row-major
+/// order, else element by element.
+fn copy_into(dst: &mut Array2<f32>, src: ArrayView2<f32>) {
+    match (src.as_slice(), dst.as_slice_mut()) {
+        (Some(s), Some(d)) => d.copy_from_slice(s),
+        _ => dst.assign(&src),
     }
 }
 

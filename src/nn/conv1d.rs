@@ -92,8 +92,7 @@ pub struct Conv1dVars {
 impl Conv1dVars {
     /// y = x W + b for x: [rows, in].
     pub fn forward(&self, tape: &mut Tape, x: Var) -> Var {
-        let xw = tape.matmul(x, self.weight);
-        tape.add_bias(xw, self.bias)
+        tape.matmul_bias(x, self.weight, self.bias)
     }
 
     /// Copy the gradients into `into` (zero where none reached a tensor).

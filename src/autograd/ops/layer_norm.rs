@@ -8,11 +8,91 @@
 //! xhat_j = (x_j - mu) r,  y_j = xhat_j gain_j + bias_j
 //! ```
 
-use ndarray::{Array2, Zip};
+use ndarray::Array2;
 
 use super::{put, Op};
 use crate::autograd::kernels::gemm::Mode;
 use crate::autograd::tape::{GradCx, Tape, Var};
+
+/// Rows whose statistics are summed side by side: independent chains the CPU overlaps, each
+/// row's additions still in column order (so the same bits as one row at a time).
+const ROWS: usize = 8;
+
+/// N rows of the forward: each row's mean and variance are `Iterator::sum`s (the sum's start
+/// value, then one addition per column in order), run for the N rows side by side.
+// Column j of every row in turn: the loops are over columns, then rows, on purpose.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn forward_rows<const N: usize>(
+    xb: &[f32],
+    gain: &[f32],
+    bias: &[f32],
+    eps: f32,
+    yb: &mut [f32],
+    stats: &mut [f32],
+) {
+    let d = gain.len();
+    let xr: [&[f32]; N] = std::array::from_fn(|r| &xb[r * d..(r + 1) * d]);
+    let zero = std::iter::empty::<f64>().sum::<f64>();
+    let mut sum = [zero; N];
+    for j in 0..d {
+        for r in 0..N {
+            sum[r] += xr[r][j] as f64;
+        }
+    }
+    let mean = sum.map(|s| s / d as f64);
+    let mut sq = [zero; N];
+    for j in 0..d {
+        for r in 0..N {
+            sq[r] += (xr[r][j] as f64 - mean[r]).powi(2);
+        }
+    }
+    for r in 0..N {
+        let var = sq[r] / d as f64;
+        let (mean, rstd) = (mean[r] as f32, (1.0 / (var + eps as f64).sqrt()) as f32);
+        stats[2 * r] = mean;
+        stats[2 * r + 1] = rstd;
+        let yr = &mut yb[r * d..(r + 1) * d];
+        for (((y, &x), &g), &b) in yr.iter_mut().zip(xr[r]).zip(gain).zip(bias) {
+            *y = (x - mean) * rstd * g + b;
+        }
+    }
+}
+
+/// N rows of dx: per row two f32 sums over the columns in order, for the N rows side by side.
+/// xh: the rows' xhat, rstd: their 1 / sqrt(var + eps).
+#[inline(always)]
+fn dx_rows<const N: usize>(
+    gb: &[f32],
+    xh: &[f32],
+    gain: &[f32],
+    rstd: [f32; N],
+    db: &mut [f32],
+    mode: Mode,
+) {
+    let d = gain.len();
+    let gr: [&[f32]; N] = std::array::from_fn(|r| &gb[r * d..(r + 1) * d]);
+    let xr: [&[f32]; N] = std::array::from_fn(|r| &xh[r * d..(r + 1) * d]);
+    let (mut sum_dxhat, mut sum_dxhat_xhat) = ([0.0f32; N], [0.0f32; N]);
+    for j in 0..d {
+        for r in 0..N {
+            let dxhat = gr[r][j] * gain[j];
+            sum_dxhat[r] += dxhat;
+            sum_dxhat_xhat[r] += dxhat * xr[r][j];
+        }
+    }
+    for r in 0..N {
+        let (mean_dxhat, mean_dxhat_xhat) = (sum_dxhat[r] / d as f32, sum_dxhat_xhat[r] / d as f32);
+        let dr = &mut db[r * d..(r + 1) * d];
+        for j in 0..d {
+            let v = rstd[r] * (gr[r][j] * gain[j] - mean_dxhat - xr[r][j] * mean_dxhat_xhat);
+            match mode {
+                Mode::Overwrite => dr[j] = v,
+                Mode::Accumulate => dr[j] += v,
+            }
+        }
+    }
+}
 
 impl Tape {
     /// y = (x - mean) / sqrt(var + eps) * gain + bias row by row, with x: [m, d], gain and
@@ -28,24 +108,32 @@ impl Tape {
         // (mean, 1 / sqrt(var + eps)) per row, kept for the backward.
         let mut stats = self.pool().array(m, 2);
         {
+            let contiguous = "tape arrays are contiguous";
             let (vx, vg, vb) = (self.value(x), self.value(gain), self.value(bias));
-            let (gain, bias) = (vg.row(0), vb.row(0));
-            Zip::from(y.rows_mut())
-                .and(stats.rows_mut())
-                .and(vx.rows())
-                .for_each(|mut yr, mut st, xr| {
-                    // Sums in f64: a row's statistics do not depend on f32 summation order.
-                    let mean = xr.iter().map(|&v| v as f64).sum::<f64>() / d as f64;
-                    let var = xr.iter().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / d as f64;
-                    let (mean, rstd) = (mean as f32, (1.0 / (var + eps as f64).sqrt()) as f32);
-                    st[0] = mean;
-                    st[1] = rstd;
-                    Zip::from(&mut yr)
-                        .and(&xr)
-                        .and(&gain)
-                        .and(&bias)
-                        .for_each(|y, &x, &g, &b| *y = (x - mean) * rstd * g + b);
-                });
+            let (xs, gain, bias) = (
+                vx.as_slice().expect(contiguous),
+                vg.as_slice().expect(contiguous),
+                vb.as_slice().expect(contiguous),
+            );
+            let ys = y.as_slice_mut().expect(contiguous);
+            let st = stats.as_slice_mut().expect(contiguous);
+            // Sums in f64: a row's statistics do not depend on f32 summation order.
+            let mut r0 = 0;
+            while r0 < m {
+                let (rows, at) = if m - r0 >= ROWS {
+                    (ROWS, r0 * d)
+                } else {
+                    (1, r0 * d)
+                };
+                let (xb, yb) = (&xs[at..at + rows * d], &mut ys[at..at + rows * d]);
+                let sb = &mut st[2 * r0..2 * (r0 + rows)];
+                if rows == ROWS {
+                    forward_rows::<ROWS>(xb, gain, bias, eps, yb, sb);
+                } else {
+                    forward_rows::<1>(xb, gain, bias, eps, yb, sb);
+                }
+                r0 += rows;
+            }
         }
         let stats = self.push_aux(stats);
         self.push_op(
@@ -108,27 +196,31 @@ pub(super) fn layer_norm_backward(
         }
         cx.pool.give_array(sums);
     }
+    let m = vx.nrows();
+    let mut xhats = cx.pool.array(ROWS, d);
     if let Some((dst, mode)) = cx.slot(x) {
         let ds = dst.as_slice_mut().expect(contiguous);
-        for (r, (gr, dr)) in gs.chunks_exact(d).zip(ds.chunks_exact_mut(d)).enumerate() {
-            xhat_row(r, xh);
-            let (mut sum_dxhat, mut sum_dxhat_xhat) = (0.0f32, 0.0f32);
-            for j in 0..d {
-                let dxhat = gr[j] * gain_s[j];
-                sum_dxhat += dxhat;
-                sum_dxhat_xhat += dxhat * xh[j];
+        let xhs = xhats.as_slice_mut().expect(contiguous);
+        let mut r0 = 0;
+        while r0 < m {
+            let rows = if m - r0 >= ROWS { ROWS } else { 1 };
+            for r in 0..rows {
+                xhat_row(r0 + r, &mut xhs[r * d..(r + 1) * d]);
             }
-            let (mean_dxhat, mean_dxhat_xhat) = (sum_dxhat / d as f32, sum_dxhat_xhat / d as f32);
-            let rstd = stats_s[2 * r + 1];
-            for j in 0..d {
-                let v = rstd * (gr[j] * gain_s[j] - mean_dxhat - xh[j] * mean_dxhat_xhat);
-                match mode {
-                    Mode::Overwrite => dr[j] = v,
-                    Mode::Accumulate => dr[j] += v,
-                }
+            let (gb, db) = (
+                &gs[r0 * d..(r0 + rows) * d],
+                &mut ds[r0 * d..(r0 + rows) * d],
+            );
+            let rstd = |r: usize| stats_s[2 * (r0 + r) + 1];
+            if rows == ROWS {
+                dx_rows::<ROWS>(gb, xhs, gain_s, std::array::from_fn(rstd), db, mode);
+            } else {
+                dx_rows::<1>(gb, xhs, gain_s, [rstd(0)], db, mode);
             }
+            r0 += rows;
         }
     }
+    cx.pool.give_array(xhats);
     cx.pool.give_array(xhat);
 }
 
@@ -208,6 +300,62 @@ mod tests {
         for (a, b) in g1.iter().zip(&g2) {
             assert_close(a, b, 1e-5);
         }
+    }
+
+    /// The forward and the x gradient one row at a time, as written before rows were
+    /// interleaved: the interleaved kernels must give the same bits.
+    fn row_at_a_time(
+        x: &Array2<f32>,
+        gain: &[f32],
+        bias: &[f32],
+        g: &Array2<f32>,
+    ) -> [Array2<f32>; 2] {
+        let (m, d) = x.dim();
+        let (mut y, mut dx) = (Array2::zeros((m, d)), Array2::zeros((m, d)));
+        for r in 0..m {
+            let xr = x.row(r);
+            let mean = xr.iter().map(|&v| v as f64).sum::<f64>() / d as f64;
+            let var = xr.iter().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / d as f64;
+            let (mean, rstd) = (mean as f32, (1.0 / (var + 1e-5f32 as f64).sqrt()) as f32);
+            let xh: Vec<f32> = xr.iter().map(|&v| (v - mean) * rstd).collect();
+            for j in 0..d {
+                y[[r, j]] = (xr[j] - mean) * rstd * gain[j] + bias[j];
+            }
+            let (mut s1, mut s2) = (0.0f32, 0.0f32);
+            for j in 0..d {
+                let dxhat = g[[r, j]] * gain[j];
+                s1 += dxhat;
+                s2 += dxhat * xh[j];
+            }
+            let (m1, m2) = (s1 / d as f32, s2 / d as f32);
+            for j in 0..d {
+                dx[[r, j]] = rstd * (g[[r, j]] * gain[j] - m1 - xh[j] * m2);
+            }
+        }
+        [y, dx]
+    }
+
+    #[test]
+    fn interleaved_rows_give_the_bits_of_one_row_at_a_time() {
+        // 19 rows: two full blocks of 8 and a partial one; one row of negative zeros.
+        let mut inputs = random_inputs(&[(19, 37), (1, 37), (1, 37), (19, 37)], Inputs::Any, 8);
+        inputs[0] *= 7.0;
+        inputs[0].row_mut(3).fill(-0.0);
+        let mut t = Tape::new();
+        let v: Vec<Var> = inputs[..3].iter().map(|a| t.param(a.view())).collect();
+        let y = t.layer_norm(v[0], v[1], v[2], 1e-5);
+        t.backward_with(y, inputs[3].view());
+        let [want_y, want_dx] = row_at_a_time(
+            &inputs[0],
+            inputs[1].as_slice().unwrap(),
+            inputs[2].as_slice().unwrap(),
+            &inputs[3],
+        );
+        assert_eq!(t.value(y).mapv(f32::to_bits), want_y.mapv(f32::to_bits));
+        assert_eq!(
+            t.grad(v[0]).unwrap().mapv(f32::to_bits),
+            want_dx.mapv(f32::to_bits)
+        );
     }
 
     #[test]

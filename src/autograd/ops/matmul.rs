@@ -40,8 +40,22 @@ impl Tape {
         assert_eq!(bs, (1, n), "add_bias: bias must be [1, {n}], got {bs:?}");
         let mut y = self.pool().array(m, n);
         y.assign(&self.value(x));
-        y += &self.value(bias);
+        add_bias_rows(&mut y, self.value(bias));
         self.push_op(y, Op::AddBias { x, bias }, &[x, bias])
+    }
+
+    /// y = a · b + bias with a: [m, k], b: [k, n] and the [1, n] row `bias` added to every row
+    /// (GPT-2's `Conv1D`): `matmul` then `add_bias` in one node, the same arithmetic (the
+    /// product, then one addition per element) without the intermediate copy and its gradient.
+    /// Panics if the inner sizes differ or bias is not [1, n].
+    pub fn matmul_bias(&mut self, a: Var, b: Var, bias: Var) -> Var {
+        let ((m, k), (k2, n), bs) = (self.shape(a), self.shape(b), self.shape(bias));
+        assert_eq!(k, k2, "matmul_bias: [{m}, {k}] · [{k2}, {n}]");
+        assert_eq!(bs, (1, n), "matmul_bias: bias must be [1, {n}], got {bs:?}");
+        let mut y = self.pool().array(m, n);
+        gemm(self.value(a), self.value(b), y.view_mut(), Mode::Overwrite);
+        add_bias_rows(&mut y, self.value(bias));
+        self.push_op(y, Op::MatMulBias { a, b, bias }, &[a, b, bias])
     }
 
     /// The fused linear layer y = act(x · w^T + b): x: [m, k], w: [n, k], b: [1, n]. One node
@@ -61,6 +75,32 @@ impl Tape {
         );
         self.push_op(y, Op::Linear { x, w, b, act }, &[x, w, b])
     }
+}
+
+/// y += bias row by row (y: [m, n] from the pool, bias: [1, n]).
+fn add_bias_rows(y: &mut Array2<f32>, bias: ArrayView2<f32>) {
+    let n = y.ncols();
+    let b = bias.as_slice().expect("tape arrays are contiguous");
+    if n == 0 {
+        return;
+    }
+    for row in y
+        .as_slice_mut()
+        .expect("pool arrays are contiguous")
+        .chunks_exact_mut(n)
+    {
+        for (v, &b) in row.iter_mut().zip(b) {
+            *v += b;
+        }
+    }
+}
+
+// y = a b + 1 bias: as add_bias (bias) then matmul (a, b), with g for the product's gradient.
+pub(super) fn matmul_bias_backward(a: Var, b: Var, bias: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    if let Some((d, mode)) = cx.slot(bias) {
+        column_sums_into(g.view(), d, mode);
+    }
+    matmul_backward(a, b, g, cx);
 }
 
 // y = a b: da = g b^T, db = a^T g
@@ -237,6 +277,43 @@ mod tests {
             &[(5, 3), (3, 3), (1, 3)],
             Inputs::Any,
         );
+    }
+
+    #[test]
+    fn matmul_bias_matches_finite_differences() {
+        grad_check(
+            |t, v| t.matmul_bias(v[0], v[1], v[2]),
+            &[(4, 3), (3, 5), (1, 5)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn matmul_bias_equals_matmul_then_add_bias_bit_for_bit() {
+        // Same arithmetic, so equal bits, in value and every gradient (x and the weight also feed
+        // a second product, so their gradients accumulate in the same order both ways).
+        use crate::autograd::ops::grad_check::random_inputs;
+        let inputs = random_inputs(&[(9, 7), (7, 5), (1, 5), (5, 3)], Inputs::Any, 5);
+        let seed = random_inputs(&[(9, 3)], Inputs::Any, 6).remove(0);
+        let run = |fused: bool| {
+            let mut t = Tape::new();
+            let v: Vec<Var> = inputs.iter().map(|a| t.param(a.view())).collect();
+            let z = if fused {
+                t.matmul_bias(v[0], v[1], v[2])
+            } else {
+                let z = t.matmul(v[0], v[1]);
+                t.add_bias(z, v[2])
+            };
+            let y = t.matmul(z, v[3]);
+            let w = t.matmul(v[0], v[1]);
+            let w = t.matmul(w, v[3]);
+            let y = t.add(y, w);
+            t.backward_with(y, seed.view());
+            let grads: Vec<Array2<f32>> =
+                v.iter().map(|&v| t.grad(v).unwrap().to_owned()).collect();
+            (t.value(y).to_owned(), grads)
+        };
+        assert_eq!(run(true), run(false));
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! | file | ops |
 //! | --- | --- |
 //! | `elementwise.rs` | `add`, `sub`, `mul`, `scale`, `sigmoid`, `tanh`, `leaky_relu`, `square`, `exp`, `log` |
-//! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `linear` (fused) |
+//! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `matmul_bias` and `linear` (fused) |
 //! | `softmax.rs` | `softmax`, `log_softmax`, `logsumexp` (row-wise) |
 //! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows`, `reshape` |
 //! | `reduce.rs` | `sum`, `mean`, `masked_mean` |
@@ -56,6 +56,11 @@ pub(crate) enum Op {
     },
     AddBias {
         x: Var,
+        bias: Var,
+    },
+    MatMulBias {
+        a: Var,
+        b: Var,
         bias: Var,
     },
     Linear {
@@ -172,6 +177,7 @@ impl Op {
             Op::MatMul { a, b } => matmul::matmul_backward(*a, *b, g, cx),
             Op::MatMulNt { a, b } => matmul::matmul_nt_backward(*a, *b, g, cx),
             Op::AddBias { x, bias } => matmul::add_bias_backward(*x, *bias, g, cx),
+            Op::MatMulBias { a, b, bias } => matmul::matmul_bias_backward(*a, *b, *bias, g, cx),
             Op::Linear { x, w, b, act } => matmul::linear_backward(*x, *w, *b, *act, y, g, cx),
             Op::Add { a, b } => elementwise::add_backward(*a, *b, g, cx),
             Op::Sub { a, b } => elementwise::sub_backward(*a, *b, g, cx),

@@ -71,7 +71,14 @@ impl Tape {
             "slice_cols: {start}..{end} of {cols} columns"
         );
         let mut y = self.pool().array(rows, end - start);
-        y.assign(&self.value(x).slice(s![.., start..end]));
+        if end > start {
+            let xs = self.value(x);
+            let xs = xs.as_slice().expect("tape arrays are contiguous");
+            let ys = y.as_slice_mut().expect("pool arrays are contiguous");
+            for (yr, xr) in ys.chunks_exact_mut(end - start).zip(xs.chunks_exact(cols)) {
+                yr.copy_from_slice(&xr[start..end]);
+            }
+        }
         self.push_op(y, Op::SliceCols { x, start }, &[x])
     }
 
@@ -125,10 +132,14 @@ impl Tape {
     pub fn gather_rows(&mut self, x: Var, index: &[usize]) -> Var {
         let (rows, cols) = self.shape(x);
         let mut y = self.pool().array(index.len(), cols);
-        let vx = self.value(x);
-        for (k, &r) in index.iter().enumerate() {
-            assert!(r < rows, "gather_rows: row {r} out of range 0..{rows}");
-            y.row_mut(k).assign(&vx.row(r));
+        if cols > 0 {
+            let vx = self.value(x);
+            let xs = vx.as_slice().expect("tape arrays are contiguous");
+            let ys = y.as_slice_mut().expect("pool arrays are contiguous");
+            for (yr, &r) in ys.chunks_exact_mut(cols).zip(index) {
+                assert!(r < rows, "gather_rows: row {r} out of range 0..{rows}");
+                yr.copy_from_slice(&xs[r * cols..(r + 1) * cols]);
+            }
         }
         self.push_op(
             y,
