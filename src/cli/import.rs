@@ -312,7 +312,7 @@ mod tests {
         );
         assert_eq!(
             env_error(&["--env", "warehouse", "--horizon", "9", "--params", "p.json"]),
-            "--params is for --reference macromarl"
+            "--params is for --reference macromarl or acac"
         );
         assert_eq!(
             env_error(&["--env", "box-pushing", "--horizon", "100"]),
@@ -337,7 +337,7 @@ mod tests {
         let mm = ["--reference", "macromarl", "--env", "BP-MA-v0"];
         assert_eq!(
             env_error(&[&mm[..], &["--grid", "6"]].concat()),
-            "--grid is for --reference icra; MacroMARL's grid is `grid_dim` in --params"
+            "--grid is for --reference icra; the grid is `grid_dim` in --params"
         );
         let dir = tempfile::tempdir().unwrap();
         let params = dir.path().join("params.json");
