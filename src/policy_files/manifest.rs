@@ -535,7 +535,14 @@ impl Manifest {
             if NetKind::of_architecture(&net.architecture) != net.kind {
                 return Err(invalid(
                     key("architecture.kind"),
-                    format!("a {:?} net is not a `{}`", net.kind, net.architecture.kind),
+                    format!(
+                        "a net of kind `{}` is not a `{}` (Q-nets are `{DDRQN}`, actors `{GRU_ACTOR}` or `{ACAC_ACTOR}`)",
+                        match net.kind {
+                            NetKind::Q => "q",
+                            NetKind::Actor => "actor",
+                        },
+                        net.architecture.kind
+                    ),
                 ));
             }
             if net.architecture.kind == ACAC_ACTOR && net.role != NetRole::Dec {
