@@ -50,7 +50,7 @@ pub fn check_acac_actor(
             "encoder.fc1.weight",
             net.obs_len(),
             obs_len,
-            "observation values (plus the time table's width)",
+            "observation values",
             vec![widths[0], a.input()],
         ),
         (
@@ -72,7 +72,11 @@ pub fn check_acac_actor(
                 name: name.to_string(),
                 found,
                 expected,
-                hint: format!(" (this agent of the domain has {want} {what})"),
+                hint: if name == "fc4.weight" || dim == 0 {
+                    format!(" (this agent of the domain has {want} {what})")
+                } else {
+                    format!(" (this agent of the domain has {want} {what}, and the file's time table adds {dim})")
+                },
             });
         }
     }
