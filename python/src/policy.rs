@@ -77,8 +77,9 @@ fn load_acting(dir: &Path) -> Result<(Manifest, Acting, Vec<&'static str>), Poli
                 let verified = manifest.verify_agent(dir, agent)?;
                 let net = manifest.agent_acting_net(&verified)?;
                 kinds.push(kind_name(&net));
+                // Every actor samples (MacroMARL's and ACAC's); a Q-net has no sampler.
                 let sampler =
-                    matches!(net, ActingNet::Actor(_)).then(|| agent_sampler(&rng, agent));
+                    (NetKind::of(&net) == NetKind::Actor).then(|| agent_sampler(&rng, agent));
                 agents.push(AgentNet {
                     policy: NetPolicy::new(Arc::new(net)),
                     sampler,
