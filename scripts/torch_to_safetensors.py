@@ -18,7 +18,11 @@ under their dotted names: `fc1.weight`, ..., `lstm.weight_ih_l0` (MacDec-MADDRQN
 `macdec import` accepts both schemes. Anything else in the pickle that is not a tensor, a storage
 or a plain container is also replaced by a record, so no code from the file runs.
 
-A file that already holds a state_dict (`torch.save(net.state_dict())`) converts too.
+A file that already holds a state_dict (`torch.save(net.state_dict())`) converts too, and with
+`--key K` the state_dict stored under K of a saved dict: ACAC's actor checkpoints
+(`<run_id>_agent_<i>_1.tar`) hold it under `actor_net_state_dict`:
+
+    python scripts/torch_to_safetensors.py --key actor_net_state_dict 0_agent_0_1.tar a0.safetensors
 """
 
 import argparse
@@ -100,7 +104,7 @@ def collect_parameters(obj, prefix=""):
     return out
 
 
-def convert(src, dst):
+def convert(src, dst, key=None):
     import numpy as np
     import torch
     from safetensors.numpy import save_file
@@ -109,6 +113,11 @@ def convert(src, dst):
         # Source-change warnings: the Records are not the classes the file was saved with.
         warnings.simplefilter("ignore")
         root = torch.load(src, map_location="cpu", pickle_module=safe_pickle, weights_only=False)
+    if key is not None:
+        if not isinstance(root, dict) or key not in root:
+            found = sorted(root) if isinstance(root, dict) else type(root).__name__
+            sys.exit(f"{src}: no entry `{key}` (found {found})")
+        root = root[key]
     params = collect_parameters(root)
     if not params:
         kind = getattr(type(root), "qualname", type(root).__name__)
@@ -128,8 +137,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("src", help="a torch.save'd DDRQN module (.pt) or state_dict")
     parser.add_argument("dst", help="the safetensors file to write")
+    parser.add_argument("--key", help="take the state_dict stored under this key of a saved dict "
+                        "(ACAC's actor checkpoints: actor_net_state_dict)")
     args = parser.parse_args()
-    convert(args.src, args.dst)
+    convert(args.src, args.dst, args.key)
 
 
 if __name__ == "__main__":

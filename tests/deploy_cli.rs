@@ -25,6 +25,7 @@ fn observe(obs: &[f32], done: bool) -> String {
     Request::Observe {
         obs: obs.to_vec(),
         macro_action_done: done,
+        step: None,
     }
     .to_line()
 }
@@ -76,7 +77,7 @@ fn stdio_robot_keeps_its_hidden_state_and_survives_bad_lines() {
     let mut reference = MockPolicy::new(5, 8, 1);
     let mut q = vec![0.0; 8];
     let mut decision = |obs: &[f32], reference: &mut MockPolicy| {
-        reference.q_values(obs, &mut q);
+        reference.q_values(obs, 0, &mut q);
         let action = greedy_action(&q);
         (action, q.clone())
     };
@@ -172,7 +173,7 @@ fn tcp_robot_announces_its_port_and_serves_connections() {
     let mut line = String::new();
     reader.read_line(&mut line).unwrap();
     let mut q = vec![0.0; 8];
-    MockPolicy::new(5, 8, 0).q_values(&[0.0; 5], &mut q);
+    MockPolicy::new(5, 8, 0).q_values(&[0.0; 5], 0, &mut q);
     assert!(matches!(
         serde_json::from_str(&line).unwrap(),
         Reply::Decision { q: got, .. } if got == q
@@ -302,7 +303,7 @@ fn a_trained_run_exported_and_deployed_on_robot_processes_equals_greedy_evaluati
         .filter(|n| n.agent.is_some())
         .map(|n| match n.net {
             ActingNetRef::Q(q) => q,
-            ActingNetRef::Actor(_) => unreachable!("an our1 run's agents have Q-nets"),
+            _ => unreachable!("an our1 run's agents have Q-nets"),
         })
         .collect();
     let mut env = manifest.env.build().unwrap();

@@ -45,7 +45,7 @@ fn reference_episode(env_spec: EnvSpec, seed_rng: &mut EnvRng) -> (f64, Vec<Vec<
         for (i, p) in policies.iter_mut().enumerate() {
             if env.is_free(i) {
                 let mut q = vec![0.0; p.n_actions()];
-                p.q_values(env.obs(i), &mut q);
+                p.q_values(env.obs(i), env.t(), &mut q);
                 actions[i] = greedy_action(&q);
             }
         }

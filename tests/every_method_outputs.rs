@@ -1,5 +1,5 @@
-//! `eval`, `export` and the robot commands on a trained run of every one of the eleven methods
-//! (issue 40 item 3): each policy evaluates with the nets its training evaluated (the agents'
+//! `eval`, `export` and the robot commands on a trained run of every method (issue 40 item 3;
+//! ACAC's three, issue 41): each policy evaluates with the nets its training evaluated (the agents'
 //! own, or one centralized net for the team), actors sample as MacroMARL evaluates, and where a
 //! centralized net makes no sense (an export for robots, a robot serving one agent) the refusal
 //! names the centralized Q-net or actor. The centralized Q-net acts as Cen-DDRQN's evaluation
@@ -234,6 +234,80 @@ fn every_actor_critic_method_evaluates_greedy_or_sampled_and_mac_cac_acts_centra
             let x_sampled = traces(&eval(&x, 3, &["--sample"]));
             assert_eq!(x_sampled, sampled, "{method}");
         }
+        check_robots(method, &policy, &greedy);
+    }
+}
+
+/// ACAC's three methods on its bp6 (Box Pushing 6x6, ACAC's keys), a few updates each.
+const TINY_ACAC: &str = r#"
+name = "tiny"
+methods = ["acac", "acac-vanilla", "acac-micro-gae"]
+seeds = "0..1"
+
+[params]
+env_name = "BP-MA-v0"
+grid_dim = [6, 6]
+env_terminate_step = 30
+total_epi = 12
+n_env = 4
+train_freq = 4
+c_target_update_freq = 8
+eval_freq = 8
+eval_num_epi = 2
+"#;
+
+/// An ACAC run's policy files hold every agent's actor with the time table it read in training,
+/// exactly the checkpoint's; `eval` (greedy and sampled), `render`, `export` and robots run them,
+/// each passing the episode's primitive step (robots get it in `"step"`).
+#[test]
+fn every_acac_method_writes_its_actors_and_evaluates_exports_and_serves_them() {
+    use macdec::experiment::run::results_tree::CHECKPOINT;
+    use macdec::experiment::run::train_run::load_checkpoint;
+    use macdec::policy_files::read_policy_files;
+    let dir = tempfile::tempdir().unwrap();
+    let results = train_config(dir.path(), TINY_ACAC);
+    for method in ["acac", "acac-vanilla", "acac-micro-gae"] {
+        let run_dir = results.join("tiny").join(method).join("seed-0");
+        let policy = run_dir.join("policy");
+        let saved = read_policy_files(&run_dir).unwrap();
+        let trainer = load_checkpoint(&run_dir.join(CHECKPOINT)).unwrap();
+        let trained: Vec<ActingNet> = trainer
+            .saved_nets()
+            .iter()
+            .map(|n| n.net.to_net())
+            .collect();
+        assert_eq!(saved.agents, trained, "{method}");
+        assert!(saved.team.is_none());
+        assert!(
+            saved.agents.iter().all(ActingNet::reads_step),
+            "{method}: ACAC's actors read the time"
+        );
+        let greedy_out = eval(&policy, 3, &[]);
+        let greedy = traces(&greedy_out);
+        let sampled_out = eval(&policy, 3, &["--sample"]);
+        let sampled = traces(&sampled_out);
+        assert_eq!(
+            traces(&eval(&policy, 3, &["--sample"])),
+            sampled,
+            "{method}"
+        );
+        let gif = dir.path().join(format!("{method}.gif"));
+        let rendered_run = rendered(&run(&[
+            "render",
+            "--run",
+            s(&run_dir),
+            "--out",
+            s(&gif),
+            "--episodes",
+            "3",
+        ]));
+        assert_eq!(
+            rendered_run,
+            json_numbers(&greedy_out, "undiscounted_return"),
+            "{method}"
+        );
+        let x = check_export(method, &run_dir, &dir.path().join(format!("{method}-x"))).unwrap();
+        assert_eq!(traces(&eval(&x, 3, &[])), greedy, "{method}");
         check_robots(method, &policy, &greedy);
     }
 }

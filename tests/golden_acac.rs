@@ -11,13 +11,14 @@
 use std::path::{Path, PathBuf};
 
 use macdec::algos::acac::batch::{AcacBatch, SqueezedEpisode};
-use macdec::algos::acac::nets::{AcacActor, AcacCritic, TIME_TABLE};
+use macdec::algos::acac::nets::AcacCritic;
 use macdec::algos::acac::train_step::update;
 use macdec::algos::acac::update::{
     AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
 };
 use macdec::algos::actor_critic::episode::Episode;
 use macdec::autograd::Tape;
+use macdec::nn::{AcacActor, TIME_TABLE};
 use macdec::nn::{BlockDropout, Gpt2Dropout, StateDict, TimeEmbedding, ValueHead};
 use ndarray::{Array2, ArrayViewD};
 use serde_json::Value;

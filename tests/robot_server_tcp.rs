@@ -85,7 +85,7 @@ impl Reference {
         }
     }
     fn observe(&mut self, obs: &[f32]) -> Vec<f32> {
-        self.policy.q_values(obs, &mut self.q);
+        self.policy.q_values(obs, 0, &mut self.q);
         self.q.clone()
     }
 }
@@ -94,6 +94,7 @@ fn observe_line(obs: &[f32], done: bool) -> String {
     Request::Observe {
         obs: obs.to_vec(),
         macro_action_done: done,
+        step: None,
     }
     .to_line()
 }
@@ -432,9 +433,9 @@ fn a_panicking_policy_closes_only_its_own_connection() {
         fn reset(&mut self) {
             self.0.reset()
         }
-        fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
+        fn q_values(&mut self, obs: &[f32], step: usize, q: &mut [f32]) {
             assert!(obs[0] != 7.0, "deliberate test panic: obs[0] = 7");
-            self.0.q_values(obs, q)
+            self.0.q_values(obs, step, q)
         }
     }
     let server = start_with(

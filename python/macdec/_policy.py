@@ -99,7 +99,9 @@ class Policy:
         ``obs`` and ``mac_done`` are dicts by agent (as ``parallel_env`` gives them; ``mac_done``
         may also be the ``infos`` dict) or lists in agent order. Agents whose ``mac_done`` is
         true decide (their hidden state advances); the others keep their running macro-action.
-        Greedy by default; ``sample=True`` draws each decision from the actors' distributions
+        Call it once per primitive step from :meth:`reset` on: ACAC's actors read the number
+        of calls since :meth:`reset` as the primitive step the observation was made at (their
+        time embedding), as ``macdec eval`` and robots pass it. Greedy by default; ``sample=True`` draws each decision from the actors' distributions
         as MacroMARL evaluates (the streams ``macdec eval --sample`` draws from, seeded by the
         run's seed and continuing across :meth:`reset`); a Q-net policy refuses it with
         ValueError, since Q-values are not probabilities. The raw scores of the decision

@@ -50,6 +50,9 @@ pub struct Policy {
     /// The kind of net each agent acts with (the team's for a centralized policy).
     kinds: Vec<&'static str>,
     probs: Vec<f64>,
+    /// `act` calls since `reset`: the primitive step an observation was made at, which ACAC's
+    /// actors read (their time embedding).
+    steps: usize,
 }
 
 /// `q` or `actor`, as Python reports a net's kind.
@@ -74,8 +77,9 @@ fn load_acting(dir: &Path) -> Result<(Manifest, Acting, Vec<&'static str>), Poli
                 let verified = manifest.verify_agent(dir, agent)?;
                 let net = manifest.agent_acting_net(&verified)?;
                 kinds.push(kind_name(&net));
+                // Every actor samples (MacroMARL's and ACAC's); a Q-net has no sampler.
                 let sampler =
-                    matches!(net, ActingNet::Actor(_)).then(|| agent_sampler(&rng, agent));
+                    (NetKind::of(&net) == NetKind::Actor).then(|| agent_sampler(&rng, agent));
                 agents.push(AgentNet {
                     policy: NetPolicy::new(Arc::new(net)),
                     sampler,
@@ -131,6 +135,7 @@ impl Policy {
                 acting,
                 kinds,
                 probs: Vec::new(),
+                steps: 0,
             })
         })
     }
@@ -219,11 +224,13 @@ impl Policy {
                 Acting::Team(team) => team.reset(),
             }
             self.last.fill(None);
+            self.steps = 0;
             Ok(())
         })
     }
 
-    /// One primitive step: each agent whose `mac_done[i]` is true decides (greedy, or with
+    /// One primitive step (the policy counts them from `reset`: ACAC's actors read that count
+    /// as the time of the observation): each agent whose `mac_done[i]` is true decides (greedy, or with
     /// `sample` drawn from its actor's distribution; a Q-net refuses to sample), the others keep
     /// their macro-actions. Agents with their own nets read `obs[i]` (their hidden states
     /// advance); a centralized net reads every agent's observation, concatenated in agent
@@ -289,7 +296,7 @@ impl Policy {
                             continue;
                         }
                         let mut q = vec![0.0f32; agent.policy.n_actions()];
-                        if !agent.policy.propose(obs[i].as_slice()?, &mut q) {
+                        if !agent.policy.propose(obs[i].as_slice()?, self.steps, &mut q) {
                             let bad = q.iter().find(|v| !v.is_finite()).copied();
                             let what = match bad {
                                 Some(v) => format!("a non-finite score ({v})"),
@@ -312,6 +319,7 @@ impl Policy {
                         self.last[i] = Some(choose_action(&q, sampler, &mut self.probs));
                         scores.push(Some(q.into_pyarray_bound(py)));
                     }
+                    self.steps += 1;
                     Ok((self.last.clone(), scores))
                 }
                 Acting::Team(team) => {
@@ -343,6 +351,7 @@ impl Policy {
                             }
                         }
                     }
+                    self.steps += 1;
                     Ok((self.last.clone(), vec![scores]))
                 }
             }

@@ -1,4 +1,5 @@
-"""Policy.load and Policy.act on a trained run of each of the eleven methods (issue 40 item 3):
+"""Policy.load and Policy.act on a trained run of every method (issue 40 item 3; ACAC's, whose
+actors read the step, issue 41):
 greedy acting gives exactly `macdec eval`'s episode, whether the policy is one net per agent or
 one centralized net for the team (Cen-DDRQN, Mac-CAC); sample=True gives exactly
 `macdec eval --sample`'s episode for actors and is refused for Q-nets."""
@@ -21,6 +22,11 @@ ACTOR = {
     "methods": ["mac-iac", "mac-cac", "naive-mac-iacc", "naive-mac-iasc", "mac-iaicc", "mac-iaisc"],
     "seeds": "0",
     "params": {"env_name": "BP-MA-v0", "grid_dim": [6, 6], "env_terminate_step": 30, "total_epi": 16,
+               "n_env": 4, "train_freq": 4, "c_target_update_freq": 8, "eval_freq": 8, "eval_num_epi": 2},
+}
+ACAC = {
+    "name": "every_acac", "methods": ["acac", "acac-vanilla", "acac-micro-gae"], "seeds": "0",
+    "params": {"env_name": "BP-MA-v0", "grid_dim": [6, 6], "env_terminate_step": 30, "total_epi": 12,
                "n_env": 4, "train_freq": 4, "c_target_update_freq": 8, "eval_freq": 8, "eval_num_epi": 2},
 }
 CENTRALIZED = {"cen-ddrqn", "mac-cac"}
@@ -53,11 +59,11 @@ def eval_line(run_cli, run, *flags):
     return json.loads(run_cli("eval", "--policy", run / "policy", "--trajectories", *flags).splitlines()[0])
 
 
-@pytest.mark.parametrize("config", [VALUE, ACTOR], ids=["value", "actor-critic"])
+@pytest.mark.parametrize("config", [VALUE, ACTOR, ACAC], ids=["value", "actor-critic", "acac"])
 def test_every_method_acts_as_macdec_eval_greedy_and_sampled(config, tmp_path, run_cli):
     runs = macdec.train(config, out=tmp_path)
     assert len(runs) == len(config["methods"])
-    actors = config is ACTOR
+    actors = config is not VALUE
     for run in runs:
         method = run.parent.name
         policy = macdec.Policy.load(run)

@@ -14,18 +14,22 @@ enum ImportReference {
     Icra,
     /// MacroMARL's GRU actors (`--env` a gym id such as `BP-MA-v0`, `--params`).
     Macromarl,
+    /// ACAC's actors with their time tables (`--env` ACAC's gym id: `BP-MA-v0`,
+    /// `Overcooked-MA-v1`, `Overcooked-MA-v0`; `--params`).
+    Acac,
 }
 
 #[derive(clap::Args)]
 pub(super) struct ImportArgs {
-    /// Whose nets: the ICRA code's Q-nets or MacroMARL's actors.
+    /// Whose nets: the ICRA code's Q-nets, MacroMARL's actors or ACAC's.
     #[arg(long, value_enum, default_value = "icra")]
     reference: ImportReference,
     /// The domain the policy was trained on: `box-pushing` or `warehouse` (icra); the gym id,
-    /// e.g. `BP-MA-v0`, `OSD-T-v0`, `Overcooked-MA-v1` (macromarl).
+    /// e.g. `BP-MA-v0`, `OSD-T-v0`, `Overcooked-MA-v1` (macromarl); ACAC's gym id (acac:
+    /// `Overcooked-MA-v1` is then ACAC's own copy of the kitchen).
     #[arg(long)]
     env: String,
-    /// MacroMARL: a JSON object of the reference's keyword arguments for `gym.make` (e.g.
+    /// MacroMARL and ACAC: a JSON object of the reference's keyword arguments for `gym.make` (e.g.
     /// `{"grid_dim": [14, 14]}`); the published values where absent.
     #[arg(long)]
     params: Option<PathBuf>,
@@ -55,6 +59,7 @@ pub(super) struct ImportArgs {
 /// Build the policy directory from the reference's state_dicts and say what was imported.
 pub(super) fn run(args: ImportArgs) -> Result<()> {
     use crate::deploy::policy::import::{import_policy, ImportRequest};
+    use crate::deploy::policy::import_acac::import_acac_actors;
     use crate::deploy::policy::import_actors::import_actors;
     let env = import_env(&args)?;
     let request = ImportRequest {
@@ -68,6 +73,7 @@ pub(super) fn run(args: ImportArgs) -> Result<()> {
     let manifest = match args.reference {
         ImportReference::Icra => import_policy(&request, &args.out),
         ImportReference::Macromarl => import_actors(&request, &args.out),
+        ImportReference::Acac => import_acac_actors(&request, &args.out),
     }
     .with_context(|| format!("importing into {}", args.out.display()))?;
     let arch = &manifest.nets[0].architecture;
@@ -89,7 +95,8 @@ pub(super) fn run(args: ImportArgs) -> Result<()> {
 }
 
 /// The domain `macdec import` names: ICRA's by `--env`, `--grid`, `--horizon`, `--tb-m-noisy`;
-/// MacroMARL's by its gym id, `--params` (the reference's keyword arguments) and `--horizon`.
+/// MacroMARL's and ACAC's by the gym id, `--params` (the reference's keyword arguments) and
+/// `--horizon`.
 fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
     use crate::envs::domain::{json_to_toml, key_table, HORIZON_KEY};
     use crate::envs::EnvSpec;
@@ -100,7 +107,7 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
                 bail!("--reference icra needs --horizon (the episode length in primitive steps)")
             };
             if args.params.is_some() {
-                bail!("--params is for --reference macromarl");
+                bail!("--params is for --reference macromarl or acac");
             }
             Ok(match (args.env.as_str(), args.grid) {
                 ("box-pushing", Some(grid)) => EnvSpec::new(
@@ -126,10 +133,24 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
                 }
             }?)
         }
-        ImportReference::Macromarl => {
+        ImportReference::Macromarl | ImportReference::Acac => {
             if args.grid.is_some() {
-                bail!("--grid is for --reference icra; MacroMARL's grid is `grid_dim` in --params");
+                bail!("--grid is for --reference icra; the grid is `grid_dim` in --params");
             }
+            let domain = match args.reference {
+                ImportReference::Acac => {
+                    crate::envs::acac::domain_of(&args.env).with_context(|| {
+                        let ids: Vec<&str> =
+                            crate::envs::acac::GYM_IDS.iter().map(|(g, _)| *g).collect();
+                        format!(
+                            "--reference acac: `{}` is not a gym id ACAC's runner builds ({})",
+                            args.env,
+                            ids.join(", ")
+                        )
+                    })?
+                }
+                _ => args.env.as_str(),
+            };
             let mut given = toml::Table::new();
             if let Some(path) = &args.params {
                 let text = crate::files::bounded_read::read_regular_file(path, 1 << 20)
@@ -154,7 +175,7 @@ fn import_env(args: &ImportArgs) -> Result<crate::envs::EnvSpec> {
             if let Some(noise) = args.tb_m_noisy {
                 given.insert("tb_m_noisy".into(), noise.into());
             }
-            Ok(EnvSpec::new(&args.env, &given)?)
+            Ok(EnvSpec::new(domain, &given)?)
         }
     }
 }
@@ -291,7 +312,7 @@ mod tests {
         );
         assert_eq!(
             env_error(&["--env", "warehouse", "--horizon", "9", "--params", "p.json"]),
-            "--params is for --reference macromarl"
+            "--params is for --reference macromarl or acac"
         );
         assert_eq!(
             env_error(&["--env", "box-pushing", "--horizon", "100"]),
@@ -316,7 +337,7 @@ mod tests {
         let mm = ["--reference", "macromarl", "--env", "BP-MA-v0"];
         assert_eq!(
             env_error(&[&mm[..], &["--grid", "6"]].concat()),
-            "--grid is for --reference icra; MacroMARL's grid is `grid_dim` in --params"
+            "--grid is for --reference icra; the grid is `grid_dim` in --params"
         );
         let dir = tempfile::tempdir().unwrap();
         let params = dir.path().join("params.json");

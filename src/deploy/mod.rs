@@ -41,12 +41,19 @@ pub trait AgentPolicy: Send {
     fn n_actions(&self) -> usize;
     /// Zero the hidden state, as at the start of an episode.
     fn reset(&mut self);
-    /// Q-values of every macro-action for `obs` (length [`Self::obs_len`]) written into `q`
-    /// (length [`Self::n_actions`]); advances the hidden state by one macro-step, but only when
-    /// every Q-value (and the new state) is finite: a non-finite answer is refused by the robot,
-    /// and the refused step must leave the hidden state exactly as it was. Callers check both
+    /// Whether the policy reads when an observation was made (ACAC's actors, whose time
+    /// embedding is part of their input). A caller that does not know the step must refuse
+    /// such a policy rather than call [`Self::q_values`] with a made-up one.
+    fn reads_step(&self) -> bool {
+        false
+    }
+    /// Q-values of every macro-action for `obs` (length [`Self::obs_len`]), an observation made
+    /// after `step` primitive steps of the episode, written into `q` (length
+    /// [`Self::n_actions`]); advances the hidden state by one macro-step, but only when every
+    /// Q-value (and the new state) is finite: a non-finite answer is refused by the robot, and
+    /// the refused step must leave the hidden state exactly as it was. Callers check both
     /// lengths first; an implementation may panic on wrong lengths.
-    fn q_values(&mut self, obs: &[f32], q: &mut [f32]);
+    fn q_values(&mut self, obs: &[f32], step: usize, q: &mut [f32]);
 }
 
 impl<P: AgentPolicy + ?Sized> AgentPolicy for Box<P> {
@@ -59,8 +66,11 @@ impl<P: AgentPolicy + ?Sized> AgentPolicy for Box<P> {
     fn reset(&mut self) {
         (**self).reset()
     }
-    fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
-        (**self).q_values(obs, q)
+    fn reads_step(&self) -> bool {
+        (**self).reads_step()
+    }
+    fn q_values(&mut self, obs: &[f32], step: usize, q: &mut [f32]) {
+        (**self).q_values(obs, step, q)
     }
 }
 

@@ -1,12 +1,17 @@
 //! The net a decentralized agent acts with, whichever family trained it: the ICRA methods'
-//! recurrent Q-net ([`QNet`], scores = Q-values) or MacroMARL's actor ([`GruActor`], scores =
-//! log-probabilities). Both are stepped one macro-observation at a time with a carried recurrent
-//! state, and the greedy macro-action is the highest score, so evaluation, robots and deploy run
-//! either without knowing which.
+//! recurrent Q-net ([`QNet`], scores = Q-values), MacroMARL's actor ([`GruActor`], scores =
+//! log-probabilities) or ACAC's ([`TimedAcacActor`], log-probabilities). All are stepped one
+//! macro-observation at a time with a carried recurrent state, and the greedy macro-action is
+//! the highest score, so evaluation, robots and deploy run any of them without knowing which.
+//! ACAC's actor also reads when the observation was made (the episode's primitive step, for its
+//! time embedding): every caller passes the step, and [`ActingNet::reads_step`] says whether a
+//! net uses it, so a robot can refuse an observation sent without one.
 
+use super::acac_actor::{AcacActor, AcacActorState, TimedAcacActor};
 use super::gru_actor::{GruActor, GruActorState};
 use super::lstm::LstmState;
 use super::qnet::QNet;
+use super::time_embedding::TimeEmbedding;
 
 /// A decentralized agent's net.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,6 +20,8 @@ pub enum ActingNet {
     Q(QNet),
     /// Log-probabilities (MacroMARL's actors).
     Actor(GruActor),
+    /// Log-probabilities of ACAC's actor, which reads the time too.
+    Acac(TimedAcacActor),
 }
 
 /// An [`ActingNet`] borrowed from whoever owns it: how a learner hands its nets over to be saved
@@ -25,6 +32,8 @@ pub enum ActingNetRef<'a> {
     Q(&'a QNet),
     /// An actor.
     Actor(&'a GruActor),
+    /// An ACAC actor and the time table it reads (held once by its learner for all agents).
+    Acac(&'a AcacActor, Option<&'a TimeEmbedding>),
 }
 
 impl ActingNetRef<'_> {
@@ -33,6 +42,10 @@ impl ActingNetRef<'_> {
         match self {
             ActingNetRef::Q(q) => ActingNet::Q(q.clone()),
             ActingNetRef::Actor(a) => ActingNet::Actor(a.clone()),
+            ActingNetRef::Acac(actor, time) => ActingNet::Acac(TimedAcacActor {
+                actor: actor.clone(),
+                time: time.cloned(),
+            }),
         }
     }
 }
@@ -44,6 +57,8 @@ pub enum ActingState {
     Lstm(LstmState),
     /// An actor's GRU state.
     Gru(GruActorState),
+    /// An ACAC actor's GRU state.
+    Acac(AcacActorState),
 }
 
 impl ActingNet {
@@ -52,6 +67,7 @@ impl ActingNet {
         match self {
             ActingNet::Q(q) => q.config().input,
             ActingNet::Actor(a) => a.config().input,
+            ActingNet::Acac(a) => a.obs_len(),
         }
     }
 
@@ -60,6 +76,7 @@ impl ActingNet {
         match self {
             ActingNet::Q(q) => q.config().output,
             ActingNet::Actor(a) => a.config().output,
+            ActingNet::Acac(a) => a.n_actions(),
         }
     }
 
@@ -67,7 +84,7 @@ impl ActingNet {
     pub fn as_q(&self) -> Option<&QNet> {
         match self {
             ActingNet::Q(q) => Some(q),
-            ActingNet::Actor(_) => None,
+            ActingNet::Actor(_) | ActingNet::Acac(_) => None,
         }
     }
 
@@ -75,7 +92,7 @@ impl ActingNet {
     pub fn scores(&self) -> &'static str {
         match self {
             ActingNet::Q(_) => "Q-values",
-            ActingNet::Actor(_) => "log-probabilities",
+            ActingNet::Actor(_) | ActingNet::Acac(_) => "log-probabilities",
         }
     }
 
@@ -84,15 +101,27 @@ impl ActingNet {
         match self {
             ActingNet::Q(q) => ActingState::Lstm(q.zero_state()),
             ActingNet::Actor(a) => ActingState::Gru(a.zero_state()),
+            ActingNet::Acac(a) => ActingState::Acac(a.actor.zero_state()),
         }
     }
 
-    /// One decision: the scores of every macro-action for `x`, advancing `state`. Panics if x or
-    /// the state do not belong to this net.
-    pub fn act_step<'s>(&self, x: &[f32], state: &'s mut ActingState) -> &'s [f32] {
+    /// Whether the net reads when an observation was made (ACAC's time embedding): a caller
+    /// that does not know the step must not use it.
+    pub fn reads_step(&self) -> bool {
+        match self {
+            ActingNet::Acac(a) => a.time.is_some(),
+            ActingNet::Q(_) | ActingNet::Actor(_) => false,
+        }
+    }
+
+    /// One decision: the scores of every macro-action for `x`, an observation made after `step`
+    /// primitive steps of the episode (read only if [`Self::reads_step`]), advancing `state`.
+    /// Panics if x or the state do not belong to this net.
+    pub fn act_step<'s>(&self, x: &[f32], step: usize, state: &'s mut ActingState) -> &'s [f32] {
         match (self, state) {
             (ActingNet::Q(q), ActingState::Lstm(s)) => q.act_step(x, s),
             (ActingNet::Actor(a), ActingState::Gru(s)) => a.act_step(x, s),
+            (ActingNet::Acac(a), ActingState::Acac(s)) => a.act_step(x, step, s),
             _ => panic!("act_step: the state belongs to another kind of net"),
         }
     }
@@ -104,6 +133,7 @@ impl ActingState {
         match self {
             ActingState::Lstm(s) => s.reset(),
             ActingState::Gru(s) => s.reset(),
+            ActingState::Acac(s) => s.reset(),
         }
     }
 
@@ -112,6 +142,7 @@ impl ActingState {
         match (self, other) {
             (ActingState::Lstm(a), ActingState::Lstm(b)) => a.copy_from(b),
             (ActingState::Gru(a), ActingState::Gru(b)) => a.copy_from(b),
+            (ActingState::Acac(a), ActingState::Acac(b)) => a.copy_from(b),
             _ => panic!("copy_from: states of different kinds of net"),
         }
     }
@@ -122,6 +153,7 @@ impl ActingState {
         match self {
             ActingState::Lstm(s) => finite(s.h()) && finite(s.c()),
             ActingState::Gru(s) => finite(s.h()),
+            ActingState::Acac(s) => finite(s.h()),
         }
     }
 }

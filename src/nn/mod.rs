@@ -16,8 +16,10 @@
 //!   (GPT-2's transposed linear layer), [`Gpt2Block`] and the encoder [`Gpt2`] (attention over the
 //!   agents of each sample, dropout masks supplied from outside: [`Gpt2Dropout`]), the
 //!   sinusoidal [`TimeEmbedding`], [`PopArt`], the [`ValueHead`]s, and [`AcacJointValue`], the
-//!   critic after its encoders.
+//!   critic after its encoders; [`AcacActor`] and its [`AcacEncoder`], and [`TimedAcacActor`],
+//!   the actor with its time table as policy files hold it and agents act with it.
 
+mod acac_actor;
 #[cfg(test)]
 mod acac_fixture;
 mod acac_joint_value;
@@ -51,6 +53,10 @@ mod value_head;
 /// can make the process allocate beyond what a net needs (README "Limits and guarantees").
 pub const MAX_NET_WIDTH: usize = 2_048;
 
+pub use acac_actor::{
+    acting_input, time_row, AcacActor, AcacActorState, AcacActorVars, AcacEncoder, AcacEncoderVars,
+    TimedAcacActor, ACAC_ACTOR_TENSOR_NAMES, TIME_TABLE,
+};
 pub use acac_joint_value::{AcacJointValue, AcacJointValueVars, ValueLayer};
 pub use acting_net::{ActingNet, ActingNetRef, ActingState};
 pub use adam::{Adam, AdamConfig};
@@ -67,6 +73,7 @@ pub use gru_actor::{
 pub use layer_norm::{LayerNormParams, LayerNormVars, LAYER_NORM_EPS};
 pub use linear::LinearVars;
 pub use lstm::LstmState;
+pub(crate) use params::{flat, flat_mut};
 pub use params::{GruParams, LinearParams, LstmParams, Params};
 pub use popart::{PopArt, POPART_BETA, POPART_EPSILON};
 pub use qnet::{

@@ -90,9 +90,7 @@ pub fn to_safetensors_bytes(params: &QNetParams) -> Vec<u8> {
 
 /// Named f32 tensors as safetensors bytes, with PyTorch's `{"format": "pt"}` metadata: the one
 /// writer behind every net's file.
-pub(crate) fn named_to_safetensors_bytes<S: AsRef<str>>(
-    named: &[(S, ArrayViewD<'_, f32>)],
-) -> Vec<u8> {
+pub fn named_to_safetensors_bytes<S: AsRef<str>>(named: &[(S, ArrayViewD<'_, f32>)]) -> Vec<u8> {
     let data: Vec<(&str, Vec<usize>, Vec<u8>)> = named
         .iter()
         .map(|(name, a)| {

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum PolicyError {
     /// A training run directory without `policy/` (older build, or no checkpoint yet).
-    #[error("{dir}: the run has no policy/{POLICY_FILE}: it was trained by a macdec from before policy files (rerun its `macdec train` command), has not reached its first checkpoint, or is an ACAC run, whose actors policy files cannot hold yet (README \"ACAC\")")]
+    #[error("{dir}: the run has no policy/{POLICY_FILE}: it was trained by a macdec from before policy files (rerun its `macdec train` command), or has not reached its first checkpoint")]
     MissingRun {
         /// The run directory.
         dir: PathBuf,

@@ -1,7 +1,7 @@
 //! `policy.json`, the description of a policy directory, and the one writer and loader of the
 //! directory (see the module doc of [`crate::policy_files`] for the JSON shape).
 
-use super::architecture::{Architecture, DDRQN, GRU_ACTOR, LEAKY_RELU_SLOPE};
+use super::architecture::{Architecture, ACAC_ACTOR, DDRQN, GRU_ACTOR, LEAKY_RELU_SLOPE};
 use super::directory::check_only_policy_files;
 use super::error::PolicyError;
 use super::policy_env::{CustomEnv, PolicyEnv};
@@ -10,7 +10,7 @@ use crate::files::atomic::write_atomic;
 use crate::files::bounded_read::read_regular_file;
 use crate::files::dir_swap::replace_dir;
 use crate::nn::safetensors_io::{named_to_safetensors_bytes, to_safetensors_bytes};
-use crate::nn::{ActingNet, GruActor, QNet, QNetConfig};
+use crate::nn::{ActingNet, GruActor, QNet, QNetConfig, TimedAcacActor};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -22,6 +22,9 @@ pub use crate::nn::MAX_NET_WIDTH;
 
 /// Largest `policy.json` read (one is a few kilobytes, most of it the run's config).
 pub(crate) const MAX_DESCRIPTION_BYTES: u64 = 1 << 20;
+/// Most rows a time table may have (one per primitive step of an episode, plus ACAC's five).
+const MAX_TIME_ROWS: usize = 1 << 20;
+
 /// Room for a weight file's JSON header beyond its tensor data.
 const MAX_SAFETENSORS_HEADER_BYTES: u64 = 1 << 16;
 
@@ -42,7 +45,7 @@ impl NetKind {
     pub fn of(net: &ActingNet) -> NetKind {
         match net {
             ActingNet::Q(_) => NetKind::Q,
-            ActingNet::Actor(_) => NetKind::Actor,
+            ActingNet::Actor(_) | ActingNet::Acac(_) => NetKind::Actor,
         }
     }
 
@@ -55,9 +58,10 @@ impl NetKind {
         }
     }
 
-    /// What a net of `architecture` computes: an actor for [`GRU_ACTOR`], else Q-values.
+    /// What a net of `architecture` computes: an actor for [`GRU_ACTOR`] and [`ACAC_ACTOR`],
+    /// else Q-values.
     pub fn of_architecture(architecture: &Architecture) -> NetKind {
-        if architecture.kind == GRU_ACTOR {
+        if architecture.kind == GRU_ACTOR || architecture.kind == ACAC_ACTOR {
             NetKind::Actor
         } else {
             NetKind::Q
@@ -226,6 +230,23 @@ impl NetFile {
         match net {
             ActingNet::Q(q) => NetFile::qnet(role, agent, file, q),
             ActingNet::Actor(a) => NetFile::actor(role, agent, file, a),
+            ActingNet::Acac(a) => NetFile::acac_actor(agent, file, a),
+        }
+    }
+
+    /// The entry and weights of agent `agent`'s ACAC actor with its time table, under ACAC's
+    /// `state_dict` names (`time_embedding.weight` included). ACAC acts only through its
+    /// agents' actors, so the role is always `dec`.
+    pub fn acac_actor(agent: Option<usize>, file: String, net: &TimedAcacActor) -> NetFile {
+        NetFile {
+            kind: NetKind::Actor,
+            role: NetRole::Dec,
+            agent,
+            file,
+            input: net.obs_len(),
+            output: net.n_actions(),
+            architecture: Architecture::acac_actor(net),
+            bytes: named_to_safetensors_bytes(&net.named()),
         }
     }
 
@@ -511,17 +532,23 @@ impl Manifest {
             let sizes = match net.kind {
                 NetKind::Q | NetKind::Actor => Some((input, output)),
             };
-            let expected_kind = match net.kind {
-                NetKind::Q => DDRQN,
-                NetKind::Actor => GRU_ACTOR,
-            };
-            if net.architecture.kind != expected_kind {
+            if NetKind::of_architecture(&net.architecture) != net.kind {
                 return Err(invalid(
                     key("architecture.kind"),
                     format!(
-                        "a {:?} net is a `{expected_kind}`, not a `{}`",
-                        net.kind, net.architecture.kind
+                        "a net of kind `{}` is not a `{}` (Q-nets are `{DDRQN}`, actors `{GRU_ACTOR}` or `{ACAC_ACTOR}`)",
+                        match net.kind {
+                            NetKind::Q => "q",
+                            NetKind::Actor => "actor",
+                        },
+                        net.architecture.kind
                     ),
+                ));
+            }
+            if net.architecture.kind == ACAC_ACTOR && net.role != NetRole::Dec {
+                return Err(invalid(
+                    key("role"),
+                    format!("an `{ACAC_ACTOR}` is one agent's net (role `dec`)"),
                 ));
             }
             if let Some((input, output)) = sizes {
@@ -835,15 +862,40 @@ fn export_net_files(
 /// The architecture is one this build runs, with widths a config could have asked for.
 fn check_architecture(arch: &Architecture, i: usize, path: &Path) -> Result<(), PolicyError> {
     let key = |field: &str| format!("nets[{i}].architecture.{field}");
-    if arch.kind != DDRQN && arch.kind != GRU_ACTOR {
+    if ![DDRQN, GRU_ACTOR, ACAC_ACTOR].contains(&arch.kind.as_str()) {
         return Err(PolicyError::invalid(
             path,
             key("kind"),
             format!(
-                "unknown architecture `{}` (this build knows `{DDRQN}` and `{GRU_ACTOR}`)",
+                "unknown architecture `{}` (this build knows `{DDRQN}`, `{GRU_ACTOR}` and `{ACAC_ACTOR}`)",
                 arch.kind
             ),
         ));
+    }
+    if arch.kind != ACAC_ACTOR {
+        for (field, set) in [
+            ("layer_norm", arch.layer_norm.is_some()),
+            ("time_embedding", arch.time_embedding.is_some()),
+        ] {
+            if set {
+                return Err(PolicyError::invalid(
+                    path,
+                    key(field),
+                    format!("is for `{ACAC_ACTOR}`, not a `{}`", arch.kind),
+                ));
+            }
+        }
+    }
+    if let Some([rows, dim]) = arch.time_embedding {
+        if rows == 0 || rows > MAX_TIME_ROWS || dim == 0 || dim > MAX_NET_WIDTH {
+            return Err(PolicyError::invalid(
+                path,
+                key("time_embedding"),
+                format!(
+                    "rows must be in 1..={MAX_TIME_ROWS} and width in 1..={MAX_NET_WIDTH}, got [{rows}, {dim}]"
+                ),
+            ));
+        }
     }
     if arch.kind == DDRQN && arch.mlp_out_size.is_some() {
         return Err(PolicyError::invalid(

@@ -63,7 +63,7 @@ impl<'a> SavedNet<'a> {
     pub fn kind(&self) -> NetKind {
         match self.net {
             ActingNetRef::Q(_) => NetKind::Q,
-            ActingNetRef::Actor(_) => NetKind::Actor,
+            ActingNetRef::Actor(_) | ActingNetRef::Acac(..) => NetKind::Actor,
         }
     }
 
@@ -81,6 +81,9 @@ impl<'a> SavedNet<'a> {
         match self.net {
             ActingNetRef::Q(q) => NetFile::qnet(self.role, self.agent, file, q),
             ActingNetRef::Actor(a) => NetFile::actor(self.role, self.agent, file, a),
+            ActingNetRef::Acac(..) => {
+                NetFile::acting(self.role, self.agent, file, &self.net.to_net())
+            }
         }
     }
 }

@@ -17,7 +17,7 @@ use super::batch::AcacBatch;
 use super::config::AcacConfig;
 use super::error::AcacError;
 use super::method::AcacMethod;
-use super::nets::{AcacActor, AcacActorState, AcacCritic};
+use super::nets::AcacCritic;
 use super::train_step::update;
 use super::update::{AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace};
 use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
@@ -30,7 +30,9 @@ use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use crate::nn::sampling::{mixture, sample_weighted};
-use crate::nn::TimeEmbedding;
+use crate::nn::{AcacActor, AcacActorState};
+use crate::nn::{ActingNetRef, TimeEmbedding};
+use crate::policy_files::SavedNet;
 
 /// The family's `metrics.csv` columns: ACAC's `Timesteps` (primitive steps of the completed
 /// training episodes, the x-axis of its curves), the exploration weight, the mean critic and
@@ -77,8 +79,6 @@ pub struct AcacLearner {
     /// The updates' tape, reset before every forward.
     #[serde(skip, default)]
     tape: Scratch<Tape>,
-    #[serde(skip, default)]
-    scratch: Vec<f32>,
     #[serde(skip, default)]
     probs: Vec<f64>,
 }
@@ -146,35 +146,28 @@ impl AcacLearner {
     }
 
     /// Free agents sample their macro-actions (busy ones keep theirs): the eps-mixture while
-    /// training (`eps` Some), the plain policy when evaluated. `step` is the primitive step of
-    /// the episode about to be taken (its observation's time is `step + 1`).
+    /// training (`eps` Some), the plain policy when evaluated. Each reads the time as every
+    /// ACAC policy does: the environment's primitive steps since reset ([`MacroEnv::t`]), as
+    /// `eval` and robots pass it ([`crate::nn::acting_input`]).
     #[allow(clippy::too_many_arguments)]
     fn choose<E: MacroEnv>(
         nets: &AcacNets,
         env: &E,
         free: &[bool],
-        step: usize,
         states: &mut [AcacActorState],
         eps: Option<f64>,
         rng: &mut ChaCha8Rng,
-        scratch: &mut Vec<f32>,
         probs: &mut Vec<f64>,
         actions: &mut [usize],
     ) {
         let running = env.executed();
+        let step = env.t();
         for (i, state) in states.iter_mut().enumerate() {
             if !free[i] {
                 actions[i] = running[i];
                 continue;
             }
-            scratch.clear();
-            scratch.extend_from_slice(env.obs(i));
-            if let Some(t) = &nets.time {
-                // The table has horizon + 5 rows; steps past it cannot occur within an episode.
-                let row = (step + 1).min(t.table.nrows() - 1);
-                scratch.extend(t.table.row(row).iter());
-            }
-            let logp = nets.actors[i].act_step(scratch, state);
+            let logp = nets.actors[i].act_at(env.obs(i), nets.time.as_ref(), step, state);
             mixture(logp, eps, probs);
             actions[i] = sample_weighted(probs, rng);
         }
@@ -263,7 +256,6 @@ impl Learner for AcacLearner {
             pending_steps: 0,
             means: UpdateMeans::default(),
             tape: Scratch::default(),
-            scratch: Vec::new(),
             probs: Vec::new(),
         })
     }
@@ -317,16 +309,13 @@ impl Learner for AcacLearner {
     }
 
     fn act<E: MacroEnv>(&mut self, lane: &mut AcacLane, env: &E, actions: &mut [usize]) {
-        let step = lane.recorder.episode().steps;
         Self::choose(
             &self.nets,
             env,
             lane.recorder.free(),
-            step,
             &mut lane.states,
             Some(self.eps),
             &mut self.explore_rng,
-            &mut self.scratch,
             &mut self.probs,
             actions,
         );
@@ -403,19 +392,16 @@ impl Learner for AcacLearner {
         }
         let mut returns = Vec::new();
         let mut actions = vec![0; n_agents];
-        let (mut scratch, mut probs) = (Vec::new(), Vec::new());
+        let mut probs = Vec::new();
         while returns.len() < c.eval_num_epi {
             for k in 0..envs.len() {
-                let step = recorders[k].episode().steps;
                 Self::choose(
                     &self.nets,
                     &*envs[k],
                     recorders[k].free(),
-                    step,
                     &mut states[k],
                     None,
                     rng,
-                    &mut scratch,
                     &mut probs,
                     &mut actions,
                 );
@@ -475,10 +461,16 @@ impl Learner for AcacLearner {
         )
     }
 
-    /// No policy files yet: ACAC's actors are not a net kind the policy files know (README
-    /// "ACAC").
+    /// Every agent's actor with the time table it reads: the policy its evaluations run (the
+    /// critic only trains them).
     fn saved_nets(&self) -> SavedNets<'_> {
-        Vec::new()
+        let time = self.nets.time.as_ref();
+        self.nets
+            .actors
+            .iter()
+            .enumerate()
+            .map(|(i, a)| SavedNet::agent(i, ActingNetRef::Acac(a, time), true))
+            .collect()
     }
 }
 

@@ -22,8 +22,9 @@ use serde::{Deserialize, Serialize};
 
 use super::batch::{AcacBatch, SqueezedEpisode};
 use super::gae::{episode_gae_lambdas, GaeEpisode, GaeError};
-use super::nets::{AcacActor, AcacCritic, CriticInput};
+use super::nets::{AcacCritic, CriticInput};
 use crate::autograd::{SeqPacking, Tape};
+use crate::nn::AcacActor;
 use crate::nn::{Adam, AdamConfig, Gpt2Dropout, Params, TimeEmbedding};
 
 /// HuggingFace GPT-2's default dropout rate, live in ACAC's critic.

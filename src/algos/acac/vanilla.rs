@@ -24,7 +24,6 @@ use std::borrow::Cow;
 use ndarray::Array2;
 
 use super::batch::AcacBatch;
-use super::nets::AcacActor;
 use super::nstep::episode_n_step_returns;
 use super::update::{
     actor_input, clip, critic_input, critic_loss, end_discounts, mixture_log_prob,
@@ -32,6 +31,7 @@ use super::update::{
     UpdateParams, UpdateTrace,
 };
 use crate::autograd::{SeqPacking, Tape};
+use crate::nn::AcacActor;
 
 /// What only `acac-vanilla` reads.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -95,8 +95,8 @@ pub trait TeamDecisions {
     ) -> Result<(), DeployError>;
 }
 
-/// One robot per agent, in agent order: each gets its agent's observation and whether its
-/// macro-action just finished, every primitive step.
+/// One robot per agent, in agent order: each gets its agent's observation, the primitive steps
+/// taken so far and whether its macro-action just finished, every primitive step.
 pub struct Robots<'a, L>(pub &'a mut [L]);
 
 impl<L: RobotLink> TeamDecisions for Robots<'_, L> {
@@ -117,7 +117,7 @@ impl<L: RobotLink> TeamDecisions for Robots<'_, L> {
         for (agent, robot) in self.0.iter_mut().enumerate() {
             let free = env.is_free(agent);
             let chosen = robot
-                .observe(env.obs(agent), free)
+                .observe(env.obs(agent), env.t(), free)
                 .map_err(|source| DeployError::Link { agent, source })?;
             if let Some(a) = chosen {
                 actions[agent] = a;

@@ -23,10 +23,15 @@ pub const MAX_REPLY_BYTES: usize = 16 * 1024 * 1024;
 pub trait RobotLink {
     /// A new episode: the robot zeroes its hidden state.
     fn reset(&mut self) -> Result<(), LinkError>;
-    /// The agent's current macro-observation. `Some(action)` exactly when `macro_action_done`
-    /// (a new macro-action is due), `None` otherwise.
-    fn observe(&mut self, obs: &[f32], macro_action_done: bool)
-        -> Result<Option<usize>, LinkError>;
+    /// The agent's current macro-observation, made after `step` primitive steps of the episode.
+    /// `Some(action)` exactly when `macro_action_done` (a new macro-action is due), `None`
+    /// otherwise.
+    fn observe(
+        &mut self,
+        obs: &[f32],
+        step: usize,
+        macro_action_done: bool,
+    ) -> Result<Option<usize>, LinkError>;
 }
 
 impl<L: RobotLink + ?Sized> RobotLink for Box<L> {
@@ -36,9 +41,10 @@ impl<L: RobotLink + ?Sized> RobotLink for Box<L> {
     fn observe(
         &mut self,
         obs: &[f32],
+        step: usize,
         macro_action_done: bool,
     ) -> Result<Option<usize>, LinkError> {
-        (**self).observe(obs, macro_action_done)
+        (**self).observe(obs, step, macro_action_done)
     }
 }
 
@@ -259,11 +265,13 @@ impl<R: BufRead, W: Write> RobotLink for JsonLink<R, W> {
     fn observe(
         &mut self,
         obs: &[f32],
+        step: usize,
         macro_action_done: bool,
     ) -> Result<Option<usize>, LinkError> {
         let reply = self.request(&Request::Observe {
             obs: obs.to_vec(),
             macro_action_done,
+            step: Some(step),
         })?;
         match (macro_action_done, reply) {
             (true, Reply::Decision { action, .. }) if action < self.n_actions => Ok(Some(action)),
@@ -314,6 +322,7 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
     fn observe(
         &mut self,
         obs: &[f32],
+        step: usize,
         macro_action_done: bool,
     ) -> Result<Option<usize>, LinkError> {
         if obs.len() != self.policy.obs_len() {
@@ -326,7 +335,7 @@ impl<P: AgentPolicy> RobotLink for LocalLink<P> {
         if !macro_action_done {
             return Ok(None);
         }
-        self.policy.q_values(obs, &mut self.q);
+        self.policy.q_values(obs, step, &mut self.q);
         // Refused exactly as a robot refuses it (`robot::Session`), so in-process and deployed
         // runs of a broken policy fail alike.
         if let Some((action, &value)) = self.q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
@@ -374,7 +383,7 @@ mod tests {
             2
         }
         fn reset(&mut self) {}
-        fn q_values(&mut self, _obs: &[f32], q: &mut [f32]) {
+        fn q_values(&mut self, _obs: &[f32], _step: usize, q: &mut [f32]) {
             q.copy_from_slice(&[0.0, self.0]);
         }
     }
@@ -382,11 +391,11 @@ mod tests {
     #[test]
     fn local_link_refuses_non_finite_q_as_a_robot_does() {
         assert_eq!(
-            LocalLink::new(Fixed(1.0)).observe(&[0.0], true),
+            LocalLink::new(Fixed(1.0)).observe(&[0.0], 0, true),
             Ok(Some(1))
         );
         let err = LocalLink::new(Fixed(f32::NAN))
-            .observe(&[0.0], true)
+            .observe(&[0.0], 0, true)
             .unwrap_err();
         let robot = ProtocolError::NonFiniteQ {
             action: 1,
@@ -394,7 +403,7 @@ mod tests {
         };
         assert_eq!(err, LinkError::Refused(robot.to_string()));
         assert_eq!(
-            LocalLink::new(Fixed(f32::NAN)).observe(&[0.0], false),
+            LocalLink::new(Fixed(f32::NAN)).observe(&[0.0], 0, false),
             Ok(None)
         );
     }

@@ -123,7 +123,7 @@ impl CentralPolicy {
     ) -> Result<Self, PolicyError> {
         let sampler = match net {
             ActingNet::Q(_) => None,
-            ActingNet::Actor(_) => Some(sampler(rng, TEAM_STREAM)),
+            ActingNet::Actor(_) | ActingNet::Acac(_) => Some(sampler(rng, TEAM_STREAM)),
         };
         if choice == Choice::Sampled && sampler.is_none() {
             return Err(not_an_actor());
@@ -210,7 +210,8 @@ impl CentralNet {
             (Choice::Sampled, Some(s)) => Some(s),
             (Choice::Sampled, None) => return Err(not_an_actor().to_string()),
         };
-        let scores = self.net.act_step(joint_obs, &mut self.state);
+        // No centralized net reads the step: policy files hold ACAC's actors only as agents'.
+        let scores = self.net.act_step(joint_obs, 0, &mut self.state);
         if let Some(bad) = scores.iter().find(|x| !x.is_finite()) {
             return Err(format!(
                 "the centralized net answered a non-finite score ({bad}); the observation is out of the range it was trained on"

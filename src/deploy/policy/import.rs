@@ -164,6 +164,18 @@ pub enum ImportError {
         /// Hidden size of the first file.
         first_hidden: usize,
     },
+    /// Two agents' ACAC actors differ in architecture.
+    #[error("{path}: {arch}, but {first} has {first_arch}; all agents of a policy share one architecture")]
+    AcacActorMismatch {
+        /// The file that disagrees.
+        path: PathBuf,
+        /// Its architecture, in words.
+        arch: String,
+        /// The first agent's file.
+        first: PathBuf,
+        /// The first file's architecture, in words.
+        first_arch: String,
+    },
     /// The number of files is not the domain's number of agents.
     #[error("the {env} domain has {expected} agents, {got} state_dict files were given (one per agent, in agent order)")]
     AgentCount {
@@ -388,16 +400,30 @@ pub fn check_state_dict(
     })
 }
 
-/// One imported file as the manifest's `run.config` records it.
+/// One imported file as the manifest's `run.config` records it (every importer's).
 #[derive(Debug, Serialize)]
-struct Source {
-    agent: usize,
+pub struct ImportedFile {
+    /// The agent it is the net of.
+    pub agent: usize,
     /// The path as given on the command line.
-    file: String,
-    /// SHA-256 of the file as read (before renaming).
-    sha256: String,
-    /// `lstm.*` or `rnn.*`.
-    tensor_names: Naming,
+    pub file: String,
+    /// SHA-256 of the file as read (before any renaming).
+    pub sha256: String,
+    /// The ICRA Q-nets' LSTM naming, `lstm.*` or `rnn.*`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tensor_names: Option<Naming>,
+}
+
+impl ImportedFile {
+    /// Agent `agent`'s file `path`, whose bytes as read are `bytes`.
+    pub fn new(agent: usize, path: &Path, bytes: &[u8]) -> Self {
+        ImportedFile {
+            agent,
+            file: path.display().to_string(),
+            sha256: sha256_hex(bytes),
+            tensor_names: None,
+        }
+    }
 }
 
 /// The request's domain, built, with one file per agent (else [`ImportError::AgentCount`]).
@@ -449,11 +475,9 @@ pub fn import_policy(request: &ImportRequest, out: &Path) -> Result<Manifest, Im
                 });
             }
         }
-        sources.push(Source {
-            agent,
-            file: path.display().to_string(),
-            sha256: sha256_hex(&bytes),
-            tensor_names: one.naming,
+        sources.push(ImportedFile {
+            tensor_names: Some(one.naming),
+            ..ImportedFile::new(agent, path, &bytes)
         });
         checked.push(one);
     }

@@ -6,24 +6,14 @@
 //! by [`Manifest::write_policy`] as for any other policy, its nets of kind `actor`.
 
 use super::import::{
-    imported_run, read_bounded, request_domain, ImportError, ImportRequest, MAX_STATE_DICT_BYTES,
+    imported_run, read_bounded, request_domain, ImportError, ImportRequest, ImportedFile,
+    MAX_STATE_DICT_BYTES,
 };
 use crate::envs::MacroEnv;
 use crate::nn::{GruActor, GruActorConfig};
 use crate::policy_files::architecture::Architecture;
-use crate::policy_files::{sha256_hex, Manifest};
-use serde::Serialize;
+use crate::policy_files::Manifest;
 use std::path::Path;
-
-/// One imported file as the manifest's `run.config` records it.
-#[derive(Debug, Serialize)]
-struct Source {
-    agent: usize,
-    /// The path as given on the command line.
-    file: String,
-    /// SHA-256 of the file as read.
-    sha256: String,
-}
 
 /// Check one agent's actor file `bytes` (from `path`) against a domain agent with `obs_len`
 /// observation values and `n_actions` macro-actions. Returns the actor's sizes.
@@ -108,11 +98,7 @@ pub fn import_actors(request: &ImportRequest, out: &Path) -> Result<Manifest, Im
             }
         }
         first.get_or_insert(cfg);
-        sources.push(Source {
-            agent,
-            file: path.display().to_string(),
-            sha256: sha256_hex(&bytes),
-        });
+        sources.push(ImportedFile::new(agent, path, &bytes));
         weights.push(bytes);
     }
     let cfg = first.expect("a domain has at least one agent");

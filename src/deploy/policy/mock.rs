@@ -58,7 +58,7 @@ impl AgentPolicy for MockPolicy {
         self.state.fill(0.0);
         self.calls = 0;
     }
-    fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
+    fn q_values(&mut self, obs: &[f32], _step: usize, q: &mut [f32]) {
         assert_eq!(
             obs.len(),
             self.obs_len,
@@ -164,11 +164,11 @@ mod tests {
         let mut p = MockPolicy::new(2, 3, 0);
         let mut q1 = vec![0.0; 3];
         let mut q2 = vec![0.0; 3];
-        p.q_values(&[1.0, 0.0], &mut q1);
-        p.q_values(&[1.0, 0.0], &mut q2);
+        p.q_values(&[1.0, 0.0], 0, &mut q1);
+        p.q_values(&[1.0, 0.0], 0, &mut q2);
         assert_ne!(q1, q2);
         p.reset();
-        p.q_values(&[1.0, 0.0], &mut q2);
+        p.q_values(&[1.0, 0.0], 0, &mut q2);
         assert_eq!(q1, q2);
     }
 

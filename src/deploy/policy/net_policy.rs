@@ -35,9 +35,9 @@ impl NetPolicy {
     /// into a candidate state that only [`NetPolicy::commit`] makes current. Whether the values
     /// and the candidate state came out finite. A team steps all-or-nothing with it: every
     /// agent proposes, and only if all are finite do all commit.
-    pub fn propose(&mut self, obs: &[f32], q: &mut [f32]) -> bool {
+    pub fn propose(&mut self, obs: &[f32], step: usize, q: &mut [f32]) -> bool {
         self.candidate.copy_from(&self.state);
-        q.copy_from_slice(self.net.act_step(obs, &mut self.candidate));
+        q.copy_from_slice(self.net.act_step(obs, step, &mut self.candidate));
         q.iter().all(|x| x.is_finite()) && self.candidate.is_finite()
     }
 
@@ -57,10 +57,13 @@ impl AgentPolicy for NetPolicy {
     fn reset(&mut self) {
         self.state.reset();
     }
-    fn q_values(&mut self, obs: &[f32], q: &mut [f32]) {
+    fn reads_step(&self) -> bool {
+        self.net.reads_step()
+    }
+    fn q_values(&mut self, obs: &[f32], step: usize, q: &mut [f32]) {
         // A huge but finite observation can overflow the recurrent layer: keep the old state
         // then, so one bad message does not break the rest of the session.
-        if self.propose(obs, q) {
+        if self.propose(obs, step, q) {
             self.commit();
         }
     }
@@ -140,7 +143,7 @@ mod tests {
                 state.reset();
             }
             let obs = [t as f32 * 0.25, 1.0, 0.0, -0.5];
-            policy.q_values(&obs, &mut q);
+            policy.q_values(&obs, t, &mut q);
             assert_eq!(q, nets[2].act_step(&obs, &mut state));
         }
     }
@@ -158,18 +161,18 @@ mod tests {
         let (a, b) = ([0.5, -1.0, 0.0, 1.0, 0.25], [1.0, 0.0, 1.0, 0.0, -0.5]);
         let mut q = [0.0; 4];
         let mut reference = NetPolicy::new(net.clone());
-        reference.q_values(&a, &mut q);
-        reference.q_values(&b, &mut q);
+        reference.q_values(&a, 0, &mut q);
+        reference.q_values(&b, 1, &mut q);
         let expected = q;
 
         let mut policy = NetPolicy::new(net);
-        policy.q_values(&a, &mut q);
-        policy.q_values(&[3.4e38; 5], &mut q);
+        policy.q_values(&a, 0, &mut q);
+        policy.q_values(&[3.4e38; 5], 1, &mut q);
         assert!(
             q.iter().any(|v| !v.is_finite()),
             "the probe must overflow: {q:?}"
         );
-        policy.q_values(&b, &mut q);
+        policy.q_values(&b, 1, &mut q);
         assert_eq!(q, expected);
     }
 }

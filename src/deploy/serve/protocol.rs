@@ -9,7 +9,10 @@
 //!   replies `{"action": k, "name": "...", "q": [..]}` (greedy, ties to the lowest index, quirk
 //!   Q14). When false the running macro-action continues, the state is untouched (the policy only
 //!   reads observations at macro-action boundaries, `docs/ALGORITHMS.md` §4.2), and the reply is
-//!   `{"ok": "continue"}`.
+//!   `{"ok": "continue"}`. An optional `"step": t` says the observation was made after t
+//!   primitive steps of the episode (0 right after reset); a policy that reads the time (ACAC's
+//!   actors, whose time embedding is part of their input) refuses a decision without it, every
+//!   other policy ignores it. `macdec deploy` always sends it.
 //! - `{"type": "info"}`: reply `{"agent": i, "manifest": {..}}` (the policy's manifest).
 //!
 //! Any bad request gets `{"error": "..."}` naming what was wrong and leaves the state unchanged.
@@ -28,6 +31,8 @@ pub enum Request {
         obs: Vec<f32>,
         /// True when the robot must pick its next macro-action.
         macro_action_done: bool,
+        /// Primitive steps of the episode before this observation, if the sender says.
+        step: Option<usize>,
     },
     /// `{"type": "info"}`: ask for the agent index and the manifest.
     Info,
@@ -42,6 +47,8 @@ enum Wire<T> {
     Observe {
         obs: Vec<T>,
         macro_action_done: bool,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        step: Option<usize>,
     },
     Info {},
 }
@@ -106,7 +113,7 @@ pub enum ProtocolError {
         hint: &'static str,
     },
     /// Valid JSON but not a known request; holds the parser's reason.
-    #[error("bad message: {0} (expected {{\"type\": \"reset\"}}, {{\"type\": \"observe\", \"obs\": [...], \"macro_action_done\": true|false}} or {{\"type\": \"info\"}})")]
+    #[error("bad message: {0} (expected {{\"type\": \"reset\"}}, {{\"type\": \"observe\", \"obs\": [...], \"macro_action_done\": true|false, \"step\": t (optional)}} or {{\"type\": \"info\"}})")]
     BadMessage(String),
     /// `obs` has the wrong number of values for this agent.
     #[error("obs has {got} values, agent {agent} expects {expected}")]
@@ -126,6 +133,10 @@ pub enum ProtocolError {
         /// The value received.
         value: f64,
     },
+    /// A decision was asked of a policy that reads the time without saying when the
+    /// observation was made.
+    #[error("this policy reads when the observation was made (ACAC's time embedding): send \"step\": the primitive steps of the episode before this observation (0 right after reset)")]
+    MissingStep,
     /// The net produced a non-finite value; the hidden state is left unchanged.
     #[error("the policy produced a non-finite Q-value ({value} for macro-action {action}) for this observation (values too large for the net?); the hidden state is unchanged")]
     NonFiniteQ {
@@ -173,6 +184,7 @@ impl Request {
             Wire::Observe {
                 obs,
                 macro_action_done,
+                step,
             } => {
                 if obs.len() != obs_len {
                     return Err(ProtocolError::ObsLength {
@@ -196,6 +208,7 @@ impl Request {
                 Ok(Request::Observe {
                     obs,
                     macro_action_done,
+                    step,
                 })
             }
         }
@@ -209,9 +222,11 @@ impl Request {
             Request::Observe {
                 obs,
                 macro_action_done,
+                step,
             } => Wire::Observe {
                 obs: obs.clone(),
                 macro_action_done: *macro_action_done,
+                step: *step,
             },
         };
         serde_json::to_string(&wire).expect("requests hold only finite numbers and strings")
@@ -248,9 +263,24 @@ mod tests {
             parse(r#"{"type": "observe", "obs": [0, 1.5, -2e-3], "macro_action_done": false}"#),
             Ok(Request::Observe {
                 obs: vec![0.0, 1.5, -0.002],
-                macro_action_done: false
+                macro_action_done: false,
+                step: None,
             })
         );
+        assert_eq!(
+            parse(r#"{"type": "observe", "obs": [0, 0, 0], "macro_action_done": true, "step": 7}"#),
+            Ok(Request::Observe {
+                obs: vec![0.0; 3],
+                macro_action_done: true,
+                step: Some(7),
+            })
+        );
+        let err = parse(
+            r#"{"type": "observe", "obs": [0, 0, 0], "macro_action_done": true, "step": -1}"#,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("bad message") && err.contains("step"), "{err}");
     }
 
     #[test]
@@ -261,6 +291,12 @@ mod tests {
             Request::Observe {
                 obs: vec![0.1, 1.0 / 3.0, -7.25e-9],
                 macro_action_done: true,
+                step: None,
+            },
+            Request::Observe {
+                obs: vec![0.5, 0.0, 1.0],
+                macro_action_done: false,
+                step: Some(199),
             },
         ] {
             assert_eq!(parse(&r.to_line()), Ok(r));

@@ -143,8 +143,17 @@ impl Session {
             Request::Observe {
                 obs,
                 macro_action_done: true,
+                step,
             } => {
-                self.policy.q_values(&obs, &mut self.q);
+                let step = match step {
+                    Some(step) => step,
+                    None if self.policy.reads_step() => {
+                        return Reply::error(ProtocolError::MissingStep)
+                    }
+                    // Read by no policy that gets here.
+                    None => 0,
+                };
+                self.policy.q_values(&obs, step, &mut self.q);
                 if let Some((action, &value)) =
                     self.q.iter().enumerate().find(|(_, v)| !v.is_finite())
                 {
@@ -248,6 +257,7 @@ mod tests {
         Request::Observe {
             obs: obs.to_vec(),
             macro_action_done: done,
+            step: None,
         }
         .to_line()
     }
@@ -261,7 +271,7 @@ mod tests {
         let mut p = MockPolicy::new(5, 8, agent);
         let mut q = vec![0.0; 8];
         for obs in history {
-            p.q_values(obs, &mut q);
+            p.q_values(obs, 0, &mut q);
         }
         q
     }
@@ -377,7 +387,7 @@ mod tests {
                 8
             }
             fn reset(&mut self) {}
-            fn q_values(&mut self, _: &[f32], q: &mut [f32]) {
+            fn q_values(&mut self, _: &[f32], _: usize, q: &mut [f32]) {
                 q.fill(f32::NAN)
             }
         }
@@ -387,6 +397,49 @@ mod tests {
             panic!()
         };
         assert!(error.contains("non-finite Q"), "{error}");
+    }
+
+    #[test]
+    fn a_policy_that_reads_the_time_needs_the_step_and_answers_by_it() {
+        /// Scores the step it is given, as a net with a time embedding would.
+        struct Clock;
+        impl AgentPolicy for Clock {
+            fn obs_len(&self) -> usize {
+                5
+            }
+            fn n_actions(&self) -> usize {
+                8
+            }
+            fn reset(&mut self) {}
+            fn reads_step(&self) -> bool {
+                true
+            }
+            fn q_values(&mut self, _: &[f32], step: usize, q: &mut [f32]) {
+                q.fill(0.0);
+                q[step % 8] = 1.0;
+            }
+        }
+        let (_, spec) = bp_spec(0);
+        let mut s = Session::new(Box::new(Clock), spec).unwrap();
+        let Reply::Error { error } = reply(&mut s, &observe(&[0.0; 5], true)) else {
+            panic!("a decision without a step")
+        };
+        assert!(error.contains("\"step\""), "{error}");
+        // Continuing needs no decision, so no step either.
+        assert_eq!(
+            reply(&mut s, &observe(&[0.0; 5], false)),
+            Reply::Ack { ok: Ack::Continue }
+        );
+        let line = Request::Observe {
+            obs: vec![0.0; 5],
+            macro_action_done: true,
+            step: Some(13),
+        }
+        .to_line();
+        let Reply::Decision { action, .. } = reply(&mut s, &line) else {
+            panic!("a decision with a step")
+        };
+        assert_eq!(action, 5);
     }
 
     #[test]

@@ -445,8 +445,7 @@ fn save_checkpoint(
 }
 
 /// Write the trainer's nets as the run's policy files (see [`crate::policy_files`]): the list its
-/// learner hands over, whatever the family. A learner that hands over none (ACAC, whose actors
-/// read a time embedding that policy files cannot carry yet; README "ACAC") leaves the run
+/// learner hands over, whatever the family. A learner that hands over none leaves the run
 /// without a `policy/` directory, and the commands that read one say it is missing.
 fn save_policy_files(dir: &Path, spec: &RunSpec, trainer: &AnyLoop) -> Result<(), RunError> {
     let nets = trainer.saved_nets();
