@@ -189,52 +189,60 @@ fn every_value_method_evaluates_exports_and_serves_or_refuses_by_name() {
     }
 }
 
+/// What every actor policy of a trained run does (`method`'s run in `run_dir`, scratch files in
+/// `dir`): greedy and sampled `eval` (sampling seeded by the run's seed: the same draws again),
+/// `render` playing the same episodes from the same streams, an export acting the same, and
+/// robots giving the greedy episodes (or refusing a centralized policy by name). Returns eval's
+/// greedy output.
+fn check_actor_policy(method: &str, run_dir: &Path, dir: &Path) -> std::process::Output {
+    let policy = run_dir.join("policy");
+    let greedy_out = eval(&policy, 3, &[]);
+    let greedy = traces(&greedy_out);
+    let sampled_out = eval(&policy, 3, &["--sample"]);
+    let sampled = traces(&sampled_out);
+    assert_eq!(
+        traces(&eval(&policy, 3, &["--sample"])),
+        sampled,
+        "{method}"
+    );
+    let gif = dir.join(format!("{method}.gif"));
+    let render = |flags: &[&str]| {
+        let args = [
+            &["render", "--run", s(run_dir), "--out", s(&gif)][..],
+            &["--episodes", "3"],
+            flags,
+        ]
+        .concat();
+        rendered(&run(&args))
+    };
+    let undiscounted = |out| json_numbers(out, "undiscounted_return");
+    assert_eq!(render(&[]), undiscounted(&greedy_out), "{method}");
+    assert_eq!(
+        render(&["--sample"]),
+        undiscounted(&sampled_out),
+        "{method}"
+    );
+    let exported = check_export(method, run_dir, &dir.join(format!("{method}-x")));
+    if let Some(x) = exported {
+        assert_eq!(traces(&eval(&x, 3, &[])), greedy, "{method}");
+        let x_sampled = traces(&eval(&x, 3, &["--sample"]));
+        assert_eq!(x_sampled, sampled, "{method}");
+    }
+    check_robots(method, &policy, &greedy);
+    greedy_out
+}
+
 #[test]
 fn every_actor_critic_method_evaluates_greedy_or_sampled_and_mac_cac_acts_centrally() {
     let dir = tempfile::tempdir().unwrap();
     let results = train_config(dir.path(), TINY_AC);
     for method in AC {
         let run_dir = results.join("tiny").join(method).join("seed-0");
-        let policy = run_dir.join("policy");
-        let greedy_out = eval(&policy, 3, &[]);
-        let greedy = traces(&greedy_out);
-        let sampled_out = eval(&policy, 3, &["--sample"]);
+        let greedy_out = check_actor_policy(method, &run_dir, dir.path());
         // `eval` says when the team acts through one centralized net.
         let summary = String::from_utf8_lossy(&greedy_out.stderr);
         let central = summary.contains("acting centrally with its centralized actor");
         assert_eq!(central, method == "mac-cac", "{method}: {summary}");
-        let sampled = traces(&sampled_out);
-        // Sampling is seeded by the run's seed: the same draws again.
-        assert_eq!(
-            traces(&eval(&policy, 3, &["--sample"])),
-            sampled,
-            "{method}"
-        );
-        // `render` plays the same policy the same way, from the same streams.
-        let gif = dir.path().join(format!("{method}.gif"));
-        let render = |flags: &[&str]| {
-            let args = [
-                &["render", "--run", s(&run_dir), "--out", s(&gif)][..],
-                &["--episodes", "3"],
-                flags,
-            ]
-            .concat();
-            rendered(&run(&args))
-        };
-        let undiscounted = |out| json_numbers(out, "undiscounted_return");
-        assert_eq!(render(&[]), undiscounted(&greedy_out), "{method}");
-        assert_eq!(
-            render(&["--sample"]),
-            undiscounted(&sampled_out),
-            "{method}"
-        );
-        let exported = check_export(method, &run_dir, &dir.path().join(format!("{method}-x")));
-        if let Some(x) = exported {
-            assert_eq!(traces(&eval(&x, 3, &[])), greedy, "{method}");
-            let x_sampled = traces(&eval(&x, 3, &["--sample"]));
-            assert_eq!(x_sampled, sampled, "{method}");
-        }
-        check_robots(method, &policy, &greedy);
     }
 }
 
@@ -257,8 +265,9 @@ eval_num_epi = 2
 "#;
 
 /// An ACAC run's policy files hold every agent's actor with the time table it read in training,
-/// exactly the checkpoint's; `eval` (greedy and sampled), `render`, `export` and robots run them,
-/// each passing the episode's primitive step (robots get it in `"step"`).
+/// exactly the checkpoint's; `eval` (greedy and sampled), `render`, `export` and robots run them
+/// as every actor policy ([`check_actor_policy`]), each passing the episode's primitive step
+/// (robots get it in `"step"`).
 #[test]
 fn every_acac_method_writes_its_actors_and_evaluates_exports_and_serves_them() {
     use macdec::experiment::run::results_tree::CHECKPOINT;
@@ -268,7 +277,6 @@ fn every_acac_method_writes_its_actors_and_evaluates_exports_and_serves_them() {
     let results = train_config(dir.path(), TINY_ACAC);
     for method in ["acac", "acac-vanilla", "acac-micro-gae"] {
         let run_dir = results.join("tiny").join(method).join("seed-0");
-        let policy = run_dir.join("policy");
         let saved = read_policy_files(&run_dir).unwrap();
         let trainer = load_checkpoint(&run_dir.join(CHECKPOINT)).unwrap();
         let trained: Vec<ActingNet> = trainer
@@ -282,33 +290,7 @@ fn every_acac_method_writes_its_actors_and_evaluates_exports_and_serves_them() {
             saved.agents.iter().all(ActingNet::reads_step),
             "{method}: ACAC's actors read the time"
         );
-        let greedy_out = eval(&policy, 3, &[]);
-        let greedy = traces(&greedy_out);
-        let sampled_out = eval(&policy, 3, &["--sample"]);
-        let sampled = traces(&sampled_out);
-        assert_eq!(
-            traces(&eval(&policy, 3, &["--sample"])),
-            sampled,
-            "{method}"
-        );
-        let gif = dir.path().join(format!("{method}.gif"));
-        let rendered_run = rendered(&run(&[
-            "render",
-            "--run",
-            s(&run_dir),
-            "--out",
-            s(&gif),
-            "--episodes",
-            "3",
-        ]));
-        assert_eq!(
-            rendered_run,
-            json_numbers(&greedy_out, "undiscounted_return"),
-            "{method}"
-        );
-        let x = check_export(method, &run_dir, &dir.path().join(format!("{method}-x"))).unwrap();
-        assert_eq!(traces(&eval(&x, 3, &[])), greedy, "{method}");
-        check_robots(method, &policy, &greedy);
+        check_actor_policy(method, &run_dir, dir.path());
     }
 }
 
