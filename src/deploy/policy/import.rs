@@ -426,6 +426,25 @@ impl ImportedFile {
     }
 }
 
+/// Every weight of `named` (a net's tensors by name, as read from `path`) is finite, else
+/// [`ImportError::NonFinite`] naming the first tensor and element that is not.
+pub fn check_finite<S: AsRef<str>>(
+    path: &Path,
+    named: &[(S, ndarray::ArrayViewD<'_, f32>)],
+) -> Result<(), ImportError> {
+    for (name, tensor) in named {
+        if let Some((index, &value)) = tensor.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(ImportError::NonFinite {
+                path: path.to_path_buf(),
+                name: name.as_ref().to_string(),
+                index,
+                value,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The request's domain, built, with one file per agent (else [`ImportError::AgentCount`]).
 pub fn request_domain(request: &ImportRequest) -> Result<AnyEnv, ImportError> {
     let env = request

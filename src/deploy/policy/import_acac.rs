@@ -8,8 +8,8 @@
 //! the time table the file holds, so it acts exactly as ACAC's actor did.
 
 use super::import::{
-    imported_run, read_bounded, request_domain, ImportError, ImportRequest, ImportedFile,
-    MAX_STATE_DICT_BYTES,
+    check_finite, imported_run, read_bounded, request_domain, ImportError, ImportRequest,
+    ImportedFile, MAX_STATE_DICT_BYTES,
 };
 use crate::envs::MacroEnv;
 use crate::nn::safetensors_io::named_to_safetensors_bytes;
@@ -44,52 +44,37 @@ pub fn check_acac_actor(
             widths[0], widths[1], widths[2]
         )));
     }
-    let dim = net.time.as_ref().map_or(0, |t| t.dim());
-    for (name, got, want, what, found) in [
-        (
+    let shape =
+        |name: &str, found: Vec<usize>, expected: String, hint: String| ImportError::Shape {
+            path: path.to_path_buf(),
+            name: name.to_string(),
+            found,
+            expected,
+            hint,
+        };
+    if net.obs_len() != obs_len {
+        let dim = net.time.as_ref().map_or(0, |t| t.dim());
+        let table = if dim == 0 {
+            String::new()
+        } else {
+            format!(", and the file's time table adds {dim}")
+        };
+        return Err(shape(
             "encoder.fc1.weight",
-            net.obs_len(),
-            obs_len,
-            "observation values",
             vec![widths[0], a.input()],
-        ),
-        (
+            format!("[{}, {}]", widths[0], obs_len + dim),
+            format!(" (this agent of the domain has {obs_len} observation values{table})"),
+        ));
+    }
+    if net.n_actions() != n_actions {
+        return Err(shape(
             "fc4.weight",
-            net.n_actions(),
-            n_actions,
-            "macro-actions",
             vec![net.n_actions(), widths[1]],
-        ),
-    ] {
-        if got != want {
-            let expected = if name == "fc4.weight" {
-                format!("[{want}, {}]", widths[1])
-            } else {
-                format!("[{}, {}]", widths[0], want + dim)
-            };
-            return Err(ImportError::Shape {
-                path: path.to_path_buf(),
-                name: name.to_string(),
-                found,
-                expected,
-                hint: if name == "fc4.weight" || dim == 0 {
-                    format!(" (this agent of the domain has {want} {what})")
-                } else {
-                    format!(" (this agent of the domain has {want} {what}, and the file's time table adds {dim})")
-                },
-            });
-        }
+            format!("[{n_actions}, {}]", widths[1]),
+            format!(" (this agent of the domain has {n_actions} macro-actions)"),
+        ));
     }
-    for (name, tensor) in net.named() {
-        if let Some((index, &value)) = tensor.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(ImportError::NonFinite {
-                path: path.to_path_buf(),
-                name,
-                index,
-                value,
-            });
-        }
-    }
+    check_finite(path, &net.named())?;
     Ok(net)
 }
 

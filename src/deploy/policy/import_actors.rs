@@ -6,8 +6,8 @@
 //! by [`Manifest::write_policy`] as for any other policy, its nets of kind `actor`.
 
 use super::import::{
-    imported_run, read_bounded, request_domain, ImportError, ImportRequest, ImportedFile,
-    MAX_STATE_DICT_BYTES,
+    check_finite, imported_run, read_bounded, request_domain, ImportError, ImportRequest,
+    ImportedFile, MAX_STATE_DICT_BYTES,
 };
 use crate::envs::MacroEnv;
 use crate::nn::{GruActor, GruActorConfig};
@@ -63,16 +63,7 @@ pub fn check_actor(
             ),
         });
     }
-    for (name, tensor) in actor.named() {
-        if let Some((index, &value)) = tensor.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(ImportError::NonFinite {
-                path: path.to_path_buf(),
-                name: name.to_string(),
-                index,
-                value,
-            });
-        }
-    }
+    check_finite(path, &actor.named())?;
     Ok(cfg)
 }
 
