@@ -6,6 +6,8 @@ tested by plain `python3 -m unittest discover -s ros` (ros/test_macdec_io.py).
 - `write_all`: a whole message to a pipe or socket before a deadline.
 - `PolicyProcess`: a `macdec robot` child over stdin/stdout; a reply that is not complete within
   the timeout kills and restarts the child instead of hanging the node.
+- `RobotSession`: what a robot node asks of that child: observations with the primitive step
+  they were made at (counted here: a ROS message carries none), resets.
 - `read_manifest`: a policy directory's `policy.json` (or an older export's `manifest.json`),
   a regular file of at most 1 MiB, as macdec itself reads it.
 - `owns_connection`: whether a TCP connection accepted here comes from a given process (Linux
@@ -166,6 +168,48 @@ class PolicyProcess:
             self.child.kill()
             self.child.wait()
         self.child.stdout.close()
+
+
+class RobotSession:
+    """One robot's policy as its node serves it: `macdec robot`'s protocol plus the primitive step.
+
+    A ROS message carries only a macro-observation, but a policy that reads the time (ACAC's
+    actors, through their time embedding) needs the primitive step the observation was made at.
+    The robot's side publishes one message per primitive step (`macro_action_done` when its
+    macro-action finished, and the first of an episode; `macro_obs` otherwise), so that step is
+    the number of observations the policy accepted since the last reset: counted here and sent
+    as `"step"` with every observation, exactly what `macdec deploy` sends from the
+    environment's clock (policies that do not read the time ignore it). Only accepted
+    observations count: a refused one (wrong length, non-finite values) leaves the count
+    unchanged, as it leaves the policy's hidden state, and so does a request that got no reply;
+    a reset starts the count again."""
+
+    def __init__(self, policy):
+        self.policy = policy
+        self.step = 0
+
+    def info(self, restart=True):
+        return self.policy.request({"type": "info"}, restart=restart)
+
+    def observe(self, obs, macro_action_done):
+        """The reply to one observation (a dict; RuntimeError as `PolicyProcess.request`)."""
+        message = {
+            "type": "observe",
+            "obs": obs,
+            "macro_action_done": macro_action_done,
+            "step": self.step,
+        }
+        reply = self.policy.request(message)
+        if "error" not in reply:
+            self.step += 1
+        return reply
+
+    def reset(self):
+        """Zero the policy's hidden state and the step count (a new episode)."""
+        reply = self.policy.request({"type": "reset"})
+        if "error" not in reply:
+            self.step = 0
+        return reply
 
 
 def manifest_path(policy_dir):

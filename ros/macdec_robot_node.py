@@ -17,11 +17,17 @@ Graph resources, relative to the node's namespace (the team launch uses /macdec/
   published   macro_action_name  std_msgs/String             its name (published right after)
   published   info               std_msgs/String (latched)   `macdec robot`'s info reply: agent
               and the policy's manifest
-  service     reset              std_srvs/Trigger            zero the LSTM state (new episode)
+  service     reset              std_srvs/Trigger            zero the LSTM state and the step count
+              (new episode)
   published   /diagnostics       diagnostic_msgs/DiagnosticArray  OK when serving, ERROR for any
               refused message (wrong length, non-finite values), a reply not complete within
               --timeout-secs (the child is killed and restarted) or a restarted child; the node
               keeps running and its state is unchanged by a refused message
+
+Policies that read the time (ACAC's actors) get the primitive step each observation was made at:
+the node counts the observations the policy accepted since the last reset (`RobotSession` in
+macdec_io.py), so the robot's side must publish one message per primitive step, on
+`macro_action_done` or `macro_obs`, from the reset on.
 
 Usage: macdec_robot_node.py --policy DIR --agent I [--macdec PATH] [--timeout-secs S]
        [--max-line-bytes N] [ROS remappings]
@@ -43,7 +49,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from std_msgs.msg import Float32MultiArray, Int32, String
 from std_srvs.srv import Trigger, TriggerResponse
 
-from macdec_io import DEFAULT_MAX_LINE_BYTES, MAX_REPLY_BYTES, PolicyProcess
+from macdec_io import DEFAULT_MAX_LINE_BYTES, MAX_REPLY_BYTES, PolicyProcess, RobotSession
 
 
 class RobotNode:
@@ -52,12 +58,13 @@ class RobotNode:
         self.name = "macdec robot %d" % agent
         command = [macdec, "robot", "--policy", policy_dir, "--agent", str(agent)]
         command += ["--max-line-bytes", str(max_line_bytes)]
-        self.policy = PolicyProcess(command, timeout_secs, MAX_REPLY_BYTES)
+        self.process = PolicyProcess(command, timeout_secs, MAX_REPLY_BYTES)
+        self.policy = RobotSession(self.process)
         try:
-            info = self.policy.request({"type": "info"}, restart=False)
+            info = self.policy.info(restart=False)
         except RuntimeError as e:  # e.g. a bad policy directory: macdec said why on stderr
             rospy.logfatal("%s: cannot serve %s: %s", self.name, policy_dir, e)
-            self.policy.stop()
+            self.process.stop()
             raise SystemExit(1)
         if "error" in info:
             rospy.logfatal("%s: macdec robot refused info: %s", self.name, info["error"])
@@ -107,15 +114,16 @@ class RobotNode:
         elif level != DiagnosticStatus.OK:
             rospy.logwarn("%s: %s", self.name, message)
 
-    def ask(self, message, what):
-        """The reply to `message`, or None after reporting why there is none."""
+    def ask(self, call, what, shown):
+        """The reply of `call()` (a RobotSession request), or None after reporting why there is
+        none; `shown` is what the report quotes of the request."""
         try:
-            reply = self.policy.request(message)
+            reply = call()
         except RuntimeError as e:
             self.report(DiagnosticStatus.ERROR, "%s: %s" % (what, e))
             return None
         if "error" in reply:
-            text = json.dumps(message)[:500]
+            text = json.dumps(shown)[:500]
             self.report(
                 DiagnosticStatus.ERROR,
                 "%s refused: %s" % (what, reply["error"]),
@@ -130,7 +138,9 @@ class RobotNode:
         obs = [float(v) for v in msg.data]
         what = "macro_action_done" if macro_action_done else "macro_obs"
         reply = self.ask(
-            {"type": "observe", "obs": obs, "macro_action_done": macro_action_done}, what
+            lambda: self.policy.observe(obs, macro_action_done),
+            what,
+            {"obs": obs, "step": self.policy.step},
         )
         if reply is None or not macro_action_done:
             return
@@ -139,13 +149,13 @@ class RobotNode:
         self.name_pub.publish(String(data=reply["name"]))
 
     def on_reset(self, _request):
-        reply = self.ask({"type": "reset"}, "reset")
+        reply = self.ask(self.policy.reset, "reset", {"type": "reset"})
         if reply is None:
             return TriggerResponse(success=False, message="reset failed; see /diagnostics")
-        return TriggerResponse(success=True, message="hidden state zeroed")
+        return TriggerResponse(success=True, message="hidden state and step count zeroed")
 
     def shutdown(self):
-        self.policy.stop()
+        self.process.stop()
 
 
 def positive_seconds(text):

@@ -23,6 +23,7 @@ from macdec_io import (  # noqa: E402
     LineTimeout,
     LineTooLong,
     PolicyProcess,
+    RobotSession,
     owns_connection,
     read_manifest,
 )
@@ -40,6 +41,22 @@ for line in sys.stdin:
         while True:
             sys.stdout.write(" "); sys.stdout.flush(); time.sleep(0.05)
     sys.stdout.write('{"n": %d}\n' % n); sys.stdout.flush()
+"""
+
+
+# A stand-in for `macdec robot` that echoes each observation's "step" and refuses one holding
+# a NaN.
+ECHO_ROBOT = r"""
+import json, math, sys
+for line in sys.stdin:
+    m = json.loads(line)
+    if m["type"] == "observe" and any(math.isnan(v) for v in m["obs"]):
+        reply = {"error": "obs: values must be finite"}
+    elif m["type"] == "observe":
+        reply = {"step": m.get("step"), "done": m["macro_action_done"]}
+    else:
+        reply = {"ok": m["type"]}
+    sys.stdout.write(json.dumps(reply) + "\n"); sys.stdout.flush()
 """
 
 
@@ -203,6 +220,28 @@ class OwnsConnectionTest(unittest.TestCase):
         self.assertTrue(owns_connection(child.pid, from_child))
         self.assertFalse(owns_connection(child.pid, accepted_us))
         self.assertTrue(owns_connection(os.getpid(), accepted_us))
+
+
+class RobotSessionTest(unittest.TestCase):
+    """The step a robot node sends is the count of accepted observations since the last reset
+    (the end-to-end check against `macdec domain` is test_robot_session_e2e.py)."""
+
+    def session(self):
+        p = PolicyProcess([sys.executable, "-c", ECHO_ROBOT], 5)
+        self.addCleanup(p.stop, True)
+        return RobotSession(p)
+
+    def test_steps_count_accepted_observations_from_each_reset(self):
+        s = self.session()
+        sent = [s.observe([0.0], done)["step"] for done in (True, False, False, True)]
+        self.assertEqual(sent, [0, 1, 2, 3])
+        # A refused observation is not a step of the policy's episode.
+        self.assertIn("error", s.observe([float("nan")], True))
+        self.assertEqual(s.observe([0.0], False)["step"], 4)
+        self.assertEqual(s.reset(), {"ok": "reset"})
+        self.assertEqual(s.observe([1.0], True), {"step": 0, "done": True})
+        self.assertEqual(s.info(), {"ok": "info"})
+        self.assertEqual(s.observe([1.0], False)["step"], 1)
 
 
 if __name__ == "__main__":

@@ -294,6 +294,43 @@ fn every_acac_method_writes_its_actors_and_evaluates_exports_and_serves_them() {
     }
 }
 
+/// A ROS robot node serves a policy that reads the time by counting the observations since the
+/// reset (a ROS message carries no step): `ros/test_robot_session_e2e.py` runs `macdec domain`
+/// against bridges that drop macdec's step and ask `macdec robot` through the node's
+/// `RobotSession`; every counted step must be macdec's and the episodes `deploy`'s. Skipped,
+/// saying so, where there is no python3.
+#[test]
+fn ros_robot_nodes_count_the_step_an_acac_policy_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = TINY_ACAC.replace(
+        r#"methods = ["acac", "acac-vanilla", "acac-micro-gae"]"#,
+        r#"methods = ["acac"]"#,
+    );
+    let results = train_config(dir.path(), &config);
+    let policy = results.join("tiny/acac/seed-0/policy");
+    let ros = Path::new(env!("CARGO_MANIFEST_DIR")).join("ros");
+    let out = match std::process::Command::new("python3")
+        .args(["-m", "unittest", "-v", "test_robot_session_e2e"])
+        .current_dir(&ros)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .env("MACDEC", common::BIN)
+        .env("MACDEC_TIMED_POLICY", &policy)
+        .output()
+    {
+        Ok(out) => out,
+        Err(e) => {
+            eprintln!("skipped: no python3 to run ros/test_robot_session_e2e.py ({e})");
+            return;
+        }
+    };
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("Ran 1 test") && !err.contains("skipped"),
+        "{err}"
+    );
+}
+
 /// A centralized Q-net for `env` with large weights, so its greedy joint action changes over an
 /// episode.
 fn cen_qnet(env: &impl MacroEnv) -> QNet {
