@@ -67,6 +67,17 @@ pub struct EvalReturns {
     pub undiscounted: f64,
 }
 
+impl EvalReturns {
+    /// The mean of both returns over `episodes` (not empty).
+    pub fn mean(episodes: &[EvalReturns]) -> EvalReturns {
+        let n = episodes.len() as f64;
+        EvalReturns {
+            discounted: episodes.iter().map(|r| r.discounted).sum::<f64>() / n,
+            undiscounted: episodes.iter().map(|r| r.undiscounted).sum::<f64>() / n,
+        }
+    }
+}
+
 /// One training lane a learner asks for: an environment the loop steps and resets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LanePlan {

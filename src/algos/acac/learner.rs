@@ -21,6 +21,7 @@ use super::nets::AcacCritic;
 use super::train_step::update;
 use super::update::{AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace};
 use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
+use crate::algos::actor_critic::lockstep_eval::lockstep_episodes;
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };
@@ -382,46 +383,20 @@ impl Learner for AcacLearner {
         rng: &mut EnvRng,
     ) -> Result<EvalReturns, EnvError> {
         let c = self.c();
-        let n_agents = envs[0].n_agents();
-        let mut recorders = Vec::with_capacity(envs.len());
-        let mut states = Vec::with_capacity(envs.len());
-        for e in envs.iter_mut() {
-            e.reset(rng);
-            recorders.push(EpisodeRecorder::new(&**e, c.gamma, false));
-            states.push(self.zero_states());
-        }
-        let mut returns = Vec::new();
-        let mut actions = vec![0; n_agents];
         let mut probs = Vec::new();
-        while returns.len() < c.eval_num_epi {
-            for k in 0..envs.len() {
+        let returns = lockstep_episodes(
+            envs,
+            c.gamma,
+            c.eval_num_epi,
+            rng,
+            || self.zero_states(),
+            |env, free, states, rng, actions| {
                 Self::choose(
-                    &self.nets,
-                    &*envs[k],
-                    recorders[k].free(),
-                    &mut states[k],
-                    None,
-                    rng,
-                    &mut probs,
-                    &mut actions,
-                );
-                let outcome = envs[k].step(&actions, rng)?;
-                recorders[k].record(&*envs[k], outcome);
-                if outcome.done {
-                    returns.push(recorders[k].returns());
-                    envs[k].reset(rng);
-                    recorders[k].begin(&*envs[k]);
-                    for s in &mut states[k] {
-                        s.reset();
-                    }
-                }
-            }
-        }
-        let n = returns.len() as f64;
-        Ok(EvalReturns {
-            discounted: returns.iter().map(|r| r.discounted).sum::<f64>() / n,
-            undiscounted: returns.iter().map(|r| r.undiscounted).sum::<f64>() / n,
-        })
+                    &self.nets, env, free, states, None, rng, &mut probs, actions,
+                )
+            },
+        )?;
+        Ok(EvalReturns::mean(&returns))
     }
 
     /// One environment: the lockstep evaluation with a single lane.

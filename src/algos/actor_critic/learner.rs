@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::acting::{act_centralized, act_decentralized, ActBuffers};
 use super::config::AcConfig;
 use super::episode::{Episode, EpisodeRecorder};
+use super::lockstep_eval::lockstep_episodes;
 use super::method::{AcActor, AcCritic, AcDesign, AcMethod};
 use super::nets::{AcNets, NetSizes};
 use super::update::{update, UpdateParams, UpdateTrace};
@@ -323,50 +324,33 @@ impl Learner for AcLearner {
         rng: &mut EnvRng,
     ) -> Result<EvalReturns, EnvError> {
         let c = self.c();
-        let n_agents = envs[0].n_agents();
-        let mut recorders = Vec::with_capacity(envs.len());
-        let mut states = Vec::with_capacity(envs.len());
-        for e in envs.iter_mut() {
-            e.reset(rng);
-            recorders.push(EpisodeRecorder::new(&**e, c.gamma, false));
-            states.push(self.zero_states());
-        }
-        let mut returns = Vec::new();
-        let mut actions = vec![0; n_agents];
         let mut buffers = ActBuffers::default();
         let actor = self.design().actor;
-        while returns.len() < c.eval_num_epi {
-            for k in 0..envs.len() {
+        let returns = lockstep_episodes(
+            envs,
+            c.gamma,
+            c.eval_num_epi,
+            rng,
+            || self.zero_states(),
+            |env, free, states, rng, actions| {
+                let n_actions = &self.sizes.n_actions;
                 choose(
                     &self.nets,
                     actor,
-                    &self.sizes.n_actions,
-                    &*envs[k],
-                    recorders[k].free(),
-                    &mut states[k],
+                    n_actions,
+                    env,
+                    free,
+                    states,
                     None,
                     rng,
                     &mut buffers,
-                    &mut actions,
-                );
-                let outcome = envs[k].step(&actions, rng)?;
-                recorders[k].record(&*envs[k], outcome);
-                if outcome.done {
-                    returns.push(recorders[k].returns());
-                    envs[k].reset(rng);
-                    recorders[k].begin(&*envs[k]);
-                    for s in &mut states[k] {
-                        s.reset();
-                    }
-                }
-            }
-        }
-        let last = &returns[returns.len() - c.eval_num_epi..];
-        let n = last.len() as f64;
-        Ok(EvalReturns {
-            discounted: last.iter().map(|r| r.discounted).sum::<f64>() / n,
-            undiscounted: last.iter().map(|r| r.undiscounted).sum::<f64>() / n,
-        })
+                    actions,
+                )
+            },
+        )?;
+        Ok(EvalReturns::mean(
+            &returns[returns.len() - c.eval_num_epi..],
+        ))
     }
 
     /// One environment: the lockstep evaluation with a single lane.

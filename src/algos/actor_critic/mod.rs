@@ -12,6 +12,7 @@ pub mod config;
 pub mod episode;
 pub mod family;
 pub mod learner;
+pub mod lockstep_eval;
 pub mod method;
 pub mod nets;
 pub mod published;
