@@ -195,7 +195,7 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
         points,
         env_steps,
         finished: true,
-        wall_seconds: 0.0,
+        wall_seconds: None,
         setting: None,
         provenance: None,
     })
@@ -356,7 +356,7 @@ runs = "bp6/mac_iaicc"
                 .collect(),
             env_steps: steps.to_vec(),
             finished: true,
-            wall_seconds: 0.0,
+            wall_seconds: None,
             setting: None,
             provenance: None,
         }

@@ -35,8 +35,9 @@ pub struct RunData {
     pub env_steps: Vec<u64>,
     /// Whether the run wrote its `finished` marker.
     pub finished: bool,
-    /// Wall-clock seconds at the run's last evaluation.
-    pub wall_seconds: f64,
+    /// Wall-clock seconds at the run's last evaluation; None for another code's logs drawn
+    /// `--beside` ours, which record neither their time nor a provenance.
+    pub wall_seconds: Option<f64>,
     /// The domain setting from `config.toml`, when it is present and readable.
     pub setting: Option<EnvSetting>,
     /// The build and machine that trained the run, when its `config.toml` records them.
@@ -297,7 +298,7 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
         points,
         env_steps,
         finished: results_tree::is_finished(dir),
-        wall_seconds: rows.last().map_or(0.0, |r| r.wall_seconds),
+        wall_seconds: Some(rows.last().map_or(0.0, |r| r.wall_seconds)),
         setting,
         provenance,
     })
@@ -412,7 +413,7 @@ pub(crate) mod tests {
         assert_eq!(our1.runs[0].points, vec![(0, 1.0)]);
         // write_run records env_steps = 50 x episode, row for row with the returns.
         assert_eq!(our1.runs[1].env_steps, vec![0, 500]);
-        assert_eq!(our1.runs[1].wall_seconds, 5.0);
+        assert_eq!(our1.runs[1].wall_seconds, Some(5.0));
         assert_eq!(
             our1.runs[1].setting.clone().unwrap().optimal_return(),
             Some(80.71093744250365)

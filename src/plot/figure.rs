@@ -245,7 +245,11 @@ fn provenance_mix(exp: &ExperimentData) -> Option<String> {
         *commits.entry(short).or_default() += 1;
         *paths.entry(p.kernel_path.clone()).or_default() += 1;
     }
-    let unknown = runs.iter().filter(|r| r.provenance.is_none()).count();
+    // Another code's logs (no wall time either) never record a provenance: not worth a note.
+    let unknown = runs
+        .iter()
+        .filter(|r| r.provenance.is_none() && r.wall_seconds.is_some())
+        .count();
     let list = |m: &BTreeMap<String, usize>| {
         m.iter()
             .map(|(k, n)| format!("{k} x {n}"))
@@ -381,17 +385,18 @@ fn summarize(
         .filter_map(|r| run_mean_over_training(&r.points))
         .collect();
     let (final_mean, final_se) = mean_and_se(&final_returns).unwrap_or((f64::NAN, f64::NAN));
-    let finished: Vec<f64> = curve
+    let finished = curve.runs.iter().filter(|r| r.finished).count();
+    let minutes: Vec<f64> = curve
         .runs
         .iter()
         .filter(|r| r.finished)
-        .map(|r| r.wall_seconds)
+        .filter_map(|r| r.wall_seconds)
         .collect();
     CurveSummary {
         curve: curve.name.clone(),
         legend: curve.legend(),
         seeds: curve.runs.len(),
-        finished: finished.len(),
+        finished,
         final_episode,
         final_mean,
         final_se,
@@ -401,8 +406,8 @@ fn summarize(
         smoothing_points,
         mean_over_training: mean_over_training(mean).unwrap_or(f64::NAN),
         optimal,
-        run_minutes: (!finished.is_empty())
-            .then(|| finished.iter().sum::<f64>() / finished.len() as f64 / 60.0),
+        run_minutes: (!minutes.is_empty())
+            .then(|| minutes.iter().sum::<f64>() / minutes.len() as f64 / 60.0),
         final_returns,
         training_means,
     }
@@ -543,6 +548,35 @@ mod tests {
         );
         assert!(note.contains("1 run(s) record no provenance"), "{note}");
         assert!(built.figure.caption.contains("Note: mixes 2 git commits"));
+    }
+
+    /// Another code's logs drawn beside ours have no time and no provenance: the summary gives
+    /// them no minutes (not 0.0) and the figure no "record no provenance" note.
+    #[test]
+    fn logs_beside_ours_have_no_minutes_and_no_provenance_note() {
+        let t = tempfile::tempdir().unwrap();
+        let a = write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
+        let path = a.join("config.toml");
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        text.push_str(&format!(
+            "\n[provenance]\nmacdec_version = \"0.1.0\"\ngit_commit = \"{}\"\n\
+             kernel_path = \"avx512\"\ncpu_model = \"test\"\n",
+            "a".repeat(40)
+        ));
+        std::fs::write(path, text).unwrap();
+        let mut exp = discover(t.path()).unwrap().experiments[0].clone();
+        let mut theirs = exp.curves[0].clone();
+        theirs.name = "theirs".into();
+        for r in &mut theirs.runs {
+            r.wall_seconds = None;
+            r.provenance = None;
+        }
+        exp.curves.push(theirs);
+        let built = build(&exp);
+        assert!(built.notes.is_empty(), "{:?}", built.notes);
+        let s = &built.summary[1];
+        assert_eq!((s.seeds, s.finished, s.run_minutes), (1, 1, None));
+        assert!(built.summary[0].run_minutes.is_some());
     }
 
     #[test]

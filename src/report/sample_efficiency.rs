@@ -64,7 +64,7 @@ mod tests {
             points: points.to_vec(),
             env_steps: points.iter().map(|p| p.0 * steps_per_episode).collect(),
             finished: true,
-            wall_seconds: 0.0,
+            wall_seconds: Some(0.0),
             setting: None,
             provenance: None,
         }
