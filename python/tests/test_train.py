@@ -119,6 +119,9 @@ def test_bad_configs_are_named(tmp_path):
         macdec.train({"params": {"env_name": "BP_MA"}}, methods="not-a-method", out=tmp_path)
     with pytest.raises(FileNotFoundError, match="missing.toml"):
         macdec.train(tmp_path / "missing.toml", out=tmp_path)
+    # An unknown key's hint comes from the method's own family (and names the family it is of).
+    with pytest.raises(ValueError, match=r"unknown key `l_rate` for mac-iac \(`l_rate` is a key of the ICRA 2020.*a_lr, c_lr"):
+        macdec.train({"methods": ["mac-iac"], "params": {"env_name": "BP-MA-v0", "l_rate": 0.01}}, out=tmp_path)
     # One key per override: a line break inside one would apply the first key and drop the rest.
     with pytest.raises(ValueError, match="line break"):
         macdec.train({"methods": ["our1"], "params": {"env_name": "BP_MA"}}, out=tmp_path,
