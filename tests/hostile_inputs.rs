@@ -781,6 +781,80 @@ fn a_joint_action_net_beyond_the_memory_bound_is_refused_before_any_run_starts()
     assert_eq!(runs, 0, "{err}");
 }
 
+#[test]
+fn the_largest_joint_action_batches_the_bound_allows_train_within_its_memory() {
+    // The other side of the bound: at the largest batch it lets through, a joint-action net
+    // (15^3 = 3375 outputs on three-cook Overcooked B) updates within 2.5 GB of address space
+    // (measured: about 1 GB resident each), for the actor-critic family's Mac-CAC (24 episodes
+    // per update; 25 are refused) and MacroMARL's value-based MacCen-Q (24 sequences of the
+    // horizon; 25 are refused).
+    let dir = tempfile::tempdir().unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let cac = format!("{root}/experiments/macromarl/overcooked_b.toml");
+    let cen_q = format!("{root}/experiments/macromarl_value/overcooked_b.toml");
+    let runs: [(&str, &str, &[&str]); 2] = [
+        (
+            &cac,
+            "mac-cac",
+            &[
+                "train_freq=24",
+                "n_env=24",
+                "total_epi=48",
+                "eval_freq=24",
+                "eval_num_epi=1",
+            ],
+        ),
+        (
+            &cen_q,
+            "mac-cen-q",
+            &[
+                "n_agent=3",
+                "batch_size=24",
+                "start_train=30",
+                "total_epi=40",
+                "eval_freq=10",
+            ],
+        ),
+    ];
+    for (config, method, sets) in runs {
+        let out = dir.path().join(method);
+        let mut args = vec![
+            "train",
+            "--config",
+            config,
+            "--methods",
+            method,
+            "--seeds",
+            "0",
+        ];
+        for set in sets {
+            args.extend(["--set", set]);
+        }
+        args.extend(["--out", s(&out), "--quiet", "--no-plot", "--jobs", "1"]);
+        let result = macdec_within(&args, Duration::from_secs(600), Some(5 << 29));
+        let err = String::from_utf8_lossy(&result.stderr);
+        assert!(result.status.success(), "{method}: {err}");
+        // One more episode per update is refused before any run starts.
+        let over: Vec<String> = sets.iter().map(|set| set.replace("=24", "=25")).collect();
+        let mut args = vec![
+            "train",
+            "--config",
+            config,
+            "--methods",
+            method,
+            "--seeds",
+            "0",
+        ];
+        for set in &over {
+            args.extend(["--set", set.as_str()]);
+        }
+        let refused_out = dir.path().join(format!("{method}-over"));
+        args.extend(["--out", s(&refused_out)]);
+        let err = refused(&macdec(&args));
+        assert!(err.contains("widest output 3375"), "{method}: {err}");
+    }
+}
+
 /// Files under `dir` (0 when it does not exist).
 fn walkdir_count(dir: &Path) -> usize {
     let Ok(entries) = std::fs::read_dir(dir) else {
