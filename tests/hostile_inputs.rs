@@ -522,6 +522,177 @@ fn no_key_is_dropped_a_set_with_a_line_break_nor_a_key_the_domain_does_not_read(
 }
 
 #[test]
+fn a_replay_file_naming_a_key_its_domain_does_not_read_is_refused_never_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    // macdec's own form and the reference's form, each with a key its domain does not read:
+    // replayed noiseless (or with the other layout) it would not be the episode the file means.
+    for (file, key) in [
+        (
+            r#"{"env": "box-pushing", "grid": 8, "horizon": 30, "tb_m_noisy": 0.5, "steps": [[0, 0]]}"#,
+            "`tb_m_noisy`",
+        ),
+        (
+            r#"{"env": "BP_MA", "params": {"grid_dim": 8, "tb_m_noisy": 0.5}, "steps": [[0, 0]]}"#,
+            "`tb_m_noisy`",
+        ),
+        (
+            r#"{"env": "OSD_S_4", "params": {"grid_dim": 7}, "steps": [[0, 0, 0]]}"#,
+            "`grid_dim`",
+        ),
+        (
+            r#"{"env": "BP-MA-v0", "grid_dim": [6, 6], "TB_move_speed": 0.5, "steps": [[0, 0]]}"#,
+            "`TB_move_speed`",
+        ),
+    ] {
+        let path = dir.path().join("actions.json");
+        std::fs::write(&path, file).unwrap();
+        let out = macdec(&["replay", "--actions", s(&path)]);
+        let err = refused(&out);
+        assert!(err.contains(key), "{file}: {err}");
+        assert!(out.stdout.is_empty(), "{file}: nothing may be replayed");
+    }
+}
+
+#[test]
+fn an_unknown_key_is_hinted_from_the_methods_own_family() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("results");
+    // An ICRA key given to an actor-critic method, and the other way round: the hint names the
+    // family the key belongs to and the method's own keys, never the other family's.
+    let err = refused(&macdec(&[
+        "train",
+        "--methods",
+        "mac-iac",
+        "--set",
+        "l_rate=0.01",
+        "--out",
+        s(&results),
+    ]));
+    assert!(
+        err.contains("unknown key `l_rate` for mac-iac")
+            && err.contains("is a key of the ICRA 2020")
+            && err.contains("a_lr, c_lr")
+            && !err.contains("replay_buffer_size"),
+        "{err}"
+    );
+    let err = refused(&macdec(&[
+        "train",
+        "--methods",
+        "our1",
+        "--set",
+        "a_lr=0.01",
+        "--out",
+        s(&results),
+    ]));
+    assert!(
+        err.contains("`a_lr` is a key of MacroMARL's")
+            && err.contains("our1 takes the keys of the ICRA 2020")
+            && !err.contains("n_env"),
+        "{err}"
+    );
+    // A typo of the family's own key.
+    let err = refused(&macdec(&[
+        "train",
+        "--methods",
+        "mac-iac",
+        "--set",
+        "a_lrr=0.01",
+        "--out",
+        s(&results),
+    ]));
+    assert!(
+        err.contains("did you mean `a_lr`?") && !err.contains("is a key of"),
+        "{err}"
+    );
+    assert!(!results.exists(), "no run may start");
+}
+
+#[test]
+fn a_run_that_could_not_update_is_refused_never_called_finished() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("results");
+    // Certain from the config: refused by name before any run starts, in every family.
+    for (method, sets, key) in [
+        // Actor-critic: one update per train_freq episodes.
+        (
+            "mac-iac",
+            &["train_freq=32", "total_epi=16", "eval_freq=8"][..],
+            "`train_freq`: must be at most total_epi (16)",
+        ),
+        // Value families: one update per train_freq main-loop steps, at most total_epi x horizon.
+        (
+            "our1",
+            &["train_freq=100000", "total_epi=20", "eval_freq=10"][..],
+            "`train_freq`: must be at most total_epi x env_terminate_step",
+        ),
+        (
+            "mac-dec-q",
+            &[
+                "train_freq=100000",
+                "total_epi=40",
+                "start_train=2",
+                "eval_freq=10",
+            ][..],
+            "`train_freq`: must be at most total_epi x env_terminate_step",
+        ),
+        (
+            "our1",
+            &["start_train=100", "total_epi=20", "eval_freq=10"][..],
+            "`start_train`: must be at most total_epi (20)",
+        ),
+        (
+            "mac-dec-q",
+            &["start_train=40", "total_epi=40", "eval_freq=10"][..],
+            "`start_train`: must be below total_epi (40)",
+        ),
+    ] {
+        let mut args = vec!["train", "--methods", method, "--seeds", "0"];
+        for set in sets {
+            args.extend(["--set", set]);
+        }
+        args.extend(["--out", s(&results)]);
+        let err = refused(&macdec(&args));
+        assert!(err.contains(key), "{method} {sets:?}: {err}");
+        assert!(!results.exists(), "no run may start");
+    }
+    // Not certain from the config (episodes ended early): the run trains its budget, then
+    // fails naming why instead of "finishing" with its initial nets and exit status 0.
+    let out = macdec(&[
+        "train",
+        "--methods",
+        "our1",
+        "--seeds",
+        "0",
+        "--set",
+        "grid_dim=8",
+        "--set",
+        "env_terminate_step=30",
+        "--set",
+        "total_epi=2",
+        "--set",
+        "start_train=2",
+        "--set",
+        "eval_freq=1",
+        "--set",
+        "train_freq=7",
+        "--out",
+        s(&results),
+        "--no-plot",
+    ]);
+    let err = refused(&out);
+    assert!(err.contains("without a single update"), "{err}");
+    let run = results.join("quickstart_bp10/our1/seed-0");
+    assert!(
+        run.join("metrics.csv").is_file(),
+        "the evaluations are kept"
+    );
+    assert!(
+        !run.join("finished").exists(),
+        "a run without an update is not finished"
+    );
+}
+
+#[test]
 fn a_robot_reads_its_weight_file_before_building_a_net_the_manifest_sizes() {
     use sha2::Digest;
     let dir = tempfile::tempdir().unwrap();
@@ -608,6 +779,80 @@ fn a_joint_action_net_beyond_the_memory_bound_is_refused_before_any_run_starts()
     );
     let runs = walkdir_count(&out);
     assert_eq!(runs, 0, "{err}");
+}
+
+#[test]
+fn the_largest_joint_action_batches_the_bound_allows_train_within_its_memory() {
+    // The other side of the bound: at the largest batch it lets through, a joint-action net
+    // (15^3 = 3375 outputs on three-cook Overcooked B) updates within 2.5 GB of address space
+    // (measured: about 1 GB resident each), for the actor-critic family's Mac-CAC (24 episodes
+    // per update; 25 are refused) and MacroMARL's value-based MacCen-Q (24 sequences of the
+    // horizon; 25 are refused).
+    let dir = tempfile::tempdir().unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let cac = format!("{root}/experiments/macromarl/overcooked_b.toml");
+    let cen_q = format!("{root}/experiments/macromarl_value/overcooked_b.toml");
+    let runs: [(&str, &str, &[&str]); 2] = [
+        (
+            &cac,
+            "mac-cac",
+            &[
+                "train_freq=24",
+                "n_env=24",
+                "total_epi=48",
+                "eval_freq=24",
+                "eval_num_epi=1",
+            ],
+        ),
+        (
+            &cen_q,
+            "mac-cen-q",
+            &[
+                "n_agent=3",
+                "batch_size=24",
+                "start_train=30",
+                "total_epi=40",
+                "eval_freq=10",
+            ],
+        ),
+    ];
+    for (config, method, sets) in runs {
+        let out = dir.path().join(method);
+        let mut args = vec![
+            "train",
+            "--config",
+            config,
+            "--methods",
+            method,
+            "--seeds",
+            "0",
+        ];
+        for set in sets {
+            args.extend(["--set", set]);
+        }
+        args.extend(["--out", s(&out), "--quiet", "--no-plot", "--jobs", "1"]);
+        let result = macdec_within(&args, Duration::from_secs(600), Some(5 << 29));
+        let err = String::from_utf8_lossy(&result.stderr);
+        assert!(result.status.success(), "{method}: {err}");
+        // One more episode per update is refused before any run starts.
+        let over: Vec<String> = sets.iter().map(|set| set.replace("=24", "=25")).collect();
+        let mut args = vec![
+            "train",
+            "--config",
+            config,
+            "--methods",
+            method,
+            "--seeds",
+            "0",
+        ];
+        for set in &over {
+            args.extend(["--set", set.as_str()]);
+        }
+        let refused_out = dir.path().join(format!("{method}-over"));
+        args.extend(["--out", s(&refused_out)]);
+        let err = refused(&macdec(&args));
+        assert!(err.contains("widest output 3375"), "{method}: {err}");
+    }
 }
 
 /// Files under `dir` (0 when it does not exist).

@@ -52,6 +52,7 @@ class MacroParallelEnv(ParallelEnv):
         self.render_mode = render_mode
         self.possible_agents = [f"agent_{i}" for i in range(self._env.n_agents)]
         self.agents: list = []
+        self._started = False
         self._index = {a: i for i, a in enumerate(self.possible_agents)}
         self._team_return = 0.0
         self.metadata = dict(self.metadata, name=f"macdec/{self._env.env_name}")
@@ -95,12 +96,15 @@ class MacroParallelEnv(ParallelEnv):
         """Start an episode. ``seed`` restarts the environment's random stream (``None``
         continues it; the first reset without a seed draws one). ``options`` is not used."""
         self._env.reset(seed)
+        self._started = True
         self.agents = list(self.possible_agents)
         self._team_return = 0.0
         return self._observations(), self._infos()
 
     def step(self, actions: Dict[str, int]):
         """One primitive step: ``(obs, rewards, terminations, truncations, infos)``, dicts by agent."""
+        if not self._started:
+            raise RuntimeError("step called before reset(): call reset() to start an episode")
         if not self.agents:
             raise RuntimeError("step called after the episode ended; call reset() first")
         row = [-1] * len(self.possible_agents)

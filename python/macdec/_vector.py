@@ -57,11 +57,33 @@ class VectorEnv:
         if a.shape != expected:
             raise ValueError(f"actions must be an integer array of shape (num_envs, n_agents) = {expected}, got shape {a.shape}")
         if a.dtype.kind not in "iu":
-            raise ValueError(f"actions must be integers, got dtype {a.dtype}")
+            env, agent = self._first_non_index(a)
+            value = a[env, agent]
+            value = value.item() if isinstance(value, np.generic) else value
+            raise ValueError(
+                f"env {env}, agent {agent}: an action is one macro-action index, an integer in "
+                f"0..{self.n_actions[agent]}, got {value!r} (actions must be integers, got dtype {a.dtype})"
+            )
         if a.dtype.kind == "u" and a.size and a.max() > np.iinfo(np.int64).max:
             env, agent = np.unravel_index(int(a.argmax()), expected)
             raise ValueError(f"env {env}, agent {agent}: the macro-action must be in 0..{self.n_actions[agent]}, got {a.max()}")
         return self._core.step(np.ascontiguousarray(a, dtype=np.int64))
+
+    def _first_non_index(self, a: np.ndarray) -> Tuple[int, int]:
+        """The first (env, agent) of a non-integer array whose entry is no macro-action index
+        (a string, a bool, NaN, infinite, fractional or out of its agent's range), else the first
+        entry: all are refused, but the message names the one most likely meant."""
+        for k, i in np.ndindex(*a.shape):
+            v = a[k, i]
+            if isinstance(v, (str, bytes, bool, np.bool_)):
+                return k, i
+            try:
+                f = float(v)
+            except (TypeError, ValueError):
+                return k, i
+            if not (np.isfinite(f) and f == int(f) and 0 <= f < self.n_actions[i]):
+                return k, i
+        return 0, 0
 
     def close(self) -> None:
         """Nothing to release."""

@@ -156,6 +156,19 @@ def test_bad_input_raises_errors_naming_the_problem():
         venv.step(np.array([[0, 0], [9, 0]]))
     with pytest.raises(ValueError, match="integers"):
         venv.step(np.zeros((2, 2)))
+    # Floats are refused, naming the entry, its agent's range and the value (not truncated).
+    for bad, shown in [(np.inf, "inf"), (2.7, "2.7"), (-np.inf, "-inf"), (1e300, "1e\\+300"), ("3", "'3'")]:
+        with pytest.raises(ValueError, match=rf"env 1, agent 0: an action is one macro-action index, an integer in 0..8, got {shown} "):
+            venv.step(np.array([[0, 0], [bad, 0]], dtype=object if isinstance(bad, str) else float))
+
+
+def test_step_before_reset_says_so():
+    env = macdec.parallel_env("BP_MA")
+    with pytest.raises(RuntimeError, match=r"step called before reset\(\)"):
+        env.step({"agent_0": 0, "agent_1": 0})
+    venv = macdec.vector_env("BP_MA", 2)
+    with pytest.raises(RuntimeError, match=r"call reset\(\) before step\(\)"):
+        venv.step(np.zeros((2, 2), dtype=np.int64))
 
 
 def test_same_seed_same_episode_and_render_draws_rgb():

@@ -104,3 +104,21 @@ def test_a_centralized_policy_keeps_busy_agents_and_names_a_missing_decision(tmp
         assert again["agent_0"] == first["agent_0"]
     # Nobody done: nothing is decided and the net does not step.
     assert p.act(obs, [False, False]) == again and p.scores == {}
+
+
+@pytest.mark.parametrize("method,net", [("mac-cac", "centralized actor"), ("cen-ddrqn", "centralized Q-net")])
+def test_a_failed_centralized_act_names_the_net_and_changes_nothing(method, net, tmp_path):
+    config = {**ACTOR, "methods": [method]} if method == "mac-cac" else {**VALUE, "methods": [method]}
+    (run,) = macdec.train(config, out=tmp_path)
+    p = macdec.Policy.load(run)
+    env = p.make_env()
+    obs, infos = env.reset(seed=0)
+    p.act(obs, infos)
+    first = p.scores["team"].copy()
+    p.reset()
+    bad = {a: np.full_like(o, np.finfo(np.float32).max) for a, o in obs.items()}
+    with pytest.raises(RuntimeError, match=rf"the {net} answered a non-finite .*its state is unchanged"):
+        p.act(bad, infos)
+    # The team's hidden state did not advance: the same observation gives the same scores.
+    p.act(obs, infos)
+    assert np.array_equal(p.scores["team"], first), "a failed act advanced the team's hidden state"

@@ -119,6 +119,13 @@ def test_bad_configs_are_named(tmp_path):
         macdec.train({"params": {"env_name": "BP_MA"}}, methods="not-a-method", out=tmp_path)
     with pytest.raises(FileNotFoundError, match="missing.toml"):
         macdec.train(tmp_path / "missing.toml", out=tmp_path)
+    # An unknown key's hint comes from the method's own family (and names the family it is of).
+    with pytest.raises(ValueError, match=r"unknown key `l_rate` for mac-iac \(`l_rate` is a key of the ICRA 2020.*a_lr, c_lr"):
+        macdec.train({"methods": ["mac-iac"], "params": {"env_name": "BP-MA-v0", "l_rate": 0.01}}, out=tmp_path)
+    # One key per override: a line break inside one would apply the first key and drop the rest.
+    with pytest.raises(ValueError, match="line break"):
+        macdec.train({"methods": ["our1"], "params": {"env_name": "BP_MA"}}, out=tmp_path,
+                     overrides=["total_epi=30\neval_freq=5"])
     assert not any(tmp_path.iterdir())
 
 
@@ -130,6 +137,26 @@ def test_a_joint_action_net_beyond_the_memory_bound_is_a_value_error(tmp_path):
     with pytest.raises(ValueError, match="widest output 3375"):
         macdec.train(config, out=tmp_path, overrides={"n_env": 200, "train_freq": 200})
     assert not any(tmp_path.iterdir())
+
+
+def test_a_run_that_could_not_update_is_refused_never_finished(tmp_path):
+    # Certain from the config: a ValueError naming the key before any run starts.
+    ac = {"methods": ["mac-iac"], "params": {"env_name": "BP-MA-v0", "grid_dim": [6, 6], "env_terminate_step": 20,
+                                            "total_epi": 16, "n_env": 4, "train_freq": 32, "eval_freq": 8}}
+    with pytest.raises(ValueError, match=r"`train_freq`: must be at most total_epi \(16\)"):
+        macdec.train(ac, out=tmp_path)
+    for method in ("our1", "mac-dec-q"):
+        with pytest.raises(ValueError, match=r"`train_freq`: must be at most total_epi x env_terminate_step"):
+            macdec.train({"methods": [method], "params": {"env_name": "BP-MA-v0" if method == "mac-dec-q" else "BP_MA"}},
+                         out=tmp_path, overrides={"total_epi": 40, "start_train": 2, "eval_freq": 10, "train_freq": 10**6})
+    assert not any(tmp_path.iterdir())
+    # Not certain (the episodes ended early): the budget is trained, then the run fails naming why.
+    value = {"methods": ["our1"], "seeds": "0", "params": {"env_name": "BP_MA", "grid_dim": 8, "env_terminate_step": 30,
+                                                           "total_epi": 2, "start_train": 2, "eval_freq": 1, "train_freq": 7}}
+    with pytest.raises(RuntimeError, match="without a single update"):
+        macdec.train(value, out=tmp_path)
+    (run,) = [d for d in tmp_path.glob("*/our1/seed-0")]
+    assert (run / "metrics.csv").is_file() and not (run / "finished").exists()
 
 
 def test_ctrl_c_stops_cleanly_and_training_again_resumes_to_the_same_metrics(tmp_path, run_cli):

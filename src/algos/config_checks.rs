@@ -125,6 +125,28 @@ pub fn check_eval_rows(total_epi: usize, eval_freq: usize) -> Result<(), (&'stat
     Ok(())
 }
 
+/// An update runs every `train_freq` main-loop steps (the value families), and a run takes at
+/// most total_epi x horizon of them: a larger `train_freq` would "finish" without a single
+/// update. (Shorter episodes can still leave a run without one; the runner refuses to call such a
+/// run finished.)
+pub fn check_train_freq_steps(
+    train_freq: usize,
+    total_epi: usize,
+    horizon: usize,
+) -> Result<(), (&'static str, String)> {
+    let most_steps = (total_epi as u128).saturating_mul(horizon as u128);
+    if train_freq as u128 > most_steps {
+        return Err((
+            "train_freq",
+            format!(
+                "must be at most total_epi x env_terminate_step = {most_steps} main-loop steps, got \
+                 {train_freq}: an update runs every train_freq steps, so none would"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,8 @@
 
 use crate::algos::config_checks::{
     check_at_most, check_batch_activations, check_discount, check_eval_rows, check_positive,
-    check_rates, check_unit, NetWidths, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
+    check_rates, check_train_freq_steps, check_unit, NetWidths, MAX_HORIZON, MAX_NET_WIDTH,
+    MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
 use crate::algos::mac_value::method::{MacValueMethod, QNets};
@@ -258,6 +259,7 @@ pub fn check(
             ),
         ));
     }
+    check_train_freq_steps(c.train_freq, c.total_epi, shape.horizon)?;
     check_eval_rows(c.total_epi, c.eval_freq)?;
     check_unit(&[
         ("init_h", c.init_h),

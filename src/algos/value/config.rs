@@ -3,8 +3,8 @@
 
 use crate::algos::config_checks::{
     check_at_most, check_batch_activations, check_discount, check_eval_rows, check_positive,
-    check_rates, check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH,
-    MAX_TOTAL_EPI,
+    check_rates, check_train_freq_steps, check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON,
+    MAX_NET_WIDTH, MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
 use crate::algos::value::method::ValueMethod;
@@ -192,6 +192,7 @@ pub fn check(
             ),
         ));
     }
+    check_train_freq_steps(c.train_freq, c.total_epi, shape.horizon)?;
     if !c.total_epi.is_multiple_of(c.eval_freq) {
         return Err((
             "total_epi",

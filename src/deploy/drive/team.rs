@@ -103,6 +103,11 @@ pub struct CentralPolicy {
 struct CentralNet {
     net: ActingNet,
     state: ActingState,
+    /// Where a step is computed; it becomes the state only if everything came out finite, so a
+    /// refused decision leaves the team as it was (as `NetPolicy` does for one agent).
+    candidate: ActingState,
+    /// The scores of the last decision.
+    scores: Vec<f32>,
     n_actions: Vec<usize>,
     /// The team's sampling stream, kept across episodes; `None` for a Q-net, which never
     /// samples.
@@ -134,6 +139,8 @@ impl CentralPolicy {
             free: vec![true; n_actions.len()],
             core: CentralNet {
                 state: net.zero_state(),
+                candidate: net.zero_state(),
+                scores: Vec::new(),
                 probs: Vec::new(),
                 net,
                 n_actions,
@@ -211,12 +218,23 @@ impl CentralNet {
             (Choice::Sampled, None) => return Err(not_an_actor().to_string()),
         };
         // No centralized net reads the step: policy files hold ACAC's actors only as agents'.
-        let scores = self.net.act_step(joint_obs, 0, &mut self.state);
-        if let Some(bad) = scores.iter().find(|x| !x.is_finite()) {
+        self.candidate.copy_from(&self.state);
+        let candidate_scores = self.net.act_step(joint_obs, 0, &mut self.candidate);
+        self.scores.clear();
+        self.scores.extend_from_slice(candidate_scores);
+        let bad = self.scores.iter().find(|x| !x.is_finite()).copied();
+        if bad.is_some() || !self.candidate.is_finite() {
+            let what = match bad {
+                Some(v) => format!("a non-finite score ({v})"),
+                None => "a non-finite hidden state".into(),
+            };
             return Err(format!(
-                "the centralized net answered a non-finite score ({bad}); the observation is out of the range it was trained on"
+                "the {} answered {what}; the observation is out of the range it was trained on (its state is unchanged)",
+                NetKind::of(&self.net).centralized_name()
             ));
         }
+        std::mem::swap(&mut self.state, &mut self.candidate);
+        let scores = &self.scores[..];
         match sampler {
             Some(s) => conditioned_joint(
                 scores,

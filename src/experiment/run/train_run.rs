@@ -357,6 +357,17 @@ pub enum RunError {
         /// Why it was refused.
         message: String,
     },
+    /// Training ran its whole budget without one update: the schedule (`train_freq`,
+    /// `start_train`) left no room for one within `total_epi`, so the nets are the initial ones.
+    #[error("{dir}: training ended after {episodes} episodes ({env_steps} primitive steps) without a single update: train_freq or start_train leaves no room for one within total_epi; the run is not marked finished")]
+    NoUpdate {
+        /// The run directory.
+        dir: PathBuf,
+        /// Training episodes completed.
+        episodes: u64,
+        /// Primitive steps taken by the training environments.
+        env_steps: u64,
+    },
     /// Training itself failed.
     #[error(transparent)]
     Train(#[from] TrainError),
@@ -585,6 +596,15 @@ pub fn train_run_until(
     save_metrics(dir, &trainer)?;
     save_checkpoint(&checkpoint, &identity, &mut trainer)?;
     save_policy_files(dir, spec, &trainer)?;
+    // A budget spent without one update is no trained run (an exit status 0 here would hide
+    // it); the config checks refuse what is certain, this catches the rest (short episodes).
+    if trainer.updates() == 0 {
+        return Err(RunError::NoUpdate {
+            dir: dir.to_path_buf(),
+            episodes: trainer.episodes(),
+            env_steps: trainer.env_steps(),
+        });
+    }
     let marker = dir.join(FINISHED);
     write_atomic(&marker, b"").map_err(|e| io(&marker, e))?;
     Ok(RunEnd::Trained)
