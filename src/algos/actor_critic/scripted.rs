@@ -19,10 +19,14 @@ pub struct ActingCall<'a> {
     pub running: &'a [usize],
 }
 
-/// A source of macro-actions: given the call, it writes the free agents' entries of `actions`
-/// (one per agent). Called once per environment and primitive step, in the loop's order.
+/// What a script runs for one call: it writes the free agents' entries of `actions` (one per
+/// agent).
+type Choose = dyn Fn(ActingCall<'_>, &mut [usize]) + Send + Sync;
+
+/// A source of macro-actions, called once per environment and primitive step in the loop's
+/// order.
 #[derive(Clone)]
-pub struct ActionScript(Arc<dyn Fn(ActingCall<'_>, &mut [usize]) + Send + Sync>);
+pub struct ActionScript(Arc<Choose>);
 
 impl ActionScript {
     /// A script from a closure (which keeps its own position, behind a lock if it moves on).
@@ -45,5 +49,30 @@ impl ActionScript {
 impl std::fmt::Debug for ActionScript {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str("ActionScript(..)")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_script_decides_only_the_free_agents() {
+        let script = ActionScript::new(|call, actions| {
+            assert_eq!(call.eps, Some(0.5));
+            actions.fill(7);
+        });
+        let mut actions = [0; 3];
+        let call = ActingCall {
+            eps: Some(0.5),
+            free: &[true, false, true],
+            running: &[1, 2, 3],
+        };
+        script.act(call, &mut actions);
+        assert_eq!(
+            actions,
+            [7, 2, 7],
+            "a busy agent keeps its running macro-action"
+        );
     }
 }
