@@ -78,52 +78,49 @@ fn spec_of(doc: &Value) -> EnvSpec {
     EnvSpec::new(name.as_str().unwrap(), &table).unwrap()
 }
 
+/// Two config values equal, an integer standing for the same float (JSON writes 1.0 as 1.0, a
+/// Python int as 1).
+fn same(a: &toml::Value, b: &toml::Value) -> bool {
+    match (a, b) {
+        (toml::Value::Float(x), toml::Value::Integer(y))
+        | (toml::Value::Integer(y), toml::Value::Float(x)) => *x == *y as f64,
+        _ => a == b,
+    }
+}
+
 /// Our published config for the case's method and domain, with the case's overrides. Every
-/// key the fixture records and does not override must already be ours (the published row is
-/// the reference's command).
+/// key the fixture records must be our published value, or an override whose published value
+/// is ours (the published row is the reference's command).
 fn config_of(doc: &Value, method: AcMethod, spec: &EnvSpec) -> AcConfig {
-    let published = method.defaults(spec);
-    let mut table = toml::Table::try_from(&published).unwrap();
+    let shape = EnvShape::of(spec).unwrap();
+    let mut table = toml::Table::try_from(method.defaults(spec)).unwrap();
     let overrides = doc["overrides"].as_object().unwrap();
     for (key, value) in doc["config"].as_object().unwrap() {
         if key == "env_terminate_step" {
-            assert_eq!(
-                u(value),
-                EnvShape::of(spec).unwrap().horizon,
-                "the horizon is the domain's"
-            );
+            assert_eq!(u(value), shape.horizon, "the horizon is the domain's");
             continue;
         }
-        let value = toml::Value::try_from(value).unwrap();
         let ours = table
             .get(key.as_str())
             .unwrap_or_else(|| panic!("no key {key}"));
-        let same = match (ours, &value) {
-            (toml::Value::Float(a), toml::Value::Integer(b)) => *a == *b as f64,
-            (a, b) => a == b,
+        let value = toml::Value::try_from(value).unwrap();
+        let published = match overrides.get(key) {
+            Some(o) => toml::Value::try_from(&o["published"]).unwrap(),
+            None => value.clone(),
         };
-        if let Some(o) = overrides.get(key) {
-            let published = toml::Value::try_from(&o["published"]).unwrap();
-            assert!(
-                ours == &published
-                    || matches!((ours, &published), (toml::Value::Float(a), toml::Value::Integer(b)) if *a == *b as f64),
-                "{key}: our published value {ours} is not the reference command's {published}"
-            );
-        } else {
-            assert!(
-                same,
-                "{key}: our published value {ours}, the reference ran {value}"
-            );
-        }
+        assert!(
+            same(ours, &published),
+            "{key}: our published value {ours}, the reference's command {published}"
+        );
         let value = match (ours, value) {
-            (toml::Value::Float(_), toml::Value::Integer(b)) => toml::Value::Float(b as f64),
+            (toml::Value::Float(_), toml::Value::Integer(v)) => toml::Value::Float(v as f64),
             (_, v) => v,
         };
         table.insert(key.clone(), value);
     }
     let c: AcConfig = toml::Value::Table(table).try_into().unwrap();
     method
-        .check(&c, &EnvShape::of(spec).unwrap())
+        .check(&c, &shape)
         .unwrap_or_else(|(k, why)| panic!("{k}: {why}"));
     c
 }
