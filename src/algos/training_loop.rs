@@ -172,6 +172,12 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         &self.learner
     }
 
+    /// The learner, to change how it acts (e.g. an actor-critic learner's action script); its
+    /// nets and counters belong to the loop.
+    pub fn learner_mut(&mut self) -> &mut L {
+        &mut self.learner
+    }
+
     /// The run's configuration.
     pub fn config(&self) -> &L::Config {
         self.learner.config()

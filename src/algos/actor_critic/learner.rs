@@ -14,6 +14,7 @@ use super::episode::{Episode, EpisodeRecorder};
 use super::lockstep_eval::lockstep_episodes;
 use super::method::{AcActor, AcCritic, AcDesign, AcMethod};
 use super::nets::{AcNets, NetSizes};
+use super::scripted::{ActingCall, ActionScript};
 use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
@@ -58,6 +59,10 @@ pub struct AcLearner {
     /// The acting path's scratch.
     #[serde(skip, default)]
     buffers: ActBuffers,
+    /// Where the free agents' macro-actions come from instead of the actors, if anywhere
+    /// (never saved: a resumed run acts with its actors).
+    #[serde(skip, default)]
+    script: Option<ActionScript>,
 }
 
 impl AcLearner {
@@ -104,6 +109,24 @@ impl AcLearner {
         &mut self.nets
     }
 
+    /// Let `script` choose the free agents' macro-actions while training and evaluating instead
+    /// of the actors (`None`: the actors again). Everything else runs as always; the runner
+    /// check against the reference replays the reference's own choices through this.
+    pub fn set_action_script(&mut self, script: Option<ActionScript>) {
+        self.script = script;
+    }
+
+    /// The current batch's exploration weight.
+    pub fn eps(&self) -> f64 {
+        self.eps
+    }
+
+    /// The last `train_freq` completed training episodes, oldest first: the batch the last
+    /// update trained on.
+    pub fn batch(&self) -> &VecDeque<Episode> {
+        &self.memory
+    }
+
     fn zero_states(&self) -> Vec<GruActorState> {
         self.nets
             .actors
@@ -117,11 +140,12 @@ impl AcLearner {
     }
 }
 
-/// Choose the free agents' macro-actions with `nets`' actors (`actor` says who acts): `eps` is
-/// the exploration mixture's weight while training, `None` when evaluated. Allocates nothing
-/// once `buffers` are warm.
+/// Choose the free agents' macro-actions with `nets`' actors (`actor` says who acts), or with
+/// `script` when one is set: `eps` is the exploration mixture's weight while training, `None`
+/// when evaluated. Allocates nothing once `buffers` are warm.
 #[allow(clippy::too_many_arguments)]
 fn choose<E: MacroEnv>(
+    script: Option<&ActionScript>,
     nets: &AcNets,
     actor: AcActor,
     n_actions: &[usize],
@@ -134,6 +158,11 @@ fn choose<E: MacroEnv>(
     actions: &mut [usize],
 ) {
     let running = env.executed();
+    if let Some(script) = script {
+        let call = ActingCall { eps, free, running };
+        script.act(call, actions);
+        return;
+    }
     match actor {
         AcActor::Decentralized => act_decentralized(
             &|i| &nets.actors[i].net,
@@ -198,6 +227,7 @@ impl Learner for AcLearner {
             means: UpdateMeans::default(),
             tape: Scratch::default(),
             buffers: ActBuffers::default(),
+            script: None,
         })
     }
 
@@ -246,6 +276,7 @@ impl Learner for AcLearner {
 
     fn act<E: MacroEnv>(&mut self, lane: &mut AcLane, env: &E, actions: &mut [usize]) {
         choose(
+            self.script.as_ref(),
             &self.nets,
             self.method.design().actor,
             &self.sizes.n_actions,
@@ -335,6 +366,7 @@ impl Learner for AcLearner {
             |env, free, states, rng, actions| {
                 let n_actions = &self.sizes.n_actions;
                 choose(
+                    self.script.as_ref(),
                     &self.nets,
                     actor,
                     n_actions,

@@ -5,7 +5,8 @@
 //! The data flow: lanes record episodes as the reference's runner does ([`episode`]); a batch
 //! of the last `train_freq` completed episodes is squeezed to macro-actions ([`squeeze`]), the
 //! critics learn SMDP returns ([`returns`]) and the actors the advantages ([`update`]) on the
-//! nets of [`nets`]; [`acting`] samples the actions; [`learner`] ties it to the training loop.
+//! nets of [`nets`]; [`acting`] samples the actions (or [`scripted`] replays given ones);
+//! [`learner`] ties it to the training loop.
 
 pub mod acting;
 pub mod config;
@@ -17,5 +18,6 @@ pub mod method;
 pub mod nets;
 pub mod published;
 pub mod returns;
+pub mod scripted;
 pub mod squeeze;
 pub mod update;
