@@ -84,6 +84,31 @@ pub fn check_unit(values: &[(&'static str, f64)]) -> Result<(), (&'static str, S
     }
 }
 
+/// Every value named must be a finite number >= 0 (weights, clips, coefficients).
+pub fn check_non_negative(values: &[(&'static str, f64)]) -> Result<(), (&'static str, String)> {
+    match values.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
+        Some((key, v)) => Err((key, format!("must be a finite number >= 0, got {v}"))),
+        None => Ok(()),
+    }
+}
+
+/// Every list named must be an MLP's two layer widths, [before, after] the recurrent layer,
+/// each 1..=[`MAX_NET_WIDTH`] (the references' `*mlp_layer_size` keys).
+pub fn check_mlp_widths(lists: &[(&'static str, &[usize])]) -> Result<(), (&'static str, String)> {
+    match lists
+        .iter()
+        .find(|(_, sizes)| sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH))
+    {
+        Some((key, sizes)) => Err((
+            key,
+            format!(
+                "must be two widths [before, after] the recurrent layer, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Every learning rate named must be a positive number.
 pub fn check_rates(rates: &[(&'static str, f64)]) -> Result<(), (&'static str, String)> {
     match rates.iter().find(|(_, lr)| !(*lr > 0.0 && lr.is_finite())) {
@@ -167,5 +192,21 @@ mod tests {
         assert!(check_discount("gamma", 1.0).is_ok());
         assert!(check_eval_rows(MAX_EVAL_ROWS * 10, 1).is_err());
         assert!(check_eval_rows(40_000, 10).is_ok());
+        assert_eq!(
+            check_non_negative(&[("a", 0.0), ("b", -1e-9)]).unwrap_err(),
+            ("b", "must be a finite number >= 0, got -0.000000001".into())
+        );
+        assert_eq!(
+            check_non_negative(&[("a", f64::INFINITY)]).unwrap_err().0,
+            "a"
+        );
+        assert!(check_non_negative(&[("a", 0.0), ("b", 3.5)]).is_ok());
+        let ok: &[usize] = &[64, MAX_NET_WIDTH];
+        assert!(check_mlp_widths(&[("a", ok)]).is_ok());
+        for bad in [&[64][..], &[64, 64, 64], &[0, 64], &[64, MAX_NET_WIDTH + 1]] {
+            let (key, why) = check_mlp_widths(&[("a", ok), ("b", bad)]).unwrap_err();
+            assert_eq!(key, "b");
+            assert!(why.contains("two widths [before, after]"), "{why}");
+        }
     }
 }

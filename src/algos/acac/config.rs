@@ -15,9 +15,9 @@
 
 use crate::algos::acac::method::AcacMethod;
 use crate::algos::config_checks::{
-    check_at_most, check_batch_activations, check_discount, check_eval_rows, check_positive,
-    check_rates, check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH,
-    MAX_TOTAL_EPI,
+    check_at_most, check_batch_activations, check_discount, check_eval_rows, check_mlp_widths,
+    check_non_negative, check_positive, check_rates, check_unit, NetWidths, MAX_EVAL_NUM_EPI,
+    MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
 use crate::envs::{EnvShape, EnvSpec};
@@ -489,19 +489,10 @@ pub fn check(
         ("time_emb_dim", c.time_emb_dim, MAX_NET_WIDTH),
         ("eval_num_epi", c.eval_num_epi, MAX_EVAL_NUM_EPI),
     ])?;
-    for (key, sizes) in [
+    check_mlp_widths(&[
         ("a_mlp_layer_size", &c.a_mlp_layer_size),
         ("c_mlp_layer_size", &c.c_mlp_layer_size),
-    ] {
-        if sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH) {
-            return Err((
-                key,
-                format!(
-                    "must be two widths [before, after] the GRU, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
-                ),
-            ));
-        }
-    }
+    ])?;
     if !c.c_rnn_layer_size.is_multiple_of(c.cc_n_head) {
         return Err((
             "cc_n_head",
@@ -554,18 +545,14 @@ pub fn check(
         ("GAE_lambda", c.gae_lambda),
         ("clip_ratio", c.clip_ratio),
     ])?;
-    for (key, v) in [
+    check_non_negative(&[
         ("etrpy_w_start", c.etrpy_w_start),
         ("etrpy_w_end", c.etrpy_w_end),
         ("grad_clip_value", c.grad_clip_value),
         ("grad_clip_norm", c.grad_clip_norm),
         ("vf_coef", c.vf_coef),
         ("tau", c.tau),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err((key, format!("must be a finite number >= 0, got {v}")));
-        }
-    }
+    ])?;
     check_discount("gamma", c.gamma)?;
     check_rates(&[("a_lr", c.a_lr), ("c_lr", c.c_lr)])?;
     // One update runs every net over the whole batch: train_freq episodes of at most the

@@ -5,8 +5,9 @@
 
 use crate::algos::actor_critic::method::{AcActor, AcCritic, AcMethod};
 use crate::algos::config_checks::{
-    check_at_most, check_batch_activations, check_discount, check_positive, check_rates,
-    check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH, MAX_TOTAL_EPI,
+    check_at_most, check_batch_activations, check_discount, check_mlp_widths, check_positive,
+    check_rates, check_unit, NetWidths, MAX_EVAL_NUM_EPI, MAX_HORIZON, MAX_NET_WIDTH,
+    MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
 use crate::envs::{EnvShape, EnvSpec};
@@ -221,19 +222,10 @@ fn check_sizes(
         ("c_rnn_layer_size", c.c_rnn_layer_size, MAX_NET_WIDTH),
         ("c_mid_layer_size", c.c_mid_layer_size, MAX_NET_WIDTH),
     ])?;
-    for (key, sizes) in [
+    check_mlp_widths(&[
         ("a_mlp_layer_size", &c.a_mlp_layer_size),
         ("c_mlp_layer_size", &c.c_mlp_layer_size),
-    ] {
-        if sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH) {
-            return Err((
-                key,
-                format!(
-                    "must be two widths [before, after] the recurrent layer, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
-                ),
-            ));
-        }
-    }
+    ])?;
     let widest = [c.a_rnn_layer_size, c.c_rnn_layer_size, c.c_mid_layer_size]
         .into_iter()
         .chain(c.a_mlp_layer_size.iter().copied())

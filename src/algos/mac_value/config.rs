@@ -3,9 +3,9 @@
 //! published script sets a key. The published rows per domain and method are [`super::published`].
 
 use crate::algos::config_checks::{
-    check_at_most, check_batch_activations, check_discount, check_eval_rows, check_positive,
-    check_rates, check_train_freq_steps, check_unit, NetWidths, MAX_HORIZON, MAX_NET_WIDTH,
-    MAX_TOTAL_EPI,
+    check_at_most, check_batch_activations, check_discount, check_eval_rows, check_mlp_widths,
+    check_positive, check_rates, check_train_freq_steps, check_unit, NetWidths, MAX_HORIZON,
+    MAX_NET_WIDTH, MAX_TOTAL_EPI,
 };
 use crate::algos::learner::FamilyConfig;
 use crate::algos::mac_value::method::{MacValueMethod, QNets};
@@ -228,20 +228,11 @@ pub fn check(
         ("rnn_h_size", c.rnn_h_size, MAX_NET_WIDTH),
         ("batch_size", c.batch_size, c.replay_buffer_size),
     ])?;
-    for (key, sizes) in [
+    check_mlp_widths(&[
         ("mlp_layer_size", &c.mlp_layer_size),
         ("dec_mlp_layer_size", &c.dec_mlp_layer_size),
         ("cen_mlp_layer_size", &c.cen_mlp_layer_size),
-    ] {
-        if sizes.len() != 2 || sizes.iter().any(|&s| s == 0 || s > MAX_NET_WIDTH) {
-            return Err((
-                key,
-                format!(
-                    "must be two widths [before, after] the GRU, each 1..={MAX_NET_WIDTH}, got {sizes:?}"
-                ),
-            ));
-        }
-    }
+    ])?;
     check_positive(&[
         ("dec_rnn_h_size", c.dec_rnn_h_size),
         ("cen_rnn_h_size", c.cen_rnn_h_size),
