@@ -876,6 +876,18 @@ def run_case(ref, case, base_seed, out_dir, ref_commit):
     return golden
 
 
+
+def reference_commit(ref_dir, given=None):
+    """The MacroMARL commit the fixtures come from: `given`, else the checkout's HEAD, else
+    KNOWN_COMMIT (a copy that is not a git checkout)."""
+    if given is not None:
+        return given
+    try:
+        return subprocess.check_output(["git", "-C", ref_dir, "rev-parse", "HEAD"],
+                                       text=True, stderr=subprocess.DEVNULL).strip()
+    except Exception:
+        return KNOWN_COMMIT
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--ref", required=True, help="checkout of yuchen-x/MacroMARL")
@@ -885,13 +897,7 @@ def main():
                     help=f"commit of --ref if it is not a git checkout (default {KNOWN_COMMIT})")
     args = ap.parse_args()
     ref_dir = os.path.abspath(args.ref)
-    commit = args.ref_commit
-    if commit is None:
-        try:
-            commit = subprocess.check_output(["git", "-C", ref_dir, "rev-parse", "HEAD"],
-                                             text=True, stderr=subprocess.DEVNULL).strip()
-        except Exception:
-            commit = KNOWN_COMMIT
+    commit = reference_commit(ref_dir, args.ref_commit)
     ref = import_reference(ref_dir)
     os.makedirs(args.out, exist_ok=True)
     for k, case in enumerate(CASES):

@@ -71,7 +71,6 @@ import io
 import json
 import os
 import random
-import subprocess
 import sys
 import tempfile
 
@@ -379,13 +378,7 @@ def main():
                     help=f"commit of --ref if it is not a git checkout (default {KNOWN_COMMIT})")
     args = ap.parse_args()
     ref_dir = os.path.abspath(args.ref)
-    commit = args.ref_commit
-    if commit is None:
-        try:
-            commit = subprocess.check_output(["git", "-C", ref_dir, "rev-parse", "HEAD"],
-                                             text=True, stderr=subprocess.DEVNULL).strip()
-        except Exception:
-            commit = KNOWN_COMMIT
+    commit = golden.reference_commit(ref_dir, args.ref_commit)
     ref = golden.import_reference(ref_dir)
     os.makedirs(args.out, exist_ok=True)
     out = os.path.abspath(args.out)
