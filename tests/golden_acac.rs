@@ -16,11 +16,13 @@ use macdec::algos::acac::train_step::update;
 use macdec::algos::acac::update::{
     AcacNets, DropoutSource, GaeLambda, Objective, UpdateParams, UpdateTrace,
 };
-use macdec::algos::actor_critic::episode::Episode;
+use macdec::algos::actor_critic::episode::{Episode, EpisodeRecorder};
 use macdec::autograd::Tape;
+use macdec::envs::{registry, EnvRng, EnvSpec, MacroEnv};
 use macdec::nn::{AcacActor, TIME_TABLE};
 use macdec::nn::{BlockDropout, Gpt2Dropout, StateDict, TimeEmbedding, ValueHead};
 use ndarray::{Array2, ArrayViewD};
+use rand::SeedableRng;
 use serde_json::Value;
 
 /// Advantages, returns, log-probabilities and losses, relative to max(|x|, 1). Measured on the
@@ -513,4 +515,81 @@ fn acac_vanilla_on_box_pushing_6x6_matches_acacs_learner() {
 #[test]
 fn acac_vanilla_on_overcooked_a_matches_acacs_learner() {
     replay("acac_vanilla_ovcA7", GaeLambda::PerMacroStep);
+}
+
+/// Our copy of the case's environment, as `experiments/acac/<env>.toml` sets it up.
+fn env_spec(case: &Value) -> EnvSpec {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("experiments/acac")
+        .join(format!("{}.toml", case["env"].as_str().unwrap()));
+    let doc: toml::Table = toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let params = doc["params"].as_table().unwrap();
+    let domain = registry::lookup(params["env_name"].as_str().unwrap()).unwrap();
+    EnvSpec::from_keys_in(domain, params).unwrap()
+}
+
+/// Floats of a record to f32 precision (ACAC's runner makes float32 tensors of float64 sums).
+fn assert_floats(what: &str, ours: &[f32], theirs: &[f32]) {
+    assert_eq!(ours.len(), theirs.len(), "{what}: lengths");
+    for (k, (a, b)) in ours.iter().zip(theirs).enumerate() {
+        let tol = 1e-6 * a.abs().max(b.abs()).max(1.0);
+        assert!((a - b).abs() <= tol, "{what}[{k}]: ours {a}, ACAC's {b}");
+    }
+}
+
+/// The batch ACAC's runner recorded (its workers' accumulators, `envs_runner.py`): our
+/// environment stepped with the same macro-actions and our lanes' [`EpisodeRecorder`] must
+/// record the same episodes, record for record: observations (the first record's included),
+/// macro-action starts, executed macro-actions, macro-rewards discounted inside the
+/// macro-action, joint rewards, terminal flags (bp6's episodes end at a goal, ovcA7's at the
+/// horizon, not terminal) and the agents' macro-action ends. The learner goldens above start
+/// from ACAC's records; this closes the gap between the environment and them.
+fn recorder_records_the_batch(case_name: &str) {
+    let case = load(case_name);
+    let j = &case.json;
+    let spec = env_spec(j);
+    let gamma = j["settings"]["gamma"].as_f64().unwrap();
+    for (e, want) in episodes(j).iter().enumerate() {
+        let n = want.n_agents;
+        let mut rng = EnvRng::seed_from_u64(0);
+        let mut env = spec.build().unwrap();
+        env.reset(&mut rng);
+        let mut rec = EpisodeRecorder::new(&env, gamma, false);
+        for t in 0..want.steps {
+            let actions: Vec<usize> = (0..n).map(|i| want.action(t, i)).collect();
+            let outcome = env.step(&actions, &mut rng).unwrap();
+            rec.record(&env, outcome);
+            assert_eq!(
+                outcome.done,
+                t + 1 == want.steps,
+                "{case_name} episode {e}: our episode ended at step {t}, ACAC's after {}",
+                want.steps
+            );
+        }
+        let ours = rec.episode();
+        let at = |what: &str| format!("{case_name} episode {e}: {what}");
+        assert_eq!(ours.steps, want.steps, "{}", at("steps"));
+        assert_eq!(ours.action, want.action, "{}", at("executed macro-actions"));
+        assert_eq!(
+            ours.mac_start,
+            want.mac_start,
+            "{}",
+            at("macro-action starts")
+        );
+        assert_eq!(ours.valid, want.valid, "{}", at("macro-action ends"));
+        assert_eq!(ours.terminate, want.terminate, "{}", at("terminal flags"));
+        assert_floats(&at("observations"), &ours.obs, &want.obs);
+        assert_floats(&at("macro-rewards"), &ours.reward, &want.reward);
+        assert_floats(&at("joint rewards"), &ours.joint_reward, &want.joint_reward);
+    }
+}
+
+#[test]
+fn our_recorder_records_acacs_box_pushing_batch() {
+    recorder_records_the_batch("acac_bp6");
+}
+
+#[test]
+fn our_recorder_records_acacs_overcooked_batch() {
+    recorder_records_the_batch("acac_ovcA7");
 }
