@@ -42,7 +42,6 @@ import random
 import subprocess
 import sys
 import threading
-import types
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FORMAT = "acac-golden-1"
@@ -54,21 +53,9 @@ FORMAT = "acac-golden-1"
 
 def install_stand_ins():
     sys.path.insert(0, HERE)
-    from macromarl_traces import install_pygame_stand_in
+    from reference_stand_ins import install_all
 
-    install_pygame_stand_in()
-    for name in ["IPython", "IPython.core", "IPython.core.debugger"]:
-        sys.modules.setdefault(name, types.ModuleType(name))
-    sys.modules["IPython"].embed = lambda *a, **k: None
-    sys.modules["IPython.core.debugger"].set_trace = lambda *a, **k: None
-    try:
-        __import__("wandb")
-    except ImportError:
-        sys.modules["wandb"] = types.ModuleType("wandb")  # ACAC imports it; off by default
-    import numpy as np
-
-    if not hasattr(np, "bool8"):
-        np.bool8 = np.bool_  # gym 0.26's passive checker names it (removed in numpy 2)
+    install_all()
 
 
 # --------------------------------------------------------------------------------------------

@@ -31,42 +31,8 @@ import os
 import resource
 import runpy
 import sys
-import types
 
-
-def install_stand_ins():
-    class Stand:
-        """Any pygame name: callable, never drawn (Overcooked imports pygame only to render)."""
-
-        def __init__(self, name):
-            self.name = name
-
-        def __call__(self, *args, **kwargs):
-            return Stand(self.name + "()")
-
-        def __getattr__(self, name):
-            return Stand(self.name + "." + name)
-
-    names = {}
-    pygame = types.ModuleType("pygame")
-
-    def stand(name):
-        if name.startswith("__"):  # module protocol (torch's inspect asks for __file__)
-            raise AttributeError(name)
-        return names.setdefault(name, Stand(name))
-
-    pygame.__getattr__ = stand
-    sys.modules.setdefault("pygame", pygame)
-    for name in ["IPython", "IPython.core", "IPython.core.debugger"]:
-        sys.modules.setdefault(name, types.ModuleType(name))
-    sys.modules["IPython"].embed = lambda *a, **k: None
-    sys.modules["IPython.core.debugger"].set_trace = lambda *a, **k: None
-    sys.modules.setdefault("wandb", types.ModuleType("wandb"))  # only used with --wandb
-
-    import numpy as np
-
-    if not hasattr(np, "bool8"):
-        np.bool8 = np.bool_  # gym 0.26's passive checker names it (removed in numpy 2)
+from reference_stand_ins import install_all
 
 
 def last_progress_row(data_dir):
@@ -91,7 +57,7 @@ def main():
     if not os.path.exists(link):
         os.symlink(os.path.join(acac_dir, "scripts"), link)
 
-    install_stand_ins()
+    install_all()
     import torch
 
     torch.set_num_threads(1)

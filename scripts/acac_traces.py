@@ -30,7 +30,8 @@ import sys
 import types
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from macromarl_traces import as_floats, as_ints, install_pygame_stand_in  # noqa: E402
+from macromarl_traces import as_floats, as_ints  # noqa: E402
+from reference_stand_ins import install_all  # noqa: E402
 
 
 def runner_kwargs(acac, setting):
@@ -65,7 +66,7 @@ def main():
     args = parser.parse_args()
 
     sys.path.insert(0, args.acac)
-    install_pygame_stand_in()
+    install_all()
     import contextlib
     import io
 

@@ -58,6 +58,8 @@ import numpy as np
 import torch
 from safetensors.torch import save_file
 
+from reference_stand_ins import install_ipython, install_matplotlib
+
 NOISE_STD = 0.05
 TENSORS = ["fc1.weight", "fc1.bias", "fc2.weight", "fc2.bias",
            "lstm.weight_ih_l0", "lstm.weight_hh_l0", "lstm.bias_ih_l0", "lstm.bias_hh_l0",
@@ -114,24 +116,8 @@ def install_stand_ins():
                       ("gym.utils.seeding", utils.seeding), ("gym.envs", envs),
                       ("gym.envs.registration", registration), ("gym.error", error)]:
         sys.modules.setdefault(name, mod)
-    if "matplotlib" not in sys.modules:
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            mpl = types.ModuleType("matplotlib")
-            mpl.pyplot = types.ModuleType("matplotlib.pyplot")
-            sys.modules["matplotlib"] = mpl
-            sys.modules["matplotlib.pyplot"] = mpl.pyplot
-    try:
-        import IPython  # noqa: F401
-    except ImportError:
-        ip = types.ModuleType("IPython")
-        ip.core = types.ModuleType("IPython.core")
-        ip.core.debugger = types.ModuleType("IPython.core.debugger")
-        ip.core.debugger.set_trace = lambda *a, **k: None
-        for name, mod in [("IPython", ip), ("IPython.core", ip.core),
-                          ("IPython.core.debugger", ip.core.debugger)]:
-            sys.modules[name] = mod
+    install_matplotlib()
+    install_ipython()
 
 
 BOOL_MASK_PATCHES = {

@@ -88,25 +88,8 @@ import time
 import types
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from macromarl_traces import install_pygame_stand_in  # noqa: E402  (one pygame stand-in)
+from reference_stand_ins import install_all  # noqa: E402
 from reference_curve import flag  # noqa: E402  (one reading of the reference's argv)
-
-
-def stand_ins():
-    """IPython, matplotlib and pygame stand-ins, only for modules that are not installed."""
-    try:
-        import IPython  # noqa: F401
-    except ImportError:
-        for name in ["IPython", "IPython.core", "IPython.core.debugger"]:
-            sys.modules[name] = types.ModuleType(name)
-        sys.modules["IPython.core.debugger"].set_trace = lambda *a, **k: None
-    try:
-        import matplotlib.pyplot  # noqa: F401
-    except ImportError:
-        for name in ["matplotlib", "matplotlib.pyplot"]:
-            sys.modules[name] = types.ModuleType(name)
-        sys.modules["matplotlib"].pyplot = sys.modules["matplotlib.pyplot"]
-    install_pygame_stand_in()
 
 
 def write_curve(out, rows):
@@ -191,12 +174,10 @@ def main():
         print("warning: --seed 0 (the default) leaves the main process unseeded", file=sys.stderr)
 
     sys.path[:0] = [os.path.join(ref, "src"), os.path.abspath(a.overcooked)]
-    stand_ins()
+    install_all()
     import numpy as np
     import torch
 
-    if not hasattr(np, "bool8"):  # gym 0.26's env checker (first step only) names np.bool8,
-        np.bool8 = np.bool_  # which numpy 2 removed; it is the same type as np.bool_
     import gym.envs.registration as registration
 
     checker = registration.PassiveEnvChecker

@@ -42,37 +42,7 @@ import json
 import os
 import sys
 
-
-def install_pygame_stand_in():
-    """A `pygame` module, when none is installed, whose every name is a callable that draws
-    nothing (Overcooked imports pygame only to render)."""
-    try:
-        import pygame  # noqa: F401
-    except ImportError:
-        import types
-
-        class Stand:
-            """Any pygame name: a distinct object per name, callable, never drawn."""
-
-            def __init__(self, name):
-                self.name = name
-
-            def __call__(self, *args, **kwargs):
-                return Stand(self.name + "()")
-
-            def __getattr__(self, name):
-                return Stand(self.name + "." + name)
-
-        names = {}
-        stand_in = types.ModuleType("pygame")
-
-        def stand(name):
-            if name.startswith("__"):  # module protocol (torch's inspect asks for __file__)
-                raise AttributeError(name)
-            return names.setdefault(name, Stand(name))
-
-        stand_in.__getattr__ = stand
-        sys.modules["pygame"] = stand_in
+from reference_stand_ins import install_pygame
 
 
 def as_floats(values):
@@ -214,7 +184,7 @@ def main():
             parser.error("Overcooked needs --overcooked DIR")
         sys.path.insert(0, args.overcooked)
         # Overcooked imports pygame only to draw; a stand-in module is enough to step it.
-        install_pygame_stand_in()
+        install_pygame()
         import gym_macro_overcooked  # noqa: F401  (registers the gym ids)
         from gym_macro_overcooked.macActEnvWrapper import MacEnvWrapper
 
