@@ -171,6 +171,8 @@ import numpy as np
 import torch
 from safetensors.torch import save_file
 
+from reference_stand_ins import install_ipython
+
 NOISE_STD = 0.05
 MAX_SEED_TRIES = 400
 KNOWN_COMMIT = "f5899cd7b96bb3dbf7b265494a3ba8a15b2e3fe2"
@@ -314,16 +316,7 @@ CASES = [
 
 def import_reference(ref):
     """Import the reference's pg_based algorithms and the three environment classes."""
-    try:
-        import IPython  # noqa: F401
-    except ImportError:
-        ip = types.ModuleType("IPython")
-        ip.core = types.ModuleType("IPython.core")
-        ip.core.debugger = types.ModuleType("IPython.core.debugger")
-        ip.core.debugger.set_trace = lambda *a, **k: None
-        for name, mod in [("IPython", ip), ("IPython.core", ip.core),
-                          ("IPython.core.debugger", ip.core.debugger)]:
-            sys.modules[name] = mod
+    install_ipython()
     src = os.path.join(ref, "src")
     sys.path.insert(0, src)
     with warnings.catch_warnings():
@@ -607,22 +600,31 @@ class Capture:
             self.actors[name]["stepped"] = True
 
     def run(self, fn):
-        def make_local(where):
-            def local(frame, event, arg):
-                if event == "line":
-                    self.on_line(frame, where)
-                return local
+        trace_lines(self.codes, self.on_line, fn)
+
+
+def trace_lines(codes, on_line, fn, on_enter=None):
+    """Run `fn()` with a line tracer on the code objects of `codes` ({code: name}) only:
+    `on_line(frame, name)` before each line they run, `on_enter(name)` (if given) each time
+    one of them is entered. Only observes; returns what `fn` returns."""
+    def local_for(where):
+        def local(frame, event, arg):
+            if event == "line":
+                on_line(frame, where)
             return local
+        return local
 
-        def glob(frame, event, arg):
-            where = self.codes.get(frame.f_code)
-            return make_local(where) if where else None
+    def glob(frame, event, arg):
+        where = codes.get(frame.f_code)
+        if where and on_enter:
+            on_enter(where)
+        return local_for(where) if where else None
 
-        sys.settrace(glob)
-        try:
-            fn()
-        finally:
-            sys.settrace(None)
+    sys.settrace(glob)
+    try:
+        return fn()
+    finally:
+        sys.settrace(None)
 
 # ---------------------------------------------------------------- what an update exercises
 

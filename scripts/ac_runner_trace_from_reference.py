@@ -69,6 +69,7 @@ import argparse
 import gzip
 import io
 import json
+import linecache
 import os
 import random
 import sys
@@ -198,8 +199,11 @@ class Tracer:
                       type(model.envs_runner)._step.__code__: "step"}
         self.n_train_returns = 0
 
+    def on_enter(self, where):
+        if where == "step":
+            self.phases[-1]["steps"].append([])
+
     def on_line(self, frame, where):
-        import linecache
         line = linecache.getline(frame.f_code.co_filename, frame.f_lineno).strip()
         f = frame.f_locals
         if where == "step":
@@ -227,24 +231,7 @@ class Tracer:
             self.phases[-1]["target_sync_after"] = True
 
     def run(self):
-        def local_for(where):
-            def local(frame, event, arg):
-                if event == "line":
-                    self.on_line(frame, where)
-                return local
-            return local
-
-        def glob(frame, event, arg):
-            where = self.codes.get(frame.f_code)
-            if where == "step":
-                self.phases[-1]["steps"].append([])
-            return local_for(where) if where else None
-
-        sys.settrace(glob)
-        try:
-            self.model.learn()
-        finally:
-            sys.settrace(None)
+        golden.trace_lines(self.codes, self.on_line, self.model.learn, on_enter=self.on_enter)
 
 
 def exercised(case, phases, n_env):
