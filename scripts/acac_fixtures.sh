@@ -16,6 +16,10 @@ $PY $S --acac $A --setting ovcCR7 --np-seed 5 --random-seed 5 --out $F/ovc_cr7_n
 $PY $S --acac $A --setting ovcBR7 --np-seed 123456789 --random-seed 6 --horizon 60 --out $F/ovc_br7_np123456789_random6
 # Box Pushing as ACAC's runner passes it (MacroMARL's env).
 $PY $S --acac $A --setting bp6 --np-seed 0 --random-seed 7 --out $F/bp6_random7
+for g in 8 10; do
+  $PY $S --acac $A --setting bp$g --np-seed 0 --plan '[[2, 4], [3, 4]]' --out $F/bp${g}_big_box
+  $PY $S --acac $A --setting bp$g --np-seed 0 --random-seed 7 --out $F/bp${g}_random7
+done
 # Overcooked-MA-v0 (Large: 11x11, 6 agents, objects A-F that start chopped, row-major numbering).
 # Random actions: seeds chosen for many cycles of 4 or 6 agents moving at once (A 22, C 22) and for
 # wrong deliveries followed by chops (B 8).

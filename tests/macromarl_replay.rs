@@ -116,7 +116,18 @@ fn bp_ma_v0_replays_the_reference() {
     );
     all(&names.iter().map(String::as_str).collect::<Vec<_>>());
     // ACAC's runner passes `terminate_step` and an integer `big_box_reward`; the env is the same.
-    in_folder("acac", &["bp6_random7"]);
+    // ACAC's 8x8 and 10x10 settings: the big box pushed to the goal, and random episodes cut by
+    // the horizon.
+    in_folder(
+        "acac",
+        &[
+            "bp6_random7",
+            "bp8_big_box",
+            "bp8_random7",
+            "bp10_big_box",
+            "bp10_random7",
+        ],
+    );
 }
 
 #[test]

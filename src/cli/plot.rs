@@ -21,8 +21,9 @@ pub(super) struct PlotArgs {
     /// --metric.
     #[arg(long = "y", value_parser = crate::plot::axis::YAxis::parse, conflicts_with = "metric")]
     y_axis: Option<crate::plot::axis::YAxis>,
-    /// What the curves are drawn against: `episode` or `env_steps` (runs interpolated between
-    /// their evaluations; files get an `_env_steps` suffix).
+    /// What the curves are drawn against: `episode`, `env_steps`, or `acac_timesteps` (ACAC's
+    /// Timesteps: steps of finished training episodes, what ACAC's logs count); along steps,
+    /// runs are interpolated between their evaluations and files get an `_<axis>` suffix.
     #[arg(long = "x", default_value = "episode", value_parser = crate::plot::axis::XAxis::parse)]
     x_axis: crate::plot::axis::XAxis,
     /// Centred moving average before drawing and reading "95% of optimal first at":
@@ -32,7 +33,8 @@ pub(super) struct PlotArgs {
     #[arg(long, default_value = "auto", value_parser = crate::curve_stats::Smoothing::parse)]
     smooth: crate::curve_stats::Smoothing,
     /// A TOML file naming outside runs (another code's per-seed logs, e.g. ACAC's) to draw
-    /// beside our curves, with --x env_steps --y undiscounted; every run of such an experiment
+    /// beside our curves, with --y undiscounted and --x env_steps (--x acac_timesteps for
+    /// ACAC's logs); every run of such an experiment
     /// is then read up to the smallest last step any run reached, so the tables compare equal
     /// budgets (README "Beside another code's logs").
     #[arg(long)]

@@ -22,7 +22,7 @@ pub(super) struct ReportArgs {
     /// Seed of the bootstrap: the same seed gives the same intervals, bit for bit.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// The sample-efficiency curves' x axis: `episode` or `env_steps`.
+    /// The sample-efficiency curves' x axis: `episode`, `env_steps` or `acac_timesteps`.
     #[arg(long = "x", default_value = "episode", value_parser = XAxis::parse)]
     x_axis: XAxis,
     /// Report only this block (repeat for several); default: every block with runs.

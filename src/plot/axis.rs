@@ -1,6 +1,6 @@
-//! The axes a learning curve can be drawn on: `--x episode|env_steps` (both `plot` and
-//! `report`) and `--y discounted|undiscounted` (`plot`), so curves compare with papers that
-//! report undiscounted returns against environment steps (ACAC, the AVF paper, marl-eval).
+//! The axes a learning curve can be drawn on: `--x episode|env_steps|acac_timesteps` (both
+//! `plot` and `report`) and `--y discounted|undiscounted` (`plot`), so curves compare with papers
+//! that report undiscounted returns against environment steps (ACAC, the AVF paper, marl-eval).
 
 use crate::plot::discover::{RunData, EVAL_RETURN};
 
@@ -13,16 +13,23 @@ pub enum XAxis {
     /// Environment steps (`env_steps`), which differ between methods that spend a different
     /// number of steps per episode.
     EnvSteps,
+    /// ACAC's `Timesteps` (column `acac_timesteps`): the primitive steps of finished training
+    /// episodes only, what ACAC's budget and its published curves count. ACAC's runner drops
+    /// the episodes still running when a batch is complete, so on Box Pushing this is 1.4 to 2.3
+    /// times fewer than `env_steps`: ACAC's logs compare with our ACAC runs only along this
+    /// axis. Runs of other families lack the column and are skipped with a note.
+    AcacTimesteps,
 }
 
 impl XAxis {
-    /// Parse `--x`: `episode` or `env_steps`.
+    /// Parse `--x`: `episode`, `env_steps` or `acac_timesteps`.
     pub fn parse(text: &str) -> Result<XAxis, String> {
         match text.trim() {
             "episode" => Ok(XAxis::Episode),
             "env_steps" => Ok(XAxis::EnvSteps),
+            "acac_timesteps" => Ok(XAxis::AcacTimesteps),
             other => Err(format!(
-                "`{other}` is not an x axis: give `episode` or `env_steps`"
+                "`{other}` is not an x axis: give `episode`, `env_steps` or `acac_timesteps`"
             )),
         }
     }
@@ -32,6 +39,7 @@ impl XAxis {
         match self {
             XAxis::Episode => "training episodes",
             XAxis::EnvSteps => "environment steps",
+            XAxis::AcacTimesteps => "steps of finished training episodes (ACAC's Timesteps)",
         }
     }
 
@@ -40,15 +48,31 @@ impl XAxis {
         match self {
             XAxis::Episode => "episode",
             XAxis::EnvSteps => "env_steps",
+            XAxis::AcacTimesteps => "acac_timesteps",
         }
+    }
+
+    /// The `metrics.csv` column of step counts runs are read with ([`RunData::steps`]): the
+    /// axis's own, `env_steps` along episodes (exports still record the steps).
+    pub fn steps_column(self) -> &'static str {
+        match self {
+            XAxis::Episode | XAxis::EnvSteps => "env_steps",
+            XAxis::AcacTimesteps => "acac_timesteps",
+        }
+    }
+
+    /// Whether curves are drawn against step counts, which differ from seed to seed, rather
+    /// than against episodes.
+    pub fn is_steps(self) -> bool {
+        self != XAxis::Episode
     }
 
     /// A run's `(x, evaluation return)` points along this axis.
     pub fn points(self, run: &RunData) -> Vec<(f64, f64)> {
         match self {
             XAxis::Episode => run.points.iter().map(|&(e, v)| (e as f64, v)).collect(),
-            XAxis::EnvSteps => run
-                .env_steps
+            XAxis::EnvSteps | XAxis::AcacTimesteps => run
+                .steps
                 .iter()
                 .zip(&run.points)
                 .map(|(&s, &(_, v))| (s as f64, v))
@@ -98,7 +122,7 @@ mod tests {
 
     #[test]
     fn the_axes_parse_from_their_names_only() {
-        for axis in [XAxis::Episode, XAxis::EnvSteps] {
+        for axis in [XAxis::Episode, XAxis::EnvSteps, XAxis::AcacTimesteps] {
             assert_eq!(XAxis::parse(axis.name()), Ok(axis));
         }
         assert!(XAxis::parse("steps")

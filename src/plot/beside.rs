@@ -17,10 +17,12 @@
 //! runs = "bp6/mac_iaicc"                 # a directory of <seed>.csv, relative to this file
 //! ```
 //!
-//! Outside logs hold environment steps and undiscounted returns only, so `--beside` draws
-//! against `--x env_steps` with `--y undiscounted`. Their runs stop at different steps from ours,
-//! so every run of an experiment that has an outside curve, ours included, is read on one grid
-//! of environment steps up to the smallest last step any of its runs reached
+//! Outside logs hold step counts and undiscounted returns only, so `--beside` draws with `--y
+//! undiscounted` against `--x env_steps`, or against `--x acac_timesteps` for ACAC's logs, whose
+//! `Timesteps` count only finished training episodes ([`super::axis::XAxis::AcacTimesteps`]).
+//! Their runs stop at different steps from ours, so every run of an experiment that has an
+//! outside curve, ours included, is read on one grid of steps up to the smallest last step any
+//! of its runs reached
 //! ([`on_common_steps`]): the summary and Welch tables then compare equal budgets, and their
 //! `final_episode` column holds that step count.
 
@@ -166,7 +168,7 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
             .ok_or_else(|| bad(path, format!("no `{name}` column")))
     };
     let (xi, yi) = (column(x)?, column(y)?);
-    let mut env_steps = Vec::new();
+    let mut steps = Vec::new();
     let mut points = Vec::new();
     for (row, record) in reader.records().enumerate() {
         let record = record.map_err(|e| bad(path, e.to_string()))?;
@@ -180,10 +182,10 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
             .and_then(|s| s.trim().parse().ok())
             .filter(|v: &f64| v.is_finite())
             .ok_or_else(|| bad(path, format!("line {line}: `{y}` is not a finite number")))?;
-        if env_steps.last().is_some_and(|&last| step <= last) {
+        if steps.last().is_some_and(|&last| step <= last) {
             return Err(bad(path, format!("line {line}: steps must increase")));
         }
-        env_steps.push(step);
+        steps.push(step);
         points.push((points.len() as u64, value));
     }
     if points.is_empty() {
@@ -193,7 +195,7 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
         seed,
         dir: path.to_path_buf(),
         points,
-        env_steps,
+        steps,
         finished: true,
         wall_seconds: None,
         setting: None,
@@ -209,7 +211,7 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
 /// budgets. A run that never reached a step past 0 is left out with a note.
 pub fn on_common_steps(exp: &mut ExperimentData, notes: &mut Vec<String>) {
     let runs = || exp.curves.iter().flat_map(|c| &c.runs);
-    let Some(end) = runs().filter_map(|r| r.env_steps.last().copied()).min() else {
+    let Some(end) = runs().filter_map(|r| r.steps.last().copied()).min() else {
         return;
     };
     if end == 0 {
@@ -220,7 +222,7 @@ pub fn on_common_steps(exp: &mut ExperimentData, notes: &mut Vec<String>) {
         return;
     }
     let sparsest = runs()
-        .map(|r| r.env_steps.iter().filter(|&&s| s <= end).count())
+        .map(|r| r.steps.iter().filter(|&&s| s <= end).count())
         .min()
         .unwrap_or(2);
     let n = sparsest.clamp(2, MAX_GRID);
@@ -230,7 +232,7 @@ pub fn on_common_steps(exp: &mut ExperimentData, notes: &mut Vec<String>) {
     for curve in &mut exp.curves {
         for run in &mut curve.runs {
             let along: Vec<(f64, f64)> = run
-                .env_steps
+                .steps
                 .iter()
                 .zip(&run.points)
                 .map(|(&s, &(_, v))| (s as f64, v))
@@ -239,7 +241,7 @@ pub fn on_common_steps(exp: &mut ExperimentData, notes: &mut Vec<String>) {
                 .iter()
                 .map(|&s| (s, interpolate(&along, s as f64)))
                 .collect();
-            run.env_steps = grid.clone();
+            run.steps = grid.clone();
         }
     }
     notes.push(format!(
@@ -290,7 +292,7 @@ runs = "bp6/mac_iaicc"
         assert_eq!(exp, "bp6");
         assert_eq!(c.legend(), "Mac-IAICC (their logs)");
         assert_eq!(c.runs.iter().map(|r| r.seed).collect::<Vec<_>>(), [0, 1]);
-        assert_eq!(c.runs[1].env_steps, [100, 250]);
+        assert_eq!(c.runs[1].steps, [100, 250]);
         assert_eq!(c.runs[1].points, [(0, 1.5), (1, 2.5)]);
     }
 
@@ -354,7 +356,7 @@ runs = "bp6/mac_iaicc"
                 .enumerate()
                 .map(|(i, &v)| (i as u64, v))
                 .collect(),
-            env_steps: steps.to_vec(),
+            steps: steps.to_vec(),
             finished: true,
             wall_seconds: None,
             setting: None,
@@ -384,7 +386,7 @@ runs = "bp6/mac_iaicc"
         on_common_steps(&mut exp, &mut notes);
         // Smallest last step 200; the sparsest run has 3 evaluations up to there.
         let ours = &exp.curves[0].runs[0];
-        assert_eq!(ours.env_steps, [0, 100, 200]);
+        assert_eq!(ours.steps, [0, 100, 200]);
         assert_eq!(ours.points, [(0, 0.0), (100, 1.0), (200, 2.0)]);
         let theirs = &exp.curves[1].runs[0];
         // Before its first evaluation a run holds its first value; 100 is halfway 50..150.

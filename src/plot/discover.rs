@@ -6,6 +6,7 @@
 //! being synced), so anything that is not a run is skipped with a note. A malformed metrics file
 //! is skipped with a warning as long as some other run is readable; if none is, it is the error.
 
+use super::axis::XAxis;
 use super::error::PlotError;
 use super::setting::EnvSetting;
 use crate::algos::families::Method;
@@ -30,9 +31,10 @@ pub struct RunData {
     /// `(episode, value)` per evaluation of the plotted column (`eval_return` unless another
     /// was asked for; rows with an empty cell are left out), episodes strictly increasing.
     pub points: Vec<(u64, f64)>,
-    /// The `env_steps` column at the same rows as `points` (environment steps taken when each
-    /// evaluation ran), for figures and exports against steps rather than episodes.
-    pub env_steps: Vec<u64>,
+    /// The step count of the x axis at the same rows as `points`, for figures and exports
+    /// against steps rather than episodes: the `env_steps` column (environment steps taken when
+    /// each evaluation ran), or the column `--x` names instead ([`XAxis::steps_column`]).
+    pub steps: Vec<u64>,
     /// Whether the run wrote its `finished` marker.
     pub finished: bool,
     /// Wall-clock seconds at the run's last evaluation; None for another code's logs drawn
@@ -96,10 +98,20 @@ pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
 /// The column plotted by default: the evaluated policy's return.
 pub const EVAL_RETURN: &str = "eval_return";
 
+/// The step column runs are read with unless an axis asks for another.
+const ENV_STEPS: &str = "env_steps";
+
 /// Scan `results` for runs, reading the `metric` column of each `metrics.csv` (any leading or
-/// family column). Fails only when the root cannot be read, when it holds no run at all, or when
-/// every metrics file found is malformed. A run without the column is skipped with a note.
+/// family column) with its `env_steps` (see [`discover_along`]).
 pub fn discover_metric(results: &Path, metric: &str) -> Result<Discovery, PlotError> {
+    discover_along(results, metric, XAxis::EnvSteps)
+}
+
+/// Scan `results` for runs, reading the `metric` column of each `metrics.csv` and the step
+/// column `x` draws against ([`XAxis::steps_column`]). Fails only when the root cannot be read,
+/// when it holds no run at all, or when every metrics file found is malformed. A run without
+/// either column is skipped with a note.
+pub fn discover_along(results: &Path, metric: &str, x: XAxis) -> Result<Discovery, PlotError> {
     let exp_dirs = sorted_subdirs(results).map_err(|source| PlotError::ReadResults {
         path: results.to_path_buf(),
         source,
@@ -115,7 +127,7 @@ pub fn discover_metric(results: &Path, metric: &str) -> Result<Discovery, PlotEr
             let method = method_name.parse::<Method>().ok();
             let mut runs = Vec::new();
             for run_dir in subdirs_or_note(&curve_dir, &mut notes) {
-                match read_run(&run_dir, metric) {
+                match read_run(&run_dir, metric, x.steps_column()) {
                     Ok(run) => runs.push(run),
                     Err(RunProblem::Skip(why)) => {
                         notes.push(format!("skipping {}: {why}", run_dir.display()))
@@ -236,7 +248,7 @@ enum RunProblem {
     Malformed(PathBuf, String),
 }
 
-fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
+fn read_run(dir: &Path, metric: &str, steps_column: &str) -> Result<RunData, RunProblem> {
     let name = file_name(dir);
     let seed = results_tree::parse_seed_dir(&name)
         .ok_or_else(|| RunProblem::Skip("not a seed-<k> directory".into()))?;
@@ -273,10 +285,25 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
             table.family_columns.join(", ")
         )));
     };
-    let (points, env_steps): (Vec<(u64, f64)>, Vec<u64>) = rows
+    let steps: Vec<Option<u64>> = if steps_column == ENV_STEPS {
+        rows.iter().map(|r| Some(r.env_steps)).collect()
+    } else {
+        let Some(counts) = table.column(steps_column) else {
+            return Err(RunProblem::Skip(format!(
+                "no `{steps_column}` column to draw against (it has {})",
+                table.family_columns.join(", ")
+            )));
+        };
+        counts
+            .into_iter()
+            .map(|c| c.filter(|c| c.is_finite() && *c >= 0.0).map(|c| c as u64))
+            .collect()
+    };
+    let (points, steps): (Vec<(u64, f64)>, Vec<u64>) = rows
         .iter()
         .zip(values)
-        .filter_map(|(r, v)| v.map(|v| ((r.episode, v), r.env_steps)))
+        .zip(steps)
+        .filter_map(|((r, v), s)| Some(((r.episode, v?), s?)))
         .unzip();
     if let Some((episode, value)) = points.iter().find(|(_, v)| !v.is_finite()) {
         return Err(bad(format!("episode {episode}: {metric} is {value}")));
@@ -296,7 +323,7 @@ fn read_run(dir: &Path, metric: &str) -> Result<RunData, RunProblem> {
         seed,
         dir: dir.to_path_buf(),
         points,
-        env_steps,
+        steps,
         finished: results_tree::is_finished(dir),
         wall_seconds: Some(rows.last().map_or(0.0, |r| r.wall_seconds)),
         setting,
@@ -412,7 +439,7 @@ pub(crate) mod tests {
         assert!(!our1.runs[0].finished && our1.runs[1].finished);
         assert_eq!(our1.runs[0].points, vec![(0, 1.0)]);
         // write_run records env_steps = 50 x episode, row for row with the returns.
-        assert_eq!(our1.runs[1].env_steps, vec![0, 500]);
+        assert_eq!(our1.runs[1].steps, vec![0, 500]);
         assert_eq!(our1.runs[1].wall_seconds, Some(5.0));
         assert_eq!(
             our1.runs[1].setting.clone().unwrap().optimal_return(),
@@ -558,5 +585,44 @@ pub(crate) mod tests {
             discover(&t.path().join("nope")).unwrap_err(),
             PlotError::ReadResults { .. }
         ));
+    }
+
+    #[test]
+    fn along_acac_timesteps_runs_are_read_with_that_column_and_others_are_skipped() {
+        let t = tempfile::tempdir().unwrap();
+        // An ACAC run: 100 steps of finished episodes per 240 steps taken, a row without the
+        // count left out.
+        let acac = write_run(t.path(), "e", "acac", 0, &[(0, 1.0)], bp10_spec(), true);
+        let rows: Vec<MetricsRow> = [(16, Some(100.0)), (32, None), (48, Some(300.0))]
+            .into_iter()
+            .map(|(episode, counted)| MetricsRow {
+                episode,
+                env_steps: episode * 15,
+                updates: episode / 16,
+                eval_return: 2.0,
+                eval_return_undiscounted: Some(2.0),
+                family: vec![counted, Some(0.5), None, None, None],
+                wall_seconds: 1.0,
+            })
+            .collect();
+        let columns = crate::algos::acac::learner::METRIC_COLUMNS;
+        metrics::write(&acac.join(METRICS_FILE), &columns, &rows).unwrap();
+        write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
+        let d = discover_along(t.path(), EVAL_RETURN, XAxis::AcacTimesteps).unwrap();
+        let curves = &d.experiments[0].curves;
+        assert_eq!(curves.len(), 1, "the value run has no such column");
+        assert_eq!(curves[0].runs[0].steps, [100, 300]);
+        assert_eq!(curves[0].runs[0].points, [(16, 2.0), (48, 2.0)]);
+        assert!(d.notes.iter().any(
+            |n| n.contains("our1") && n.contains("no `acac_timesteps` column to draw against")
+        ));
+        // Along env_steps the same runs give the steps taken.
+        let d = discover_along(t.path(), EVAL_RETURN, XAxis::EnvSteps).unwrap();
+        let acac = d.experiments[0]
+            .curves
+            .iter()
+            .find(|c| c.name == "acac")
+            .unwrap();
+        assert_eq!(acac.runs[0].steps, [240, 480, 720]);
     }
 }

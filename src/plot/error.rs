@@ -54,7 +54,7 @@ pub enum PlotError {
         reason: String,
     },
     /// `--beside` with axes the outside logs do not have.
-    #[error("--beside draws outside logs of undiscounted returns against environment steps: give --x env_steps --y undiscounted")]
+    #[error("--beside draws outside logs of undiscounted returns against step counts: give --y undiscounted with --x env_steps (or --x acac_timesteps, the steps ACAC's logs count)")]
     BesideAxes,
     /// The embedded font did not load (a build error).
     #[error("the embedded DejaVu Sans font could not be loaded")]

@@ -132,12 +132,12 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing, x:
         ));
         let drawn = match x {
             XAxis::Episode => points,
-            XAxis::EnvSteps => {
+            XAxis::EnvSteps | XAxis::AcacTimesteps => {
                 let runs: Vec<Vec<(u64, f64)>> = curve
                     .runs
                     .iter()
                     .map(|r| {
-                        r.env_steps
+                        r.steps
                             .iter()
                             .zip(&r.points)
                             .map(|(&s, &(_, v))| (s, v))
@@ -177,6 +177,9 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing, x:
     let along = match x {
         XAxis::Episode => "",
         XAxis::EnvSteps => ", each run interpolated linearly between its evaluations' env steps",
+        XAxis::AcacTimesteps => {
+            ", each run interpolated linearly between its evaluations' steps of finished training episodes"
+        }
     };
     let mut caption = format!(
         "Mean over seeds of {quantity}{along}; band: standard error (ddof 1); {}.",

@@ -73,8 +73,8 @@ pub struct PlotOptions {
     pub metric: String,
     /// The moving average applied to each curve before it is drawn and read.
     pub smoothing: stats::Smoothing,
-    /// What the curves are drawn against; figures against environment steps are named
-    /// `<experiment>[_<metric>]_env_steps.*`.
+    /// What the curves are drawn against; figures against step counts are named
+    /// `<experiment>[_<metric>]_<axis>.*` (`_env_steps`, `_acac_timesteps`).
     pub x: axis::XAxis,
     /// A `--beside` file: outside runs drawn beside ours ([`beside`]).
     pub beside: Option<PathBuf>,
@@ -108,7 +108,7 @@ pub fn plot_results_with(
     options: &PlotOptions,
 ) -> Result<PlotReport, PlotError> {
     let metric = options.metric.as_str();
-    let mut found = discover::discover_metric(results, metric)?;
+    let mut found = discover::discover_along(results, metric, options.x)?;
     if let Some(file) = &options.beside {
         add_beside(&mut found, file, options)?;
     }
@@ -126,8 +126,9 @@ pub fn plot_results_with(
         } else {
             format!("{}_{metric}", exp.name)
         };
-        if options.x == axis::XAxis::EnvSteps {
-            stem.push_str("_env_steps");
+        if options.x.is_steps() {
+            stem.push('_');
+            stem.push_str(options.x.name());
         }
         let png = out.join(format!("{stem}.png"));
         let svg = out.join(format!("{stem}.svg"));
@@ -158,7 +159,7 @@ fn add_beside(
     file: &Path,
     options: &PlotOptions,
 ) -> Result<(), PlotError> {
-    if options.x != axis::XAxis::EnvSteps || options.metric != axis::EVAL_RETURN_UNDISCOUNTED {
+    if !options.x.is_steps() || options.metric != axis::EVAL_RETURN_UNDISCOUNTED {
         return Err(PlotError::BesideAxes);
     }
     let read = beside::read_file(file)?;
@@ -400,7 +401,7 @@ mod tests {
         let mut found = discover::discover(&res).unwrap();
         // Seed 1 takes twice the steps per episode: 0, 10000, ..., 40000 against 0, ..., 20000.
         let runs = &mut found.experiments[0].curves[0].runs;
-        runs[1].env_steps = runs[1].env_steps.iter().map(|s| s * 2).collect();
+        runs[1].steps = runs[1].steps.iter().map(|s| s * 2).collect();
         let exp = &found.experiments[0];
         let smoothing = stats::Smoothing::Points(1);
         let by_episode = figure::build_metric(exp, "eval_return", smoothing, axis::XAxis::Episode);

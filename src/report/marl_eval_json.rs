@@ -141,7 +141,7 @@ pub fn build(block: &Block, notes: &mut Vec<String>) -> MarlEvalJson {
                             .enumerate()
                             .map(|(k, at)| {
                                 let entry = RunEntry::Step {
-                                    step_count: run.env_steps[at],
+                                    step_count: run.steps[at],
                                     value: run.points[at].1,
                                 };
                                 (format!("step_{k}"), entry)

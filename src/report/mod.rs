@@ -26,7 +26,7 @@ pub mod scores;
 pub use crate::plot::axis::XAxis;
 pub use error::ReportError;
 
-use crate::plot::discover::{discover, ExperimentData};
+use crate::plot::discover::{discover_along, ExperimentData, EVAL_RETURN};
 use crate::plot::summary::{format_number, write_csv};
 use crate::plot::PlotError;
 use aggregate::AggregateRow;
@@ -114,7 +114,7 @@ pub fn report_results(
             max,
         });
     }
-    let found = discover(results)?;
+    let found = discover_along(results, EVAL_RETURN, options.x_axis)?;
     let mut notes = found.notes;
     let chosen = choose(&found.experiments, &options.blocks)?;
     std::fs::create_dir_all(out).map_err(|source| PlotError::Write {

@@ -62,7 +62,7 @@ mod tests {
             seed,
             dir: PathBuf::from(format!("seed-{seed}")),
             points: points.to_vec(),
-            env_steps: points.iter().map(|p| p.0 * steps_per_episode).collect(),
+            steps: points.iter().map(|p| p.0 * steps_per_episode).collect(),
             finished: true,
             wall_seconds: Some(0.0),
             setting: None,
