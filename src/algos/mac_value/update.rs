@@ -31,6 +31,7 @@ use ndarray::{Array2, ArrayView1, ArrayView2};
 use serde::{Deserialize, Serialize};
 
 use super::episode::Step;
+use super::prefetch::prefetch_batch;
 use crate::autograd::{SeqPacking, Tape, Var};
 use crate::nn::argmax::{first_argmax, FirstArgmax};
 use crate::nn::loss::hysteretic_td_loss;
@@ -492,6 +493,7 @@ pub fn update_dec(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<Vec<TdTrace>> {
+    prefetch_batch(batch);
     let squeezed: Vec<_> = (0..nets.len())
         .map(|i| {
             let obs = dims.obs_range(i);
@@ -538,6 +540,7 @@ pub fn update_cen(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
+    prefetch_batch(batch);
     let (s, records) = Squeezed::joint(batch, sub_trace_len, dims);
     if s.lengths.is_empty() {
         return None;
@@ -584,6 +587,7 @@ pub fn update_dec_cen(
         running_actions(r, &mut running);
         conditional_argmax(row, &running, &r.next_avail, dims)
     };
+    prefetch_batch(cen_batch);
     let (s, records) = joint(cen_batch);
     if s.lengths.is_empty() {
         return None;
@@ -597,6 +601,7 @@ pub fn update_dec_cen(
         discount,
         scratch,
     );
+    prefetch_batch(dec_batch);
     let (s, records) = joint(dec_batch);
     if s.lengths.is_empty() {
         return Some((cen_trace, Vec::new()));
