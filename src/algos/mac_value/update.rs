@@ -173,10 +173,9 @@ pub fn for_each_allowed_joint(
     }
 }
 
-/// Into `running`: each agent's macro-action in `r` where it did not end there (it keeps running),
-/// `None` where it ended.
-fn running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
-    running.clear();
+/// Appends to `running` each agent's macro-action in `r` where it did not end there (it keeps
+/// running), `None` where it ended.
+fn push_running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
     running.extend(
         r.valid
             .iter()
@@ -209,12 +208,22 @@ struct Squeezed {
     rewards: Vec<f32>,
     gammas: Vec<f32>,
     terminals: Vec<f32>,
+    /// [sum lengths, avail_width]: the availability after each kept record (the net's own
+    /// masks). Copied out while the squeeze has the records in cache: choosing a' comes after the
+    /// unrolls, whose buffers evict the scattered records, and reading them again there cost more
+    /// than the choice itself.
+    next_avail: Vec<f32>,
+    avail_width: usize,
+    /// [sum lengths, n_agents] for the joint squeeze (empty otherwise): each agent's running
+    /// macro-action at each kept record, `None` where it ended (read by the conditional argmax).
+    running: Vec<Option<usize>>,
 }
 
 impl Squeezed {
     /// Keep the records `keep` accepts, reading each with `obs`/`next_obs` (the net's input
-    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go. Also
-    /// gives the kept records, in the same (flat) order.
+    /// slice), `fields` (action, reward, gamma) and `avail` (the net's slice of `next_avail`);
+    /// sequences shorter than `sub_trace_len` go. Also gives the kept records, in the same (flat)
+    /// order.
     fn of<'a>(
         batch: &[&'a [Step]],
         sub_trace_len: usize,
@@ -222,6 +231,7 @@ impl Squeezed {
         keep: impl Fn(&Step) -> bool,
         input: impl Fn(&'a [f32]) -> &'a [f32],
         fields: impl Fn(&Step) -> (usize, f32, f32),
+        avail: impl Fn(&'a Step) -> &'a [f32],
     ) -> (Squeezed, Vec<&'a Step>) {
         let mut s = Squeezed {
             width,
@@ -236,6 +246,9 @@ impl Squeezed {
             v.reserve(most);
         }
         s.actions.reserve(most);
+        if let Some(r) = batch.iter().find_map(|seq| seq.first()) {
+            s.next_avail.reserve(most * avail(r).len());
+        }
         for seq in batch {
             let first = records.len();
             records.extend(seq.iter().filter(|r| keep(r)));
@@ -254,6 +267,9 @@ impl Squeezed {
                 s.rewards.push(rew);
                 s.gammas.push(g);
                 s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
+                let mask = avail(r);
+                s.avail_width = mask.len();
+                s.next_avail.extend_from_slice(mask);
             }
         }
         (s, records)
@@ -266,14 +282,37 @@ impl Squeezed {
         sub_trace_len: usize,
         dims: &Dims,
     ) -> (Squeezed, Vec<&'a Step>) {
-        Squeezed::of(
+        let (mut s, records) = Squeezed::of(
             batch,
             sub_trace_len,
             dims.obs_sizes.iter().sum(),
             Step::any_valid,
             |o| o,
             |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-        )
+            |r| &r.next_avail,
+        );
+        s.running.reserve(records.len() * dims.n_actions.len());
+        for r in &records {
+            push_running_actions(r, &mut s.running);
+        }
+        (s, records)
+    }
+
+    /// Record k's availability after it (the net's masks).
+    fn next_avail(&self, k: usize) -> &[f32] {
+        &self.next_avail[k * self.avail_width..(k + 1) * self.avail_width]
+    }
+
+    /// Record k's running macro-actions (joint squeezes only), `n_agents` of them.
+    fn running(&self, k: usize, n_agents: usize) -> &[Option<usize>] {
+        &self.running[k * n_agents..(k + 1) * n_agents]
+    }
+
+    /// The joint conditional argmax of record k's next values `row` (`get_conditional_action`:
+    /// agents whose macro-action did not end keep it).
+    fn conditional_argmax(&self, k: usize, row: &[f32], dims: &Dims) -> usize {
+        let running = self.running(k, dims.n_actions.len());
+        conditional_argmax(row, running, self.next_avail(k), dims)
     }
 
     /// Whether every sequence's continuation starts with its observations, bit for bit
@@ -482,6 +521,22 @@ fn td_step(
     }
 }
 
+/// Agent i's squeeze (MacDec-Q's): the records where its macro-action ended, its observation,
+/// macro-action, reward, gamma and availability masks.
+fn agent_squeeze(batch: &[&[Step]], sub_trace_len: usize, dims: &Dims, i: usize) -> Squeezed {
+    let (obs, masks) = (dims.obs_range(i), dims.action_range(i));
+    Squeezed::of(
+        batch,
+        sub_trace_len,
+        obs.len(),
+        |r| r.valid[i],
+        |o| &o[obs.clone()],
+        |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+        |r| &r.next_avail[masks.clone()],
+    )
+    .0
+}
+
 /// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
 /// (then no net changes). `scratch` is reused memory (see [`UpdateScratch`]).
 pub fn update_dec(
@@ -495,31 +550,19 @@ pub fn update_dec(
 ) -> Option<Vec<TdTrace>> {
     prefetch_batch(batch);
     let squeezed: Vec<_> = (0..nets.len())
-        .map(|i| {
-            let obs = dims.obs_range(i);
-            Squeezed::of(
-                batch,
-                sub_trace_len,
-                obs.len(),
-                |r| r.valid[i],
-                |o| &o[obs.clone()],
-                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-            )
-        })
+        .map(|i| agent_squeeze(batch, sub_trace_len, dims, i))
         .collect();
-    if squeezed.iter().any(|(s, _)| s.lengths.is_empty()) {
+    if squeezed.iter().any(|s| s.lengths.is_empty()) {
         return None;
     }
     Some(
         nets.iter_mut()
             .zip(&squeezed)
-            .enumerate()
-            .map(|(i, (q, (s, records)))| {
-                let masks = dims.action_range(i);
+            .map(|(q, s)| {
                 td_step(
                     q,
                     s,
-                    |k, row| masked_argmax(row, &records[k].next_avail[masks.clone()]),
+                    |k, row| masked_argmax(row, s.next_avail(k)),
                     hysteresis,
                     discount,
                     scratch,
@@ -541,20 +584,14 @@ pub fn update_cen(
     scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
     prefetch_batch(batch);
-    let (s, records) = Squeezed::joint(batch, sub_trace_len, dims);
+    let (s, _) = Squeezed::joint(batch, sub_trace_len, dims);
     if s.lengths.is_empty() {
         return None;
     }
-    let mut running = Vec::with_capacity(dims.n_actions.len());
     Some(td_step(
         q,
         &s,
-        |k, row| {
-            let r = records[k];
-            // Agents whose macro-action did not end keep it (`get_conditional_action`).
-            running_actions(r, &mut running);
-            conditional_argmax(row, &running, &r.next_avail, dims)
-        },
+        |k, row| s.conditional_argmax(k, row, dims),
         hysteresis,
         discount,
         scratch,
@@ -581,14 +618,8 @@ pub fn update_dec_cen(
     scratch: &mut UpdateScratch,
 ) -> Option<(TdTrace, Vec<TdTrace>)> {
     let joint = |batch| Squeezed::joint(batch, sub_trace_len, dims);
-    let choose = |records: &[&Step], k: usize, row: &[f32]| {
-        let r = records[k];
-        let mut running = Vec::with_capacity(dims.n_actions.len());
-        running_actions(r, &mut running);
-        conditional_argmax(row, &running, &r.next_avail, dims)
-    };
     prefetch_batch(cen_batch);
-    let (s, records) = joint(cen_batch);
+    let (s, _) = joint(cen_batch);
     if s.lengths.is_empty() {
         return None;
     }
@@ -596,7 +627,7 @@ pub fn update_dec_cen(
     let cen_trace = td_step(
         cen,
         &s,
-        |k, row| choose(&records, k, row),
+        |k, row| s.conditional_argmax(k, row, dims),
         1.0,
         discount,
         scratch,
@@ -611,21 +642,10 @@ pub fn update_dec_cen(
         .online_next
         .chunks_exact(cen.net.config().output)
         .enumerate()
-        .map(|(k, row)| choose(&records, k, row))
+        .map(|(k, row)| s.conditional_argmax(k, row, dims))
         .collect();
     let squeezed: Vec<_> = (0..decs.len())
-        .map(|i| {
-            let obs = dims.obs_range(i);
-            Squeezed::of(
-                dec_batch,
-                sub_trace_len,
-                obs.len(),
-                |r| r.valid[i],
-                |o| &o[obs.clone()],
-                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-            )
-            .0
-        })
+        .map(|i| agent_squeeze(dec_batch, sub_trace_len, dims, i))
         .collect();
     if squeezed.iter().any(|s| s.lengths.is_empty()) {
         return Some((cen_trace, Vec::new()));
@@ -737,17 +757,7 @@ mod tests {
         use rand::SeedableRng;
         let episode = held_episode(9);
         let batch: Vec<&[Step]> = vec![&episode[..], &episode[2..7], &episode[5..6]];
-        let agent = |i: usize| {
-            Squeezed::of(
-                &batch,
-                1,
-                1,
-                |r| r.valid[i],
-                move |o| &o[i..i + 1],
-                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-            )
-            .0
-        };
+        let agent = |i: usize| agent_squeeze(&batch, 1, &dims(), i);
         // Agent 0's squeeze (every other record), agent 1's (every record), the joint one.
         let squeezes = [agent(0), agent(1), Squeezed::joint(&batch, 1, &dims()).0];
         for (k, s) in squeezes.iter().enumerate() {
