@@ -391,6 +391,16 @@ fn packed_outputs(
     (out, h, vars)
 }
 
+/// Row `i` of a standard-layout `a` as a slice (a copy of it is one `memcpy`, not an element-wise
+/// iterator). Panics if the rows are not contiguous.
+fn row_slice<'a>(a: &ArrayView2<'a, f32>, i: usize) -> &'a [f32] {
+    let w = a.ncols();
+    let all = a
+        .to_slice()
+        .expect("tape and fresh arrays are in standard layout");
+    &all[i * w..(i + 1) * w]
+}
+
 /// Values (no gradient) of `net` over the continuation sequences at each record's next row, into
 /// `into` as [records, n_out] row-major; the tape is left empty.
 fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32>) {
@@ -403,7 +413,7 @@ fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32
     for &l in &s.lengths {
         // Record k of the sequence is continuation position k + 1.
         for f in start + 1..start + 1 + l {
-            into.extend(v.row(packing.flat_to_packed()[f]).iter());
+            into.extend_from_slice(row_slice(&v, packing.flat_to_packed()[f]));
         }
         start += l + 1;
     }
@@ -442,9 +452,9 @@ fn next_values_from_unroll(
     let mut at = 0;
     for (seq, &l) in s.lengths.iter().enumerate() {
         for &p in &to_packed[at + 1..at + l] {
-            into.extend(out.row(p).iter());
+            into.extend_from_slice(row_slice(&out, p));
         }
-        into.extend(past.row(seq).iter());
+        into.extend_from_slice(row_slice(&past.view(), seq));
         at += l;
     }
 }
