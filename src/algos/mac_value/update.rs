@@ -113,15 +113,54 @@ impl Dims {
 /// `avail` (per-agent masks, concatenated) and equals `running[i]` where that is `Some` (an agent
 /// still executing its macro-action): the reference's `get_conditional_argmax`, first maximal
 /// index in C order; 0 when none qualifies (all -inf in the reference).
+///
+/// The last agent's actions are consecutive indices, so each choice of the other agents'
+/// components gives one contiguous block of `q`; each block's winner ([`block_argmax`]) is offered
+/// in order. That is the choice offering every allowed index in order makes (a block's winner is
+/// its first largest non-NaN value, or its first entry when all are NaN), with no branch per
+/// index.
 pub fn conditional_argmax(
     q: &[f32],
     running: &[Option<usize>],
     avail: &[f32],
     dims: &Dims,
 ) -> usize {
+    let Some(last) = dims.n_actions.len().checked_sub(1) else {
+        // One joint macro-action, of no components.
+        return 0;
+    };
+    let n = dims.n_actions[last];
+    let mask = &avail[dims.action_range(last)];
     let mut best = FirstArgmax::default();
-    for_each_allowed_joint(dims, running, avail, &mut |j| best.offer(j, q[j]));
+    for_each_allowed_prefix(dims, last, running, avail, &mut |prefix| {
+        let block = &q[prefix * n..(prefix + 1) * n];
+        let winner = match running[last] {
+            Some(r) => (r < n && mask[r] != 0.0).then_some(r),
+            None => block_argmax(block, mask),
+        };
+        if let Some(a) = winner {
+            best.offer(prefix * n + a, block[a]);
+        }
+    });
     best.index().unwrap_or(0)
+}
+
+/// The first index of the largest value of `q` among those where `mask` is nonzero, a NaN losing
+/// to any number, or the first such index when all are NaN; `None` when the mask allows none.
+/// The choice of offering the allowed entries to [`FirstArgmax`] in order, found as the maximum
+/// (`f32::max` skips NaN) and then its first position (`==` also equates -0 and +0, which the
+/// strict `>` never lets replace each other).
+fn block_argmax(q: &[f32], mask: &[f32]) -> Option<usize> {
+    let mut top = f32::NAN;
+    for (&v, &ok) in q.iter().zip(mask) {
+        top = top.max(if ok != 0.0 { v } else { f32::NAN });
+    }
+    if top.is_nan() {
+        return mask.iter().position(|&ok| ok != 0.0);
+    }
+    q.iter()
+        .zip(mask)
+        .position(|(&v, &ok)| ok != 0.0 && v == top)
 }
 
 /// Calls `f` with every joint macro-action index whose every component is available in `avail`
@@ -134,6 +173,18 @@ pub fn for_each_allowed_joint(
     avail: &[f32],
     f: &mut impl FnMut(usize),
 ) {
+    for_each_allowed_prefix(dims, dims.n_actions.len(), running, avail, f);
+}
+
+/// [`for_each_allowed_joint`] over the first `depth` agents only: `f` gets the C-order index of
+/// each allowed choice of their components, in increasing order (0 once for depth 0).
+fn for_each_allowed_prefix(
+    dims: &Dims,
+    depth: usize,
+    running: &[Option<usize>],
+    avail: &[f32],
+    f: &mut impl FnMut(usize),
+) {
     /// Agent `i` on, its mask at avail[lo..], the components before it giving `prefix`.
     fn visit(
         n_actions: &[usize],
@@ -142,19 +193,17 @@ pub fn for_each_allowed_joint(
         (i, lo, prefix): (usize, usize, usize),
         f: &mut impl FnMut(usize),
     ) {
+        if i == n_actions.len() {
+            f(prefix);
+            return;
+        }
         let n = n_actions[i];
         let actions = match running[i] {
             Some(r) => r..(r + 1).min(n),
             None => 0..n,
         };
-        let last = i + 1 == n_actions.len();
         for a in actions {
-            if avail[lo + a] == 0.0 {
-                continue;
-            }
-            if last {
-                f(prefix * n + a);
-            } else {
+            if avail[lo + a] != 0.0 {
                 visit(
                     n_actions,
                     running,
@@ -165,12 +214,7 @@ pub fn for_each_allowed_joint(
             }
         }
     }
-    if dims.n_actions.is_empty() {
-        // One joint macro-action, of no components.
-        f(0);
-    } else {
-        visit(&dims.n_actions, running, avail, (0, 0, 0), f);
-    }
+    visit(&dims.n_actions[..depth], running, avail, (0, 0, 0), f);
 }
 
 /// Appends to `running` each agent's macro-action in `r` where it did not end there (it keeps
@@ -710,10 +754,15 @@ mod tests {
             n_actions: vec![3, 2, 4],
         };
         for _ in 0..2000 {
-            // Few distinct values (ties), some NaN, masks and running actions at random.
+            // Few distinct values (ties, zeros of both signs, infinities), some NaN, masks and
+            // running actions at random.
             let q: Vec<f32> = (0..dims.n_joint())
-                .map(|_| match rng.gen_range(0..8) {
+                .map(|_| match rng.gen_range(0..11) {
                     0 => f32::NAN,
+                    1 => -0.0,
+                    2 => 0.0,
+                    3 => f32::NEG_INFINITY,
+                    4 => f32::INFINITY,
                     k => k as f32,
                 })
                 .collect();
