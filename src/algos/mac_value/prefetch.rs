@@ -10,17 +10,20 @@
 
 use super::episode::Step;
 
+/// Bytes per cache line on the CPUs this targets (x86-64).
+const LINE: usize = 64;
+
 /// Asks the CPU to bring every record of `batch` and the heap blocks the update reads (the
 /// observations, actions, rewards, gammas, next availability and `valid`) into its caches. A hint
 /// only: on CPUs other than x86-64 it does nothing.
 pub fn prefetch_batch(batch: &[&[Step]]) {
-    // The records first: a window's records are contiguous, one Step spans up to 4 lines.
+    // The records first: a window's records are contiguous, so every line of its byte range
+    // (a record straddles up to four lines).
     for seq in batch {
-        for r in seq.iter() {
-            let at = r as *const Step as *const u8;
-            for line in (0..std::mem::size_of::<Step>()).step_by(64) {
-                prefetch(at.wrapping_add(line));
-            }
+        let (start, bytes) = (seq.as_ptr() as *const u8, std::mem::size_of_val(*seq));
+        let first_line = start as usize % LINE;
+        for offset in (0..first_line + bytes).step_by(LINE) {
+            prefetch(start.wrapping_sub(first_line).wrapping_add(offset));
         }
     }
     // Then the blocks they point to; reading the pointers waits for no branch, so these loads
