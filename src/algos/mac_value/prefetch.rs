@@ -1,12 +1,12 @@
 //! Loading a sampled batch's records ahead of the squeeze.
 //!
-//! A batch is 64 windows of up to 10 records drawn at random from a replay memory of tens of
-//! megabytes, and each [`Step`] keeps its fields in separate heap blocks, so reading a record is
-//! two cache misses in a row (the record, then the block it points to). The squeeze tests
-//! `valid[i]` and branches on it before it reads the next record, which leaves the CPU waiting for
-//! one miss at a time: `perf annotate` put more than half of `Squeezed::of` on that test. Asking
-//! for every line first, with prefetches that neither branch nor wait, lets the misses overlap.
-//! Nothing is computed, so no number depends on it.
+//! A batch (64 windows of up to 10 records in the published settings) is drawn at random from a
+//! replay memory of tens of megabytes, and each [`Step`] keeps its fields in separate heap
+//! blocks, so reading a record is two cache misses in a row (the record, then the block it points
+//! to). The squeeze tests `valid[i]` and branches on it before it reads the next record, which
+//! leaves the CPU waiting for one miss at a time: `perf annotate` put more than half of
+//! `Squeezed::of` on that test. Asking for every line first, with prefetches that neither branch
+//! nor wait, lets the misses overlap. Nothing is computed, so no number depends on it.
 
 use super::episode::Step;
 

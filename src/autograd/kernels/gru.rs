@@ -9,11 +9,11 @@
 //! ```
 //!
 //! Rows are in packed order (see [`SeqPacking`]), as for the LSTM (`lstm.rs`), and the design is
-//! the LSTM's: the input product of all steps at once, then per step the recurrent product over
-//! the sequences still running and one fused, vectorized pass for the pointwise part. Unlike the LSTM the two
-//! products cannot be summed into one buffer (the reset gate multiplies only the recurrent part
-//! of n), so the recurrent product goes to a scratch [n, 3H] block, and the forward keeps
-//! b_n = W_hn h_prev + b_hn for the backward.
+//! the LSTM's, except that the input product of all steps is one product up front: then per step
+//! the recurrent product over the sequences still running and one fused, vectorized pass for the
+//! pointwise part. Unlike the LSTM the two products cannot be summed into one buffer (the reset
+//! gate multiplies only the recurrent part of n), so the recurrent product goes to a scratch
+//! [n, 3H] block, and the forward keeps b_n = W_hn h_prev + b_hn for the backward.
 //!
 //! The backward mirrors it: per step one fused pass computes the input-side gate gradients
 //! dA = [da_r, da_z, da_n] and the recurrent-side ones dB = [da_r, da_z, r * da_n] (they differ
