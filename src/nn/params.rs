@@ -167,8 +167,14 @@ pub(crate) fn copy_grad(tape: &Tape, v: Var, dst: &mut [f32]) {
                 dst.len(),
                 "gradient size differs from the parameter's"
             );
-            for (d, &g) in dst.iter_mut().zip(g.iter()) {
-                *d = g;
+            match g.as_slice() {
+                // Tape gradients are contiguous: one memcpy, not ndarray's element iterator.
+                Some(g) => dst.copy_from_slice(g),
+                None => {
+                    for (d, &g) in dst.iter_mut().zip(g.iter()) {
+                        *d = g;
+                    }
+                }
             }
         }
         None => dst.fill(0.0),

@@ -22,5 +22,6 @@ pub mod family;
 pub mod learner;
 pub mod memory;
 pub mod method;
+mod prefetch;
 pub mod published;
 pub mod update;

@@ -31,6 +31,7 @@ use ndarray::{Array2, ArrayView1, ArrayView2};
 use serde::{Deserialize, Serialize};
 
 use super::episode::Step;
+use super::prefetch::prefetch_batch;
 use crate::autograd::{SeqPacking, Tape, Var};
 use crate::nn::argmax::{first_argmax, FirstArgmax};
 use crate::nn::loss::hysteretic_td_loss;
@@ -112,15 +113,54 @@ impl Dims {
 /// `avail` (per-agent masks, concatenated) and equals `running[i]` where that is `Some` (an agent
 /// still executing its macro-action): the reference's `get_conditional_argmax`, first maximal
 /// index in C order; 0 when none qualifies (all -inf in the reference).
+///
+/// The last agent's actions are consecutive indices, so each choice of the other agents'
+/// components gives one contiguous block of `q`; each block's winner ([`block_argmax`]) is offered
+/// in order. That is the choice offering every allowed index in order makes (a block's winner is
+/// its first largest non-NaN value, or its first entry when all are NaN), with no branch per
+/// index.
 pub fn conditional_argmax(
     q: &[f32],
     running: &[Option<usize>],
     avail: &[f32],
     dims: &Dims,
 ) -> usize {
+    let Some(last) = dims.n_actions.len().checked_sub(1) else {
+        // One joint macro-action, of no components.
+        return 0;
+    };
+    let n = dims.n_actions[last];
+    let mask = &avail[dims.action_range(last)];
     let mut best = FirstArgmax::default();
-    for_each_allowed_joint(dims, running, avail, &mut |j| best.offer(j, q[j]));
+    for_each_allowed_prefix(dims, last, running, avail, &mut |prefix| {
+        let block = &q[prefix * n..(prefix + 1) * n];
+        let winner = match running[last] {
+            Some(r) => (r < n && mask[r] != 0.0).then_some(r),
+            None => block_argmax(block, mask),
+        };
+        if let Some(a) = winner {
+            best.offer(prefix * n + a, block[a]);
+        }
+    });
     best.index().unwrap_or(0)
+}
+
+/// The first index of the largest value of `q` among those where `mask` is nonzero, a NaN losing
+/// to any number, or the first such index when all are NaN; `None` when the mask allows none.
+/// The choice of offering the allowed entries to [`FirstArgmax`] in order, found as the maximum
+/// (`f32::max` skips NaN) and then its first position (`==` also equates -0 and +0, which the
+/// strict `>` never lets replace each other).
+fn block_argmax(q: &[f32], mask: &[f32]) -> Option<usize> {
+    let mut top = f32::NAN;
+    for (&v, &ok) in q.iter().zip(mask) {
+        top = top.max(if ok != 0.0 { v } else { f32::NAN });
+    }
+    if top.is_nan() {
+        return mask.iter().position(|&ok| ok != 0.0);
+    }
+    q.iter()
+        .zip(mask)
+        .position(|(&v, &ok)| ok != 0.0 && v == top)
 }
 
 /// Calls `f` with every joint macro-action index whose every component is available in `avail`
@@ -133,6 +173,18 @@ pub fn for_each_allowed_joint(
     avail: &[f32],
     f: &mut impl FnMut(usize),
 ) {
+    for_each_allowed_prefix(dims, dims.n_actions.len(), running, avail, f);
+}
+
+/// [`for_each_allowed_joint`] over the first `depth` agents only: `f` gets the C-order index of
+/// each allowed choice of their components, in increasing order (0 once for depth 0).
+fn for_each_allowed_prefix(
+    dims: &Dims,
+    depth: usize,
+    running: &[Option<usize>],
+    avail: &[f32],
+    f: &mut impl FnMut(usize),
+) {
     /// Agent `i` on, its mask at avail[lo..], the components before it giving `prefix`.
     fn visit(
         n_actions: &[usize],
@@ -141,19 +193,17 @@ pub fn for_each_allowed_joint(
         (i, lo, prefix): (usize, usize, usize),
         f: &mut impl FnMut(usize),
     ) {
+        if i == n_actions.len() {
+            f(prefix);
+            return;
+        }
         let n = n_actions[i];
         let actions = match running[i] {
             Some(r) => r..(r + 1).min(n),
             None => 0..n,
         };
-        let last = i + 1 == n_actions.len();
         for a in actions {
-            if avail[lo + a] == 0.0 {
-                continue;
-            }
-            if last {
-                f(prefix * n + a);
-            } else {
+            if avail[lo + a] != 0.0 {
                 visit(
                     n_actions,
                     running,
@@ -164,18 +214,12 @@ pub fn for_each_allowed_joint(
             }
         }
     }
-    if dims.n_actions.is_empty() {
-        // One joint macro-action, of no components.
-        f(0);
-    } else {
-        visit(&dims.n_actions, running, avail, (0, 0, 0), f);
-    }
+    visit(&dims.n_actions[..depth], running, avail, (0, 0, 0), f);
 }
 
-/// Into `running`: each agent's macro-action in `r` where it did not end there (it keeps running),
-/// `None` where it ended.
-fn running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
-    running.clear();
+/// Appends to `running` each agent's macro-action in `r` where it did not end there (it keeps
+/// running), `None` where it ended.
+fn push_running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
     running.extend(
         r.valid
             .iter()
@@ -208,12 +252,22 @@ struct Squeezed {
     rewards: Vec<f32>,
     gammas: Vec<f32>,
     terminals: Vec<f32>,
+    /// [sum lengths, avail_width]: the availability after each kept record (the net's own
+    /// masks). Copied out while the squeeze has the records in cache: choosing a' comes after the
+    /// unrolls, whose buffers evict the scattered records, and reading them again there cost more
+    /// than the choice itself.
+    next_avail: Vec<f32>,
+    avail_width: usize,
+    /// [sum lengths, n_agents] for the joint squeeze (empty otherwise): each agent's running
+    /// macro-action at each kept record, `None` where it ended (read by the conditional argmax).
+    running: Vec<Option<usize>>,
 }
 
 impl Squeezed {
     /// Keep the records `keep` accepts, reading each with `obs`/`next_obs` (the net's input
-    /// slice), `fields` (action, reward, gamma); sequences shorter than `sub_trace_len` go. Also
-    /// gives the kept records, in the same (flat) order.
+    /// slice), `fields` (action, reward, gamma) and `avail` (the net's slice of `next_avail`);
+    /// sequences shorter than `sub_trace_len` go. Also gives the kept records, in the same (flat)
+    /// order.
     fn of<'a>(
         batch: &[&'a [Step]],
         sub_trace_len: usize,
@@ -221,6 +275,7 @@ impl Squeezed {
         keep: impl Fn(&Step) -> bool,
         input: impl Fn(&'a [f32]) -> &'a [f32],
         fields: impl Fn(&Step) -> (usize, f32, f32),
+        avail: impl Fn(&'a Step) -> &'a [f32],
     ) -> (Squeezed, Vec<&'a Step>) {
         let mut s = Squeezed {
             width,
@@ -235,6 +290,9 @@ impl Squeezed {
             v.reserve(most);
         }
         s.actions.reserve(most);
+        if let Some(r) = batch.iter().find_map(|seq| seq.first()) {
+            s.next_avail.reserve(most * avail(r).len());
+        }
         for seq in batch {
             let first = records.len();
             records.extend(seq.iter().filter(|r| keep(r)));
@@ -253,6 +311,9 @@ impl Squeezed {
                 s.rewards.push(rew);
                 s.gammas.push(g);
                 s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
+                let mask = avail(r);
+                s.avail_width = mask.len();
+                s.next_avail.extend_from_slice(mask);
             }
         }
         (s, records)
@@ -265,14 +326,37 @@ impl Squeezed {
         sub_trace_len: usize,
         dims: &Dims,
     ) -> (Squeezed, Vec<&'a Step>) {
-        Squeezed::of(
+        let (mut s, records) = Squeezed::of(
             batch,
             sub_trace_len,
             dims.obs_sizes.iter().sum(),
             Step::any_valid,
             |o| o,
             |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
-        )
+            |r| &r.next_avail,
+        );
+        s.running.reserve(records.len() * dims.n_actions.len());
+        for r in &records {
+            push_running_actions(r, &mut s.running);
+        }
+        (s, records)
+    }
+
+    /// Record k's availability after it (the net's masks).
+    fn next_avail(&self, k: usize) -> &[f32] {
+        &self.next_avail[k * self.avail_width..(k + 1) * self.avail_width]
+    }
+
+    /// Record k's running macro-actions (joint squeezes only), `n_agents` of them.
+    fn running(&self, k: usize, n_agents: usize) -> &[Option<usize>] {
+        &self.running[k * n_agents..(k + 1) * n_agents]
+    }
+
+    /// The joint conditional argmax of record k's next values `row` (`get_conditional_action`:
+    /// agents whose macro-action did not end keep it).
+    fn conditional_argmax(&self, k: usize, row: &[f32], dims: &Dims) -> usize {
+        let running = self.running(k, dims.n_actions.len());
+        conditional_argmax(row, running, self.next_avail(k), dims)
     }
 
     /// Whether every sequence's continuation starts with its observations, bit for bit
@@ -351,6 +435,16 @@ fn packed_outputs(
     (out, h, vars)
 }
 
+/// Row `i` of a standard-layout `a` as a slice (a copy of it is one `memcpy`, not an element-wise
+/// iterator). Panics if the rows are not contiguous.
+fn row_slice<'a>(a: &ArrayView2<'a, f32>, i: usize) -> &'a [f32] {
+    let w = a.ncols();
+    let all = a
+        .to_slice()
+        .expect("tape and fresh arrays are in standard layout");
+    &all[i * w..(i + 1) * w]
+}
+
 /// Values (no gradient) of `net` over the continuation sequences at each record's next row, into
 /// `into` as [records, n_out] row-major; the tape is left empty.
 fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32>) {
@@ -363,7 +457,7 @@ fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32
     for &l in &s.lengths {
         // Record k of the sequence is continuation position k + 1.
         for f in start + 1..start + 1 + l {
-            into.extend(v.row(packing.flat_to_packed()[f]).iter());
+            into.extend_from_slice(row_slice(&v, packing.flat_to_packed()[f]));
         }
         start += l + 1;
     }
@@ -402,9 +496,9 @@ fn next_values_from_unroll(
     let mut at = 0;
     for (seq, &l) in s.lengths.iter().enumerate() {
         for &p in &to_packed[at + 1..at + l] {
-            into.extend(out.row(p).iter());
+            into.extend_from_slice(row_slice(&out, p));
         }
-        into.extend(past.row(seq).iter());
+        into.extend_from_slice(row_slice(&past.view(), seq));
         at += l;
     }
 }
@@ -481,6 +575,22 @@ fn td_step(
     }
 }
 
+/// Agent i's squeeze (MacDec-Q's): the records where its macro-action ended, its observation,
+/// macro-action, reward, gamma and availability masks.
+fn agent_squeeze(batch: &[&[Step]], sub_trace_len: usize, dims: &Dims, i: usize) -> Squeezed {
+    let (obs, masks) = (dims.obs_range(i), dims.action_range(i));
+    Squeezed::of(
+        batch,
+        sub_trace_len,
+        obs.len(),
+        |r| r.valid[i],
+        |o| &o[obs.clone()],
+        |r| (r.actions[i], r.rewards[i], r.gammas[i]),
+        |r| &r.next_avail[masks.clone()],
+    )
+    .0
+}
+
 /// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
 /// (then no net changes). `scratch` is reused memory (see [`UpdateScratch`]).
 pub fn update_dec(
@@ -492,32 +602,21 @@ pub fn update_dec(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<Vec<TdTrace>> {
+    prefetch_batch(batch);
     let squeezed: Vec<_> = (0..nets.len())
-        .map(|i| {
-            let obs = dims.obs_range(i);
-            Squeezed::of(
-                batch,
-                sub_trace_len,
-                obs.len(),
-                |r| r.valid[i],
-                |o| &o[obs.clone()],
-                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-            )
-        })
+        .map(|i| agent_squeeze(batch, sub_trace_len, dims, i))
         .collect();
-    if squeezed.iter().any(|(s, _)| s.lengths.is_empty()) {
+    if squeezed.iter().any(|s| s.lengths.is_empty()) {
         return None;
     }
     Some(
         nets.iter_mut()
             .zip(&squeezed)
-            .enumerate()
-            .map(|(i, (q, (s, records)))| {
-                let masks = dims.action_range(i);
+            .map(|(q, s)| {
                 td_step(
                     q,
                     s,
-                    |k, row| masked_argmax(row, &records[k].next_avail[masks.clone()]),
+                    |k, row| masked_argmax(row, s.next_avail(k)),
                     hysteresis,
                     discount,
                     scratch,
@@ -538,20 +637,15 @@ pub fn update_cen(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
-    let (s, records) = Squeezed::joint(batch, sub_trace_len, dims);
+    prefetch_batch(batch);
+    let (s, _) = Squeezed::joint(batch, sub_trace_len, dims);
     if s.lengths.is_empty() {
         return None;
     }
-    let mut running = Vec::with_capacity(dims.n_actions.len());
     Some(td_step(
         q,
         &s,
-        |k, row| {
-            let r = records[k];
-            // Agents whose macro-action did not end keep it (`get_conditional_action`).
-            running_actions(r, &mut running);
-            conditional_argmax(row, &running, &r.next_avail, dims)
-        },
+        |k, row| s.conditional_argmax(k, row, dims),
         hysteresis,
         discount,
         scratch,
@@ -578,13 +672,8 @@ pub fn update_dec_cen(
     scratch: &mut UpdateScratch,
 ) -> Option<(TdTrace, Vec<TdTrace>)> {
     let joint = |batch| Squeezed::joint(batch, sub_trace_len, dims);
-    let choose = |records: &[&Step], k: usize, row: &[f32]| {
-        let r = records[k];
-        let mut running = Vec::with_capacity(dims.n_actions.len());
-        running_actions(r, &mut running);
-        conditional_argmax(row, &running, &r.next_avail, dims)
-    };
-    let (s, records) = joint(cen_batch);
+    prefetch_batch(cen_batch);
+    let (s, _) = joint(cen_batch);
     if s.lengths.is_empty() {
         return None;
     }
@@ -592,11 +681,12 @@ pub fn update_dec_cen(
     let cen_trace = td_step(
         cen,
         &s,
-        |k, row| choose(&records, k, row),
+        |k, row| s.conditional_argmax(k, row, dims),
         1.0,
         discount,
         scratch,
     );
+    prefetch_batch(dec_batch);
     let (s, records) = joint(dec_batch);
     if s.lengths.is_empty() {
         return Some((cen_trace, Vec::new()));
@@ -606,21 +696,10 @@ pub fn update_dec_cen(
         .online_next
         .chunks_exact(cen.net.config().output)
         .enumerate()
-        .map(|(k, row)| choose(&records, k, row))
+        .map(|(k, row)| s.conditional_argmax(k, row, dims))
         .collect();
     let squeezed: Vec<_> = (0..decs.len())
-        .map(|i| {
-            let obs = dims.obs_range(i);
-            Squeezed::of(
-                dec_batch,
-                sub_trace_len,
-                obs.len(),
-                |r| r.valid[i],
-                |o| &o[obs.clone()],
-                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-            )
-            .0
-        })
+        .map(|i| agent_squeeze(dec_batch, sub_trace_len, dims, i))
         .collect();
     if squeezed.iter().any(|s| s.lengths.is_empty()) {
         return Some((cen_trace, Vec::new()));
@@ -675,10 +754,15 @@ mod tests {
             n_actions: vec![3, 2, 4],
         };
         for _ in 0..2000 {
-            // Few distinct values (ties), some NaN, masks and running actions at random.
+            // Few distinct values (ties, zeros of both signs, infinities), some NaN, masks and
+            // running actions at random.
             let q: Vec<f32> = (0..dims.n_joint())
-                .map(|_| match rng.gen_range(0..8) {
+                .map(|_| match rng.gen_range(0..11) {
                     0 => f32::NAN,
+                    1 => -0.0,
+                    2 => 0.0,
+                    3 => f32::NEG_INFINITY,
+                    4 => f32::INFINITY,
                     k => k as f32,
                 })
                 .collect();
@@ -732,17 +816,7 @@ mod tests {
         use rand::SeedableRng;
         let episode = held_episode(9);
         let batch: Vec<&[Step]> = vec![&episode[..], &episode[2..7], &episode[5..6]];
-        let agent = |i: usize| {
-            Squeezed::of(
-                &batch,
-                1,
-                1,
-                |r| r.valid[i],
-                move |o| &o[i..i + 1],
-                |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-            )
-            .0
-        };
+        let agent = |i: usize| agent_squeeze(&batch, 1, &dims(), i);
         // Agent 0's squeeze (every other record), agent 1's (every record), the joint one.
         let squeezes = [agent(0), agent(1), Squeezed::joint(&batch, 1, &dims()).0];
         for (k, s) in squeezes.iter().enumerate() {

@@ -9,11 +9,11 @@
 //! ```
 //!
 //! Rows are in packed order (see [`SeqPacking`]), as for the LSTM (`lstm.rs`), and the design is
-//! the LSTM's: per step, the input product and the recurrent product over the sequences still
-//! running, then one fused, vectorized pass for the pointwise part. Unlike the LSTM the two
-//! products cannot be summed into one buffer (the reset gate multiplies only the recurrent part
-//! of n), so the recurrent product goes to a scratch [n, 3H] block, and the forward keeps
-//! b_n = W_hn h_prev + b_hn for the backward.
+//! the LSTM's, except that the input product of all steps is one product up front: then per step
+//! the recurrent product over the sequences still running and one fused, vectorized pass for the
+//! pointwise part. Unlike the LSTM the two products cannot be summed into one buffer (the reset
+//! gate multiplies only the recurrent part of n), so the recurrent product goes to a scratch
+//! [n, 3H] block, and the forward keeps b_n = W_hn h_prev + b_hn for the backward.
 //!
 //! The backward mirrors it: per step one fused pass computes the input-side gate gradients
 //! dA = [da_r, da_z, da_n] and the recurrent-side ones dB = [da_r, da_z, r * da_n] (they differ
@@ -128,15 +128,14 @@ pub fn gru_forward(
     // The recurrent product of one step; zero at step 0, where h_prev = 0.
     let mut rec = Array2::<f32>::zeros((n0, 3 * h));
 
+    // The input product of every step at once: it does not depend on h, and each output
+    // element's arithmetic is the same whatever rows a product covers (see `gemm`), so this is
+    // the per-step products' bits with one call instead of one per step.
+    gemm(x, w_ih_t.view(), cache.gates.view_mut(), Mode::Overwrite);
+
     let y = y.as_slice_mut().expect("gru: y must be contiguous");
     for t in 0..packing.n_steps() {
         let (n, o) = (packing.batch_size(t), packing.offset(t));
-        gemm(
-            x.slice(s![o..o + n, ..]),
-            w_ih_t.view(),
-            cache.gates.slice_mut(s![o..o + n, ..]),
-            Mode::Overwrite,
-        );
         if t > 0 {
             gemm(
                 cache.h_prev.slice(s![o..o + n, ..]),
