@@ -2,7 +2,7 @@
 //! `plot` and `report`) and `--y discounted|undiscounted` (`plot`), so curves compare with papers
 //! that report undiscounted returns against environment steps (ACAC, the AVF paper, marl-eval).
 
-use crate::plot::discover::{RunData, EVAL_RETURN};
+use crate::plot::discover::{RunData, ENV_STEPS, EVAL_RETURN};
 
 /// What learning curves are drawn against (`--x` of `plot` and `report`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -56,7 +56,7 @@ impl XAxis {
     /// axis's own, `env_steps` along episodes (exports still record the steps).
     pub fn steps_column(self) -> &'static str {
         match self {
-            XAxis::Episode | XAxis::EnvSteps => "env_steps",
+            XAxis::Episode | XAxis::EnvSteps => ENV_STEPS,
             XAxis::AcacTimesteps => "acac_timesteps",
         }
     }

@@ -6,7 +6,6 @@
 //! being synced), so anything that is not a run is skipped with a note. A malformed metrics file
 //! is skipped with a warning as long as some other run is readable; if none is, it is the error.
 
-use super::axis::XAxis;
 use super::error::PlotError;
 use super::setting::EnvSetting;
 use crate::algos::families::Method;
@@ -33,7 +32,8 @@ pub struct RunData {
     pub points: Vec<(u64, f64)>,
     /// The step count of the x axis at the same rows as `points`, for figures and exports
     /// against steps rather than episodes: the `env_steps` column (environment steps taken when
-    /// each evaluation ran), or the column `--x` names instead ([`XAxis::steps_column`]).
+    /// each evaluation ran), or the column `--x` names instead
+    /// ([`crate::plot::axis::XAxis::steps_column`]).
     pub steps: Vec<u64>,
     /// Whether the run wrote its `finished` marker.
     pub finished: bool,
@@ -99,19 +99,24 @@ pub fn discover(results: &Path) -> Result<Discovery, PlotError> {
 pub const EVAL_RETURN: &str = "eval_return";
 
 /// The step column runs are read with unless an axis asks for another.
-const ENV_STEPS: &str = "env_steps";
+pub const ENV_STEPS: &str = "env_steps";
 
 /// Scan `results` for runs, reading the `metric` column of each `metrics.csv` (any leading or
 /// family column) with its `env_steps` (see [`discover_along`]).
 pub fn discover_metric(results: &Path, metric: &str) -> Result<Discovery, PlotError> {
-    discover_along(results, metric, XAxis::EnvSteps)
+    discover_along(results, metric, ENV_STEPS)
 }
 
-/// Scan `results` for runs, reading the `metric` column of each `metrics.csv` and the step
-/// column `x` draws against ([`XAxis::steps_column`]). Fails only when the root cannot be read,
-/// when it holds no run at all, or when every metrics file found is malformed. A run without
-/// either column is skipped with a note.
-pub fn discover_along(results: &Path, metric: &str, x: XAxis) -> Result<Discovery, PlotError> {
+/// Scan `results` for runs, reading the `metric` column of each `metrics.csv` and the column of
+/// step counts `steps_column` (`env_steps`, or another an x axis draws against:
+/// [`crate::plot::axis::XAxis::steps_column`]). Fails only when the root cannot be read, when
+/// it holds no run at all, or when every metrics file found is malformed. A run without either
+/// column is skipped with a note.
+pub fn discover_along(
+    results: &Path,
+    metric: &str,
+    steps_column: &str,
+) -> Result<Discovery, PlotError> {
     let exp_dirs = sorted_subdirs(results).map_err(|source| PlotError::ReadResults {
         path: results.to_path_buf(),
         source,
@@ -127,7 +132,7 @@ pub fn discover_along(results: &Path, metric: &str, x: XAxis) -> Result<Discover
             let method = method_name.parse::<Method>().ok();
             let mut runs = Vec::new();
             for run_dir in subdirs_or_note(&curve_dir, &mut notes) {
-                match read_run(&run_dir, metric, x.steps_column()) {
+                match read_run(&run_dir, metric, steps_column) {
                     Ok(run) => runs.push(run),
                     Err(RunProblem::Skip(why)) => {
                         notes.push(format!("skipping {}: {why}", run_dir.display()))
@@ -608,7 +613,7 @@ pub(crate) mod tests {
         let columns = crate::algos::acac::learner::METRIC_COLUMNS;
         metrics::write(&acac.join(METRICS_FILE), &columns, &rows).unwrap();
         write_run(t.path(), "e", "our1", 0, &[(0, 1.0)], bp10_spec(), true);
-        let d = discover_along(t.path(), EVAL_RETURN, XAxis::AcacTimesteps).unwrap();
+        let d = discover_along(t.path(), EVAL_RETURN, "acac_timesteps").unwrap();
         let curves = &d.experiments[0].curves;
         assert_eq!(curves.len(), 1, "the value run has no such column");
         assert_eq!(curves[0].runs[0].steps, [100, 300]);
@@ -617,7 +622,7 @@ pub(crate) mod tests {
             |n| n.contains("our1") && n.contains("no `acac_timesteps` column to draw against")
         ));
         // Along env_steps the same runs give the steps taken.
-        let d = discover_along(t.path(), EVAL_RETURN, XAxis::EnvSteps).unwrap();
+        let d = discover_along(t.path(), EVAL_RETURN, ENV_STEPS).unwrap();
         let acac = d.experiments[0]
             .curves
             .iter()

@@ -108,7 +108,7 @@ pub fn plot_results_with(
     options: &PlotOptions,
 ) -> Result<PlotReport, PlotError> {
     let metric = options.metric.as_str();
-    let mut found = discover::discover_along(results, metric, options.x)?;
+    let mut found = discover::discover_along(results, metric, options.x.steps_column())?;
     if let Some(file) = &options.beside {
         add_beside(&mut found, file, options)?;
     }

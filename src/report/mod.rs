@@ -114,7 +114,7 @@ pub fn report_results(
             max,
         });
     }
-    let found = discover_along(results, EVAL_RETURN, options.x_axis)?;
+    let found = discover_along(results, EVAL_RETURN, options.x_axis.steps_column())?;
     let mut notes = found.notes;
     let chosen = choose(&found.experiments, &options.blocks)?;
     std::fs::create_dir_all(out).map_err(|source| PlotError::Write {
