@@ -115,7 +115,7 @@ impl Dims {
 /// index in C order; 0 when none qualifies (all -inf in the reference).
 ///
 /// The last agent's actions are consecutive indices, so each choice of the other agents'
-/// components gives one contiguous block of `q`; each block's winner ([`block_argmax`]) is offered
+/// components gives one contiguous block of `q`; each block's winner (`block_argmax`) is offered
 /// in order. That is the choice offering every allowed index in order makes (a block's winner is
 /// its first largest non-NaN value, or its first entry when all are NaN), with no branch per
 /// index.
