@@ -203,9 +203,9 @@ fn read_run(path: &Path, seed: u64, x: &str, y: &str) -> Result<RunData, PlotErr
     })
 }
 
-/// Put every run of `exp` on one grid of environment steps from 0 to the smallest last step
-/// any run reached, with as many points as the sparsest run has evaluations up to there (at
-/// most 1,000): each run's value at a step is linearly interpolated between its
+/// Put every run of `exp` on one grid of steps (its x axis's step column) from 0 to the smallest
+/// last step any run reached, with as many points as the sparsest run has evaluations up to
+/// there (at most 1,000): each run's value at a step is linearly interpolated between its
 /// evaluations (its first value before its first evaluation), and its points' episode is the
 /// step, so every run is complete at the same last "episode" and the tables compare equal
 /// budgets. A run that never reached a step past 0 is left out with a note.
@@ -245,7 +245,7 @@ pub fn on_common_steps(exp: &mut ExperimentData, notes: &mut Vec<String>) {
         }
     }
     notes.push(format!(
-        "{}: every run read on {n} environment steps from 0 to {end} (the smallest last step), so the tables compare equal budgets",
+        "{}: every run read on {n} points of its step axis from 0 to {end} (the smallest last step), so the tables compare equal budgets",
         exp.name
     ));
 }
