@@ -15,7 +15,7 @@ pub enum XAxis {
     EnvSteps,
     /// ACAC's `Timesteps` (column `acac_timesteps`): the primitive steps of finished training
     /// episodes only, what ACAC's budget and its published curves count. ACAC's runner drops
-    /// the episodes still running when a batch is complete, so on Box Pushing this is 1.4 to 2.3
+    /// the episodes still running when a batch is complete, so on Box Pushing this is 1.4 to 3.1
     /// times fewer than `env_steps`: ACAC's logs compare with our ACAC runs only along this
     /// axis. Runs of other families lack the column and are skipped with a note.
     AcacTimesteps,
