@@ -18,7 +18,8 @@ use macdec::algos::acac::update::{
 };
 use macdec::algos::actor_critic::episode::{Episode, EpisodeRecorder};
 use macdec::autograd::Tape;
-use macdec::envs::{registry, EnvRng, EnvSpec, MacroEnv};
+use macdec::envs::{EnvRng, EnvSpec, MacroEnv};
+use macdec::experiment::definition::config::{Experiment, Overrides};
 use macdec::nn::{AcacActor, TIME_TABLE};
 use macdec::nn::{BlockDropout, Gpt2Dropout, StateDict, TimeEmbedding, ValueHead};
 use ndarray::{Array2, ArrayViewD};
@@ -522,10 +523,8 @@ fn env_spec(case: &Value) -> EnvSpec {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("experiments/acac")
         .join(format!("{}.toml", case["env"].as_str().unwrap()));
-    let doc: toml::Table = toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    let params = doc["params"].as_table().unwrap();
-    let domain = registry::lookup(params["env_name"].as_str().unwrap()).unwrap();
-    EnvSpec::from_keys_in(domain, params).unwrap()
+    let experiment = Experiment::load(&path, &Overrides::default()).unwrap();
+    experiment.runs().unwrap()[0].env.clone()
 }
 
 /// Floats of a record to f32 precision (ACAC's runner makes float32 tensors of float64 sums).

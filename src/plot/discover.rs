@@ -290,20 +290,16 @@ fn read_run(dir: &Path, metric: &str, steps_column: &str) -> Result<RunData, Run
             table.family_columns.join(", ")
         )));
     };
-    let steps: Vec<Option<u64>> = if steps_column == ENV_STEPS {
-        rows.iter().map(|r| Some(r.env_steps)).collect()
-    } else {
-        let Some(counts) = table.column(steps_column) else {
-            return Err(RunProblem::Skip(format!(
-                "no `{steps_column}` column to draw against (it has {})",
-                table.family_columns.join(", ")
-            )));
-        };
-        counts
-            .into_iter()
-            .map(|c| c.filter(|c| c.is_finite() && *c >= 0.0).map(|c| c as u64))
-            .collect()
+    // Step counts are whole numbers far below 2^53, so they pass through f64 exactly.
+    let Some(counts) = table.column(steps_column) else {
+        return Err(RunProblem::Skip(format!(
+            "no `{steps_column}` column to draw against (it has {})",
+            table.family_columns.join(", ")
+        )));
     };
+    let steps = counts
+        .into_iter()
+        .map(|c| c.filter(|c| c.is_finite() && *c >= 0.0).map(|c| c as u64));
     let (points, steps): (Vec<(u64, f64)>, Vec<u64>) = rows
         .iter()
         .zip(values)
