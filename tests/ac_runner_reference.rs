@@ -284,6 +284,10 @@ fn replays_like_the_reference(case: &str) -> Vec<String> {
     let mut updates = 0;
     let mut last_eps = config.eps_start;
     let mut returns_since_eval: Vec<f64> = Vec::new();
+    // Steps of the reference's completed training episodes: known exactly while every batch
+    // kept all its completed episodes (the ones a batch completes beyond `train_freq` are not
+    // in the recording), a lower bound after.
+    let (mut completed_steps, mut completed_exact) = (0u64, true);
     let mut evals = 0;
     let mut p = 0;
     while p < phases.len() {
@@ -345,6 +349,12 @@ fn replays_like_the_reference(case: &str) -> Vec<String> {
                 assert!(close64(ours, m), "{at}: train_return {ours} vs {m}");
             }
             returns_since_eval.clear();
+            let ours = point.family[4].unwrap() as u64;
+            if completed_exact {
+                assert_eq!(ours, completed_steps, "{at}: steps of completed episodes");
+            } else {
+                assert!(ours > completed_steps, "{at}: steps of completed episodes");
+            }
             if returns.len() > config.eval_num_epi {
                 shown.push(format!(
                     "{at}: {} episodes completed, the mean of the last {} ({last:?})",
@@ -378,6 +388,11 @@ fn replays_like_the_reference(case: &str) -> Vec<String> {
             ));
         }
         returns_since_eval.extend(list(&train["train_returns"]).iter().map(f));
+        completed_exact &= completed == config.train_freq;
+        completed_steps += batch
+            .iter()
+            .map(|e| list(&e["action"]).len() as u64)
+            .sum::<u64>();
         train_steps += list(&train["steps"]).len();
         updates += 1;
         assert_eq!(l.updates(), updates, "{at}");

@@ -42,7 +42,7 @@ fn actor_critic_runs_train_evaluate_and_export() {
     let iaisc = out.join("ac/mac-iaisc/seed-0");
     let metrics = std::fs::read_to_string(iaisc.join("metrics.csv")).unwrap();
     assert!(
-        metrics.starts_with("episode,env_steps,updates,eval_return,eval_return_undiscounted,eps,critic_loss,actor_loss,train_return,wall_seconds\n"),
+        metrics.starts_with("episode,env_steps,updates,eval_return,eval_return_undiscounted,eps,critic_loss,actor_loss,train_return,acac_timesteps,wall_seconds\n"),
         "{metrics}"
     );
     assert_eq!(

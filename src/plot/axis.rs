@@ -2,6 +2,7 @@
 //! `plot` and `report`) and `--y discounted|undiscounted` (`plot`), so curves compare with papers
 //! that report undiscounted returns against environment steps (ACAC, the AVF paper, marl-eval).
 
+use crate::experiment::run::metrics::COMPLETED_EPISODE_STEPS;
 use crate::plot::discover::{RunData, ENV_STEPS, EVAL_RETURN};
 
 /// What learning curves are drawn against (`--x` of `plot` and `report`).
@@ -16,8 +17,9 @@ pub enum XAxis {
     /// ACAC's `Timesteps` (column `acac_timesteps`): the primitive steps of finished training
     /// episodes only, what ACAC's budget and its published curves count. ACAC's runner drops
     /// the episodes still running when a batch is complete, so on Box Pushing this is 1.4 to 3.1
-    /// times fewer than `env_steps`: ACAC's logs compare with our ACAC runs only along this
-    /// axis. Runs of other families lack the column and are skipped with a note.
+    /// times fewer than `env_steps`: ACAC's logs compare with our runs only along this axis.
+    /// The ACAC and actor-critic families write the column (MacroMARL's runner drops unfinished
+    /// episodes too); runs without it (other families, older runs) are skipped with a note.
     AcacTimesteps,
 }
 
@@ -57,7 +59,7 @@ impl XAxis {
     pub fn steps_column(self) -> &'static str {
         match self {
             XAxis::Episode | XAxis::EnvSteps => ENV_STEPS,
-            XAxis::AcacTimesteps => "acac_timesteps",
+            XAxis::AcacTimesteps => COMPLETED_EPISODE_STEPS,
         }
     }
 

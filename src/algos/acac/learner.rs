@@ -30,6 +30,7 @@ use crate::algos::train_error::TrainError;
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use crate::experiment::run::metrics::COMPLETED_EPISODE_STEPS;
 use crate::nn::sampling::{mixture, sample_weighted};
 use crate::nn::{AcacActor, AcacActorState};
 use crate::nn::{ActingNetRef, TimeEmbedding};
@@ -40,7 +41,7 @@ use crate::policy_files::SavedNet;
 /// actor losses of the updates since the previous row, and the mean undiscounted return of the
 /// training episodes completed since then (ACAC's `Train/Return`).
 pub const METRIC_COLUMNS: [&str; 5] = [
-    "acac_timesteps",
+    COMPLETED_EPISODE_STEPS,
     "eps",
     "critic_loss",
     "actor_loss",

@@ -24,12 +24,21 @@ use crate::algos::training_loop::TrainError;
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
+use crate::experiment::run::metrics::COMPLETED_EPISODE_STEPS;
 use crate::nn::GruActorState;
 
 /// The family's `metrics.csv` columns: the exploration weight of the batch before the
 /// evaluation, the mean critic and actor losses over the updates since the previous row (mean
-/// over nets), and the mean discounted return of the training episodes completed since then.
-pub const METRIC_COLUMNS: [&str; 4] = ["eps", "critic_loss", "actor_loss", "train_return"];
+/// over nets), the mean discounted return of the training episodes completed since then, and
+/// the primitive steps of every training episode completed so far (the count ACAC's logs are
+/// drawn against, which also leaves out the episodes each batch drops unfinished).
+pub const METRIC_COLUMNS: [&str; 5] = [
+    "eps",
+    "critic_loss",
+    "actor_loss",
+    "train_return",
+    COMPLETED_EPISODE_STEPS,
+];
 
 /// One training lane: the episode being recorded and the actors' recurrent states.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -53,6 +62,9 @@ pub struct AcLearner {
     memory: VecDeque<Episode>,
     /// Losses and training returns since the last metrics row.
     means: UpdateMeans,
+    /// Primitive steps of the training episodes completed so far (dropped unfinished ones are
+    /// not counted).
+    completed_steps: u64,
     /// The updates' tape, reset after every pass.
     #[serde(skip, default)]
     tape: Scratch<Tape>,
@@ -225,6 +237,7 @@ impl Learner for AcLearner {
             eps: config.eps_start,
             memory: VecDeque::new(),
             means: UpdateMeans::default(),
+            completed_steps: 0,
             tape: Scratch::default(),
             buffers: ActBuffers::default(),
             script: None,
@@ -301,6 +314,7 @@ impl Learner for AcLearner {
             return Ok(false);
         }
         self.means.record_return(lane.recorder.returns().discounted);
+        self.completed_steps += lane.recorder.episode().steps as u64;
         self.memory.push_back(lane.recorder.episode().clone());
         while self.memory.len() > self.c().train_freq {
             self.memory.pop_front();
@@ -400,7 +414,8 @@ impl Learner for AcLearner {
 
     fn metric_values(&mut self) -> Vec<Option<f64>> {
         let [critic, actor, ret] = self.means.take_row();
-        vec![Some(self.eps), critic, actor, ret]
+        let steps = Some(self.completed_steps as f64);
+        vec![Some(self.eps), critic, actor, ret, steps]
     }
 
     fn progress(&self) -> String {
@@ -424,5 +439,61 @@ impl Learner for AcLearner {
                 }
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::algos::family::FamilyMethod;
+    use crate::algos::training_loop::{Advance, TrainingLoop};
+    use crate::envs::AnyEnv;
+    use crate::experiment::run::train_run::run_rngs;
+
+    /// Mac-IAICC on Box Pushing 6x6 with `n_env` lanes and batches of `train_freq` episodes.
+    fn short_run(n_env: usize, train_freq: usize) -> TrainingLoop<AcLearner, AnyEnv> {
+        let spec = crate::envs::bp_ma_v0::spec(6, 30);
+        let method = AcMethod::MacIaicc;
+        let mut c = method.defaults(&spec);
+        (c.n_env, c.train_freq, c.c_target_update_freq) = (n_env, train_freq, 4 * train_freq);
+        (c.eval_freq, c.eval_num_epi, c.total_epi) = (4 * train_freq, 2, 16 * train_freq);
+        (c.a_mlp_layer_size, c.a_rnn_layer_size) = (vec![8, 8], 8);
+        (c.c_mlp_layer_size, c.c_rnn_layer_size) = (vec![8, 8], 8);
+        TrainingLoop::new(&c, method, 0, run_rngs(0), || spec.build()).unwrap()
+    }
+
+    fn completed_steps(l: &mut TrainingLoop<AcLearner, AnyEnv>) -> Vec<(u64, u64)> {
+        while let Advance::Episode { .. } = l.advance().unwrap() {}
+        let at = METRIC_COLUMNS.len() - 1;
+        l.evals()
+            .iter()
+            .map(|e| (e.family[at].unwrap() as u64, e.env_steps))
+            .collect()
+    }
+
+    #[test]
+    fn one_lane_with_batches_of_one_episode_drops_nothing_so_both_counts_agree() {
+        let counts = completed_steps(&mut short_run(1, 1));
+        assert!(
+            counts.len() > 3 && counts.last().unwrap().0 > 0,
+            "{counts:?}"
+        );
+        assert!(
+            counts.iter().all(|(done, taken)| done == taken),
+            "{counts:?}"
+        );
+    }
+
+    #[test]
+    fn lockstep_lanes_leave_out_the_steps_of_the_episodes_each_batch_drops() {
+        let counts = completed_steps(&mut short_run(4, 2));
+        assert!(counts.windows(2).all(|w| w[0].0 <= w[1].0), "{counts:?}");
+        assert!(
+            counts.iter().all(|(done, taken)| done <= taken),
+            "{counts:?}"
+        );
+        // Four lanes, two episodes a batch: the other lanes' steps are dropped every batch.
+        let (done, taken) = *counts.last().unwrap();
+        assert!(done > 0 && done < taken, "{counts:?}");
     }
 }

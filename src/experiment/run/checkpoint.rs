@@ -20,6 +20,8 @@ use sha2::{Digest, Sha256};
 /// First bytes of every checkpoint.
 pub const MAGIC: &[u8; 8] = b"MACDECCK";
 /// The format version this build writes and reads.
+/// Version 7: actor-critic learners count the steps of completed training episodes (their
+/// `acac_timesteps` column); runs checkpointed by version 6 restart.
 /// Version 6: Overcooked kitchens hold up to 11 x 11 cells, 6 foods, 4 plates and 4 knives (ACAC's
 /// Overcooked-MA-v0); runs checkpointed by version 5 restart.
 /// Version 5: Overcooked environments carry ACAC's variant (numbering, random starts, state) and
@@ -29,7 +31,7 @@ pub const MAGIC: &[u8; 8] = b"MACDECCK";
 /// Version 3: evaluation points and actor-critic recorders carry the undiscounted return.
 /// Version 2: the payload is the family-tagged training loop (`AnyLoop`); version 1 held the
 /// value-based trainer alone.
-pub const VERSION: u32 = 6;
+pub const VERSION: u32 = 7;
 /// Longest identity header accepted (names are at most 200 bytes each).
 const MAX_IDENTITY_BYTES: usize = 4096;
 
