@@ -74,10 +74,9 @@ impl XAxis {
         match self {
             XAxis::Episode => run.points.iter().map(|&(e, v)| (e as f64, v)).collect(),
             XAxis::EnvSteps | XAxis::AcacTimesteps => run
-                .steps
-                .iter()
-                .zip(&run.points)
-                .map(|(&s, &(_, v))| (s as f64, v))
+                .along_steps()
+                .into_iter()
+                .map(|(s, v)| (s as f64, v))
                 .collect(),
         }
     }

@@ -46,6 +46,14 @@ pub struct RunData {
     pub provenance: Option<Provenance>,
 }
 
+impl RunData {
+    /// `(step count, value)` per evaluation: the run's curve against its [`RunData::steps`].
+    pub fn along_steps(&self) -> Vec<(u64, f64)> {
+        let values = self.points.iter().map(|&(_, v)| v);
+        self.steps.iter().copied().zip(values).collect()
+    }
+}
+
 /// All runs of one curve (a method, or a method at one sweep point), seeds ascending.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CurveData {

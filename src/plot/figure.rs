@@ -133,17 +133,8 @@ pub fn build_metric(exp: &ExperimentData, metric: &str, smoothing: Smoothing, x:
         let drawn = match x {
             XAxis::Episode => points,
             XAxis::EnvSteps | XAxis::AcacTimesteps => {
-                let runs: Vec<Vec<(u64, f64)>> = curve
-                    .runs
-                    .iter()
-                    .map(|r| {
-                        r.steps
-                            .iter()
-                            .zip(&r.points)
-                            .map(|(&s, &(_, v))| (s, v))
-                            .collect()
-                    })
-                    .collect();
+                let runs: Vec<Vec<(u64, f64)>> =
+                    curve.runs.iter().map(RunData::along_steps).collect();
                 smooth(&aggregate_interpolated(&runs, mean.len()), half_window)
             }
         };

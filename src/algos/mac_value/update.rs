@@ -290,8 +290,10 @@ impl Squeezed {
             v.reserve(most);
         }
         s.actions.reserve(most);
+        // Every record of a net has a mask of the same width.
         if let Some(r) = batch.iter().find_map(|seq| seq.first()) {
-            s.next_avail.reserve(most * avail(r).len());
+            s.avail_width = avail(r).len();
+            s.next_avail.reserve(most * s.avail_width);
         }
         for seq in batch {
             let first = records.len();
@@ -312,7 +314,7 @@ impl Squeezed {
                 s.gammas.push(g);
                 s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
                 let mask = avail(r);
-                s.avail_width = mask.len();
+                debug_assert_eq!(mask.len(), s.avail_width);
                 s.next_avail.extend_from_slice(mask);
             }
         }
