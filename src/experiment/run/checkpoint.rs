@@ -318,8 +318,9 @@ mod tests {
         assert!(e.to_string().contains("delete it"), "{e}");
         // Versions 1 (the value-based trainer before the learner seam), 2 (before the
         // undiscounted return), 3 (before the one list of families) and 4 (before ACAC's
-        // Overcooked), 5 (before ACAC's Large kitchen), and any future version.
-        for found in [1, 2, 3, 4, 5, 7] {
+        // Overcooked), 5 (before ACAC's Large kitchen), 6 (before the actor-critic learners
+        // counted completed episodes' steps), and any future version.
+        for found in [1, 2, 3, 4, 5, 6, 8] {
             let mut other = encode(&tiny().0, &t).unwrap();
             other[8] = found as u8;
             assert_eq!(
