@@ -125,6 +125,13 @@ pub trait FamilyConfig:
     fn discount(&self) -> f64;
 }
 
+/// The family column of step counts ACAC's logs are drawn against (their `Timesteps`): the
+/// primitive steps of completed training episodes, cumulative at each evaluation. The families
+/// whose runners drop the episodes still running when a batch is complete (actor-critic, ACAC)
+/// write it under this one name, so one axis (`--x acac_timesteps`) reads them all and compares
+/// them with ACAC's published curves; files of runs trained before a family wrote it lack it.
+pub const COMPLETED_EPISODE_STEPS: &str = "acac_timesteps";
+
 /// A method family, as the training loop drives it. The learner is saved inside every checkpoint
 /// (with its lanes' state), so a resumed run continues with exactly the numbers of an
 /// uninterrupted one.

@@ -24,13 +24,13 @@ use crate::algos::actor_critic::episode::{Episode, EpisodeRecorder};
 use crate::algos::actor_critic::lockstep_eval::lockstep_episodes;
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+    COMPLETED_EPISODE_STEPS,
 };
 use crate::algos::scratch::Scratch;
 use crate::algos::train_error::TrainError;
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
-use crate::experiment::run::metrics::COMPLETED_EPISODE_STEPS;
 use crate::nn::sampling::{mixture, sample_weighted};
 use crate::nn::{AcacActor, AcacActorState};
 use crate::nn::{ActingNetRef, TimeEmbedding};

@@ -18,13 +18,13 @@ use super::scripted::{ActingCall, ActionScript};
 use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+    COMPLETED_EPISODE_STEPS,
 };
 use crate::algos::scratch::Scratch;
 use crate::algos::training_loop::TrainError;
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
-use crate::experiment::run::metrics::COMPLETED_EPISODE_STEPS;
 use crate::nn::GruActorState;
 
 /// The family's `metrics.csv` columns: the exploration weight of the batch before the

@@ -25,12 +25,8 @@ pub const METRICS_FILE_GZ: &str = "metrics.csv.gz";
 pub const LEADING_COLUMNS: [&str; 4] = ["episode", "env_steps", "updates", "eval_return"];
 /// The column written after the leading ones since it exists; files of older runs lack it.
 pub const EVAL_RETURN_UNDISCOUNTED: &str = "eval_return_undiscounted";
-/// The family column of step counts ACAC's logs are drawn against (their `Timesteps`): the
-/// primitive steps of completed training episodes, cumulative at each evaluation. The families
-/// whose runners drop the episodes still running when a batch is complete (actor-critic, ACAC)
-/// write it under this one name, so one axis (`--x acac_timesteps`) reads them all and compares
-/// them with ACAC's published curves; files of runs trained before a family wrote it lack it.
-pub const COMPLETED_EPISODE_STEPS: &str = "acac_timesteps";
+/// The family column of ACAC's counted steps (defined beside the learners that write it).
+pub use crate::algos::learner::COMPLETED_EPISODE_STEPS;
 /// The column every family writes after its own.
 pub const WALL_SECONDS: &str = "wall_seconds";
 
