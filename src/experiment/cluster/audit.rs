@@ -9,7 +9,9 @@
 //! recompute the results it affects.
 
 use crate::experiment::definition::config::RunSpec;
-use crate::experiment::run::metrics::{self, MetricsError, EVAL_RETURN_UNDISCOUNTED};
+use crate::experiment::run::metrics::{
+    self, MetricsError, COMPLETED_EPISODE_STEPS, EVAL_RETURN_UNDISCOUNTED,
+};
 use crate::experiment::run::progress::Progress;
 use crate::experiment::run::provenance::Provenance;
 use crate::experiment::run::results_tree::{self, CONFIG};
@@ -171,9 +173,7 @@ pub fn audit_run(dir: &Path, scratch: &Path) -> Result<RunAudit, AuditError> {
     let retrained_path = run_dir.join(metrics::METRICS_FILE);
     let committed = rows_without_wall(&committed_path)?;
     let mut retrained = rows_without_wall(&retrained_path)?;
-    if !has_column(&committed, EVAL_RETURN_UNDISCOUNTED) {
-        drop_column(&mut retrained, EVAL_RETURN_UNDISCOUNTED);
-    }
+    drop_columns_added_since(&committed, &mut retrained);
     Ok(RunAudit {
         dir: dir.to_path_buf(),
         provenance: manifest.provenance,
@@ -196,6 +196,19 @@ fn rows_without_wall(path: &Path) -> Result<Vec<String>, AuditError> {
         .chain(lines)
         .map(|l| l.rsplit_once(',').map_or(l, |(rest, _)| rest).to_string())
         .collect())
+}
+
+/// The columns added to `metrics.csv` after runs had been committed (each changed no number):
+/// a run committed without one is compared without it.
+const ADDED_COLUMNS: [&str; 2] = [EVAL_RETURN_UNDISCOUNTED, COMPLETED_EPISODE_STEPS];
+
+/// Drop from `retrained` each of [`ADDED_COLUMNS`] that `committed` lacks.
+fn drop_columns_added_since(committed: &[String], retrained: &mut [String]) {
+    for column in ADDED_COLUMNS {
+        if !has_column(committed, column) {
+            drop_column(retrained, column);
+        }
+    }
 }
 
 /// Whether the header (the first of `lines`) names `column`.
@@ -336,6 +349,36 @@ mod tests {
             compare(&old, &moved),
             AuditOutcome::Differs { row: 2, .. }
         ));
+    }
+
+    #[test]
+    fn a_run_committed_before_the_counted_steps_column_is_compared_without_it_and_others_with() {
+        let header = "episode,eval_return,eval_return_undiscounted,eps,train_return";
+        let old = lines(&[header, "0,1.5,2,1,", "96,2.5,3,0.9,4"]);
+        let retrained = lines(&[
+            &format!("{header},acac_timesteps"),
+            "0,1.5,2,1,,0",
+            "96,2.5,3,0.9,4,1150",
+        ]);
+        let mut new = retrained.clone();
+        drop_columns_added_since(&old, &mut new);
+        assert_eq!(compare(&old, &new), AuditOutcome::Identical { rows: 2 });
+        // A run committed with the column keeps it compared: a moved count differs.
+        let mut moved = retrained.clone();
+        moved[2] = "96,2.5,3,0.9,4,1151".into();
+        drop_columns_added_since(&retrained, &mut moved);
+        assert!(matches!(
+            compare(&retrained, &moved),
+            AuditOutcome::Differs { row: 2, .. }
+        ));
+        // Both added columns go for a run older than either.
+        let oldest = lines(&["episode,eval_return,eps", "0,1.5,1"]);
+        let mut new = lines(&[
+            "episode,eval_return,eval_return_undiscounted,eps,acac_timesteps",
+            "0,1.5,2,1,0",
+        ]);
+        drop_columns_added_since(&oldest, &mut new);
+        assert_eq!(compare(&oldest, &new), AuditOutcome::Identical { rows: 1 });
     }
 
     #[test]
