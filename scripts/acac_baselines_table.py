@@ -59,8 +59,8 @@ def row(label, runs):
         if hit is not None:
             found.append(hit)
         finals.append(within[-1][1])
-        if r[-1][0] < BUDGET:
-            label += " (a run ends before the budget)"
+    if any(r[-1][0] < BUDGET for r in runs):
+        label += " (a run ends before the budget)"
     where = ", ".join(f"{s / 1000:.0f} k" for s in sorted(found))
     return (f"| {label} | {len(runs)} | {statistics.mean(first):.0f} ({min(first):.0f}-{max(first):.0f}) "
             f"| {len(found)} of {len(runs)}{' (' + where + ')' if where else ''} | {statistics.mean(finals):.1f} |")
