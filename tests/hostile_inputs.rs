@@ -113,6 +113,16 @@ fn refused(out: &Output) -> String {
     err
 }
 
+/// `macdec train ARGS --out RESULTS`, which must be refused before any run starts; its error.
+fn train_refused(results: &Path, args: &[&str]) -> String {
+    let mut all = vec!["train"];
+    all.extend_from_slice(args);
+    all.extend(["--out", s(results)]);
+    let err = refused(&macdec(&all));
+    assert!(!results.exists(), "{args:?}: no run may start");
+    err
+}
+
 fn mkfifo(path: &Path) {
     let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
     // SAFETY: a valid NUL-terminated path.
@@ -461,56 +471,36 @@ fn replay_verbose_on_the_largest_grid_stays_small() {
 fn a_nan_rate_and_a_seed_beyond_the_largest_are_named_before_any_run() {
     let dir = tempfile::tempdir().unwrap();
     let results = dir.path().join("results");
-    let err = refused(&macdec(&[
-        "train",
-        "--set",
-        "l_rate=nan",
-        "--out",
-        s(&results),
-    ]));
+    let err = train_refused(&results, &["--set", "l_rate=nan"]);
     assert!(
         err.contains("`l_rate`")
             && err.contains("positive number")
             && !err.contains("does not use"),
         "{err}"
     );
-    let err = refused(&macdec(&[
-        "train",
-        "--seeds",
-        "9223372036854775808",
-        "--out",
-        s(&results),
-    ]));
+    let err = train_refused(&results, &["--seeds", "9223372036854775808"]);
     assert!(
         err.contains("9223372036854775808") && err.contains("largest"),
         "{err}"
     );
-    assert!(!results.exists(), "no run may start");
 }
 
 #[test]
 fn no_key_is_dropped_a_set_with_a_line_break_nor_a_key_the_domain_does_not_read() {
     let dir = tempfile::tempdir().unwrap();
     let results = dir.path().join("results");
-    let err = refused(&macdec(&[
-        "train",
-        "--set",
-        "total_epi=30\neval_freq=5",
-        "--out",
-        s(&results),
-    ]));
+    let err = train_refused(&results, &["--set", "total_epi=30\neval_freq=5"]);
     assert!(err.contains("line break"), "{err}");
     for (set, key) in [
         ("tb_m_noisy=0.5", "`tb_m_noisy`"),
         ("env_name=\"BP-MA-v0\"", ""),
     ] {
-        let mut args = vec!["train", "--set", set];
+        let mut args = vec!["--set", set];
         if key.is_empty() {
             // MacroMARL's Box Pushing with a kwarg only its Warehouses read.
             args.extend(["--methods", "mac-iac", "--set", "TB_move_speed=0.6"]);
         }
-        args.extend(["--out", s(&results)]);
-        let err = refused(&macdec(&args));
+        let err = train_refused(&results, &args);
         let key = if key.is_empty() {
             "`TB_move_speed`"
         } else {
@@ -518,7 +508,6 @@ fn no_key_is_dropped_a_set_with_a_line_break_nor_a_key_the_domain_does_not_read(
         };
         assert!(err.contains(key) && err.contains("leave it out"), "{err}");
     }
-    assert!(!results.exists(), "no run may start");
 }
 
 #[test]
@@ -559,15 +548,7 @@ fn an_unknown_key_is_hinted_from_the_methods_own_family() {
     let results = dir.path().join("results");
     // An ICRA key given to an actor-critic method, and the other way round: the hint names the
     // family the key belongs to and the method's own keys, never the other family's.
-    let err = refused(&macdec(&[
-        "train",
-        "--methods",
-        "mac-iac",
-        "--set",
-        "l_rate=0.01",
-        "--out",
-        s(&results),
-    ]));
+    let err = train_refused(&results, &["--methods", "mac-iac", "--set", "l_rate=0.01"]);
     assert!(
         err.contains("unknown key `l_rate` for mac-iac")
             && err.contains("is a key of the ICRA 2020")
@@ -575,15 +556,7 @@ fn an_unknown_key_is_hinted_from_the_methods_own_family() {
             && !err.contains("replay_buffer_size"),
         "{err}"
     );
-    let err = refused(&macdec(&[
-        "train",
-        "--methods",
-        "our1",
-        "--set",
-        "a_lr=0.01",
-        "--out",
-        s(&results),
-    ]));
+    let err = train_refused(&results, &["--methods", "our1", "--set", "a_lr=0.01"]);
     assert!(
         err.contains("`a_lr` is a key of MacroMARL's")
             && err.contains("our1 takes the keys of the ICRA 2020")
@@ -591,20 +564,11 @@ fn an_unknown_key_is_hinted_from_the_methods_own_family() {
         "{err}"
     );
     // A typo of the family's own key.
-    let err = refused(&macdec(&[
-        "train",
-        "--methods",
-        "mac-iac",
-        "--set",
-        "a_lrr=0.01",
-        "--out",
-        s(&results),
-    ]));
+    let err = train_refused(&results, &["--methods", "mac-iac", "--set", "a_lrr=0.01"]);
     assert!(
         err.contains("did you mean `a_lr`?") && !err.contains("is a key of"),
         "{err}"
     );
-    assert!(!results.exists(), "no run may start");
 }
 
 #[test]
@@ -646,14 +610,12 @@ fn a_run_that_could_not_update_is_refused_never_called_finished() {
             "`start_train`: must be below total_epi (40)",
         ),
     ] {
-        let mut args = vec!["train", "--methods", method, "--seeds", "0"];
+        let mut args = vec!["--methods", method, "--seeds", "0"];
         for set in sets {
             args.extend(["--set", set]);
         }
-        args.extend(["--out", s(&results)]);
-        let err = refused(&macdec(&args));
+        let err = train_refused(&results, &args);
         assert!(err.contains(key), "{method} {sets:?}: {err}");
-        assert!(!results.exists(), "no run may start");
     }
     // Not certain from the config (episodes ended early): the run trains its budget, then
     // fails naming why instead of "finishing" with its initial nets and exit status 0.
