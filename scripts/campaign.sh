@@ -20,6 +20,9 @@
 #                                 # reproduction/acac: Box Pushing 6, 8, 10 at 5 seeds, then
 #                                 # Overcooked A, B, C and their random-start variants one seed
 #                                 # at a time, at ACAC's budgets
+#   scripts/campaign.sh acac-baselines # ACAC's Mac-IAICC / Naive Mac-IACC baselines (issue 42
+#                                 # item 5) into reproduction/acac_baselines: Box Pushing under
+#                                 # every assumption, then Overcooked A, B, C under ACAC's keys
 #   scripts/campaign.sh collect   # gzip each finished run's metrics and stage it (and each
 #                                 # experiment's shared_curves.toml) for a commit
 #   scripts/campaign.sh status    # finished seeds per curve
@@ -108,6 +111,27 @@ acac_lane() {
     done
 }
 
+train_acac_baselines() {
+    "$MACDEC" train --config "experiments/acac_baselines/$1.toml" --out "$OUT/acac_baselines" \
+        --jobs 1 --quiet --no-plot "${@:2}"
+}
+
+acac_baselines_lane() {
+    set -e
+    # Box Pushing: every assumption, seconds a run (all committed; skipped when finished).
+    for grid in 6 8 10; do
+        for assumed in "" _state _acac_keys _state_acac_keys; do
+            train_acac_baselines "bp$grid$assumed"
+        done
+    done
+    # Overcooked under ACAC's keys (about half an hour a run): every map's seed k before k + 1.
+    for seed in 0 1 2 3 4; do
+        for map in A B C; do
+            train_acac_baselines "ovc${map}7_acac_keys" --seeds "$seed"
+        done
+    done
+}
+
 lanes() {
     pids=()
     for _ in $(seq "$JOBS"); do
@@ -151,6 +175,9 @@ macromarl-value)
 acac)
     lanes acac_lane
     ;;
+acac-baselines)
+    lanes acac_baselines_lane
+    ;;
 collect)
     find "$OUT" -name finished -type f | sort | while read -r marker; do
         dir=$(dirname "$marker")
@@ -165,14 +192,16 @@ collect)
     ;;
 status)
     # Curves are <experiment>/<curve>/ and, for MacroMARL, macromarl/<block>/<method>/ and
-    # macromarl_value/<block>/<method>/, and acac/<env>/<method>/ for ACAC.
-    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/ "$OUT"/macromarl_value/*/*/ "$OUT"/acac/*/*/; do
+    # macromarl_value/<block>/<method>/, acac/<env>/<method>/ for ACAC and
+    # acac_baselines/<experiment>/<method>/.
+    for curve in "$OUT"/*/*/ "$OUT"/macromarl/*/*/ "$OUT"/macromarl_value/*/*/ "$OUT"/acac/*/*/ \
+        "$OUT"/acac_baselines/*/*/; do
         n=$(find "$curve" -mindepth 2 -maxdepth 2 -name finished | wc -l)
         [[ $n -gt 0 ]] && echo "${curve#"$OUT"/}: $n finished"
     done
     ;;
 *)
-    echo "usage: $0 run|macromarl|macromarl-rest|macromarl-value|acac|collect|status" >&2
+    echo "usage: $0 run|macromarl|macromarl-rest|macromarl-value|acac|acac-baselines|collect|status" >&2
     exit 2
     ;;
 esac
