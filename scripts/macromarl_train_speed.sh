@@ -13,10 +13,12 @@
 # row per run: setting, side, seed, episodes, cpu_s, wall_s. Settings (default: all) are the
 # published rows of experiments/{BoxPushing,Warehouse,Overcooked}/mac_*.sh, verbatim but for
 # --total_epi, with an explicit --seed. ROUNDS (default 1) reference runs per setting, each between
-# two of ours. Optional tool: tests and CI never run it.
+# OURS (default 1) runs of ours in a row; ROUNDS=0 times ours alone. Optional tool: tests and CI
+# never run it.
 set -euo pipefail
 MM=$1; OC=$2; CSV=$3; shift 3
 PY=${PY:-python3}; MACDEC=${MACDEC:-target/release/macdec}; ROUNDS=${ROUNDS:-1}; SEED=${SEED:-1}
+OURS=${OURS:-1}
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 cd "$(dirname "$0")/.."
@@ -57,10 +59,12 @@ timed() { # side name seed episodes command...
         "$(awk "BEGIN { print $user + $sys }")" "$wall" | tee -a "$CSV"
 }
 
-ours() { # name episodes config flags
-    # shellcheck disable=SC2086
-    timed macdec "$1" "$SEED" "$2" "$MACDEC" train --config "$3" $4 --set "total_epi=$2" \
-        --seeds "$SEED" --out "$TMP/ours" --jobs 1 --quiet --no-plot --force
+ours() { # name episodes config flags; OURS runs in a row
+    for _ in $(seq "$OURS"); do
+        # shellcheck disable=SC2086
+        timed macdec "$1" "$SEED" "$2" "$MACDEC" train --config "$3" $4 --set "total_epi=$2" \
+            --seeds "$SEED" --out "$TMP/ours" --jobs 1 --quiet --no-plot --force
+    done
 }
 
 settings | while IFS='|' read -r name episodes config our_flags ref_flags; do
