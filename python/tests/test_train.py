@@ -164,7 +164,12 @@ def test_ctrl_c_stops_cleanly_and_training_again_resumes_to_the_same_metrics(tmp
     config.write_text(TINY.replace("total_epi = 60", "total_epi = 3000").replace('seeds = "0..2"', 'seeds = "0"')
                       .replace('methods = ["dec-hddrqn", "our1"]', 'methods = ["our1"]'))
     run_cli("train", "--config", config, "--out", tmp_path / "whole", "--quiet", "--no-plot")
+    # Python leaves SIGINT ignored when it started ignored (a background job of a non-interactive
+    # shell, as CI may be launched): restore Ctrl-C's KeyboardInterrupt so the test sees macdec's
+    # handling, not its launcher's.
     script = textwrap.dedent(f"""
+        import signal
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         import macdec
         try:
             macdec.train({str(config)!r}, out={str(tmp_path / "py")!r})
