@@ -36,6 +36,8 @@ OC_COMMON=$(echo $OC_COMMON)
 WH=$(echo $WH)
 
 # name | episodes | our experiment file | our extra flags | the reference's flags
+# (The reference's Overcooked `--n_agent=3` never reaches its environment, which trains 2 agents:
+# the 3-agent row times ours with the paper's 3 against a second run of the 2-agent command.)
 settings() {
     cat <<EOF
 oc_a_mac_iaicc_2agents|400|experiments/macromarl/overcooked_a.toml|--methods mac-iaicc --set n_agent=2|--save_dir=iaicc_overcooked_A --alg=MacIAICC --l_mode=0 --a_lr=0.0003 $OC_COMMON
