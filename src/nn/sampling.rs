@@ -28,12 +28,15 @@ pub fn sample_weighted(weights: &[f64], rng: &mut ChaCha8Rng) -> usize {
 pub fn mixture(logp: &[f32], eps: Option<f64>, out: &mut Vec<f64>) {
     out.clear();
     let n = logp.len() as f64;
+    out.extend(logp.iter().map(|&l| mixture_weight(l, eps, n)));
+}
+
+/// One entry of [`mixture`]: (1 - eps) exp(l) + eps / n, or exp(l) without exploration.
+#[inline]
+fn mixture_weight(l: f32, eps: Option<f64>, n: f64) -> f64 {
     match eps {
-        Some(eps) => out.extend(
-            logp.iter()
-                .map(|&l| (1.0 - eps) * f64::from(l).exp() + eps / n),
-        ),
-        None => out.extend(logp.iter().map(|&l| f64::from(l).exp())),
+        Some(eps) => (1.0 - eps) * f64::from(l).exp() + eps / n,
+        None => f64::from(l).exp(),
     }
 }
 
@@ -61,19 +64,48 @@ pub fn conditioned_joint(
     probs: &mut Vec<f64>,
     actions: &mut [usize],
 ) {
-    mixture(logp, eps, probs);
-    for (j, p) in probs.iter_mut().enumerate() {
-        if !keeps_busy_agents(j, free, running, n_actions) {
-            *p = 0.0;
-        }
-    }
-    let mut j = match pick {
-        Pick::Sample(rng) => sample_weighted(probs, rng),
+    debug_assert_eq!(logp.len(), n_actions.iter().product::<usize>());
+    let rng = match pick {
+        Pick::Sample(rng) => rng,
         Pick::MostProbable => return conditioned_argmax(logp, free, running, n_actions, actions),
     };
+    // The mixture of the allowed entries only, the rest zero: with one agent free of three,
+    // most joint macro-actions are not allowed, and their exponentials were most of acting.
+    let n = logp.len() as f64;
+    probs.clear();
+    probs.resize(logp.len(), 0.0);
+    visit_allowed(0, 0, free, running, n_actions, &mut |j| {
+        probs[j] = mixture_weight(logp[j], eps, n);
+    });
+    let mut j = sample_weighted(probs, rng);
     for i in (0..n_actions.len()).rev() {
         actions[i] = j % n_actions[i];
         j /= n_actions[i];
+    }
+}
+
+/// Calls `f` on every joint macro-action index (C order, agent 0 most significant) that keeps
+/// every busy agent's running macro-action, in increasing order: agents `i..` vary under the
+/// index `prefix` of agents `..i`. None when a busy agent's `running[i]` is out of range (as
+/// [`keeps_busy_agents`] decides).
+fn visit_allowed(
+    i: usize,
+    prefix: usize,
+    free: &[bool],
+    running: &[usize],
+    n_actions: &[usize],
+    f: &mut impl FnMut(usize),
+) {
+    let Some(&n) = n_actions.get(i) else {
+        f(prefix);
+        return;
+    };
+    if free[i] {
+        for a in 0..n {
+            visit_allowed(i + 1, prefix * n + a, free, running, n_actions, f);
+        }
+    } else if running[i] < n {
+        visit_allowed(i + 1, prefix * n + running[i], free, running, n_actions, f);
     }
 }
 
@@ -176,6 +208,80 @@ mod tests {
                 &mut actions,
             );
             assert_eq!(actions[0], 0);
+        }
+    }
+
+    /// The whole mixture, then every joint macro-action that changes a busy agent's running
+    /// one zeroed: what `conditioned_joint` computed before it visited only the allowed ones.
+    fn masked_mixture(
+        logp: &[f32],
+        eps: Option<f64>,
+        free: &[bool],
+        running: &[usize],
+        n_actions: &[usize],
+    ) -> Vec<f64> {
+        let mut p = Vec::new();
+        mixture(logp, eps, &mut p);
+        for (j, w) in p.iter_mut().enumerate() {
+            if !keeps_busy_agents(j, free, running, n_actions) {
+                *w = 0.0;
+            }
+        }
+        p
+    }
+
+    #[test]
+    fn the_joint_draw_equals_the_masked_whole_mixture_bit_for_bit() {
+        let mut gen = ChaCha8Rng::seed_from_u64(11);
+        for case in 0..3000 {
+            let agents = gen.gen_range(1..=4);
+            let n_actions: Vec<usize> = (0..agents).map(|_| gen.gen_range(1..=5)).collect();
+            let free: Vec<bool> = (0..agents).map(|_| gen.gen_bool(0.5)).collect();
+            // Now and then a running macro-action out of range: nothing is allowed then.
+            let running: Vec<usize> = n_actions
+                .iter()
+                .map(|&n| gen.gen_range(0..n + usize::from(case % 50 == 0)))
+                .collect();
+            let total: usize = n_actions.iter().product();
+            let logp: Vec<f32> = (0..total)
+                .map(|_| match gen.gen_range(0..20) {
+                    0 => f32::NEG_INFINITY,
+                    1 => f32::NAN,
+                    2 => -200.0,
+                    _ => -gen.gen::<f32>() * 6.0,
+                })
+                .collect();
+            let eps = [None, Some(0.0), Some(0.3), Some(1.0)][case % 4];
+            let want_probs = masked_mixture(&logp, eps, &free, &running, &n_actions);
+            let (mut a, mut b) = (
+                ChaCha8Rng::seed_from_u64(case as u64),
+                ChaCha8Rng::seed_from_u64(case as u64),
+            );
+            let mut j = sample_weighted(&want_probs, &mut a);
+            let mut want = vec![0; agents];
+            for i in (0..agents).rev() {
+                want[i] = j % n_actions[i];
+                j /= n_actions[i];
+            }
+            let (mut probs, mut got) = (vec![7.0], vec![9; agents]);
+            conditioned_joint(
+                &logp,
+                eps,
+                &free,
+                &running,
+                &n_actions,
+                Pick::Sample(&mut b),
+                &mut probs,
+                &mut got,
+            );
+            assert_eq!(got, want, "case {case}");
+            let bits = |p: &[f64]| p.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&probs), bits(&want_probs), "case {case}");
+            assert_eq!(
+                a.gen::<u64>(),
+                b.gen::<u64>(),
+                "case {case}: the streams diverged"
+            );
         }
     }
 
