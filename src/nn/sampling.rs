@@ -52,7 +52,9 @@ pub enum Pick<'a> {
 /// centralized actor's log-probabilities `logp` under `eps` ([`mixture`], into `probs`), zeroed
 /// for every joint macro-action in which a busy agent's part differs from its running
 /// macro-action (`running[i]` where `!free[i]`), then picked by `pick` and unravelled in C order
-/// (agent 0 most significant) into `actions`.
+/// (agent 0 most significant) into `actions`. `logp` has one entry per joint macro-action (the
+/// product of `n_actions`, as a policy's manifest checks). `Pick::MostProbable` is
+/// [`conditioned_argmax`] of `logp` and leaves `probs` alone.
 #[allow(clippy::too_many_arguments)]
 pub fn conditioned_joint(
     logp: &[f32],
