@@ -18,8 +18,8 @@
 #                                 # Warehouse A, B, C
 #   scripts/campaign.sh acac      # ACAC's own method on its settings (issue 41) into
 #                                 # reproduction/acac: Box Pushing 6, 8, 10 at 5 seeds, then
-#                                 # Overcooked A, B, C and their random-start variants one seed
-#                                 # at a time, at ACAC's budgets
+#                                 # Overcooked A, B, C one seed at a time, then their random-start
+#                                 # variants, at ACAC's budgets (a run left with a checkpoint first)
 #   scripts/campaign.sh acac-baselines # ACAC's Mac-IAICC / Naive Mac-IACC baselines (issue 42
 #                                 # item 5) into reproduction/acac_baselines: Box Pushing under
 #                                 # every assumption, then Overcooked A, B, C under ACAC's keys
@@ -103,16 +103,33 @@ train_acac() {
         --jobs 1 --quiet --no-plot "${@:2}"
 }
 
+# ACAC's Overcooked runs in campaign order, one "<env> <seed>" a line: the fixed-start maps
+# (20M primitive steps, about 100-110 minutes of a core) at every seed, then the random-start
+# maps (40M: longer than a session, so they finish only on a machine that outlives one).
+acac_overcooked_runs() {
+    for envs in "ovcA7 ovcB7 ovcC7" "ovcAR7 ovcBR7 ovcCR7"; do
+        for seed in 0 1 2 3 4; do
+            for env in $envs; do
+                echo "$env $seed"
+            done
+        done
+    done
+}
+
 acac_lane() {
     set -e
     for env in bp6 bp8 bp10; do
         train_acac "$env" --seeds 0..5
     done
-    # Overcooked (20M to 40M primitive steps a run): every setting's seed k before seed k + 1.
-    for seed in 0 1 2 3 4; do
-        for env in ovcA7 ovcB7 ovcC7 ovcAR7 ovcBR7 ovcCR7; do
-            train_acac "$env" --seeds "$seed"
-        done
+    # A run a previous session left with a checkpoint (the machine outlived it) goes first.
+    acac_overcooked_runs | while read -r env seed; do
+        dir="$OUT/acac/$env/acac/seed-$seed"
+        if [[ -f $dir/checkpoint.bin && ! -f $dir/finished ]]; then
+            train_acac "$env" --seeds "$seed" </dev/null
+        fi
+    done
+    acac_overcooked_runs | while read -r env seed; do
+        train_acac "$env" --seeds "$seed" </dev/null
     done
 }
 
