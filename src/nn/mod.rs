@@ -34,6 +34,7 @@ mod gpt2_dropout;
 mod gru;
 mod gru_actor;
 pub mod init;
+pub mod joint_index;
 mod layer_norm;
 mod linear;
 pub mod loss;

@@ -5,6 +5,9 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+use super::argmax::FirstArgmax;
+use super::joint_index::{for_each_allowed, unravel};
+
 /// Sample index a from weights p_a (not necessarily normalized; zero weights never drawn).
 pub fn sample_weighted(weights: &[f64], rng: &mut ChaCha8Rng) -> usize {
     let total: f64 = weights.iter().sum();
@@ -76,52 +79,15 @@ pub fn conditioned_joint(
     let n = logp.len() as f64;
     probs.clear();
     probs.resize(logp.len(), 0.0);
-    visit_allowed(0, 0, free, running, n_actions, &mut |j| {
+    for_each_allowed(n_actions, busy_part(free, running), None, &mut |j| {
         probs[j] = mixture_weight(logp[j], eps, n);
     });
-    let mut j = sample_weighted(probs, rng);
-    for i in (0..n_actions.len()).rev() {
-        actions[i] = j % n_actions[i];
-        j /= n_actions[i];
-    }
+    unravel(sample_weighted(probs, rng), n_actions, actions);
 }
 
-/// Calls `f` on every joint macro-action index (C order, agent 0 most significant) that keeps
-/// every busy agent's running macro-action, in increasing order: agents `i..` vary under the
-/// index `prefix` of agents `..i`. None when a busy agent's `running[i]` is out of range (as
-/// [`keeps_busy_agents`] decides).
-fn visit_allowed(
-    i: usize,
-    prefix: usize,
-    free: &[bool],
-    running: &[usize],
-    n_actions: &[usize],
-    f: &mut impl FnMut(usize),
-) {
-    let Some(&n) = n_actions.get(i) else {
-        f(prefix);
-        return;
-    };
-    if free[i] {
-        for a in 0..n {
-            visit_allowed(i + 1, prefix * n + a, free, running, n_actions, f);
-        }
-    } else if running[i] < n {
-        visit_allowed(i + 1, prefix * n + running[i], free, running, n_actions, f);
-    }
-}
-
-/// Whether joint macro-action `joint` (C order, agent 0 most significant) keeps every busy
-/// agent's running macro-action (`running[i]` where `!free[i]`).
-fn keeps_busy_agents(joint: usize, free: &[bool], running: &[usize], n_actions: &[usize]) -> bool {
-    let mut rest = joint;
-    for i in (0..n_actions.len()).rev() {
-        if !free[i] && rest % n_actions[i] != running[i] {
-            return false;
-        }
-        rest /= n_actions[i];
-    }
-    true
+/// The part [`for_each_allowed`] fixes for agent `i`: its running macro-action while it is busy.
+fn busy_part<'a>(free: &'a [bool], running: &'a [usize]) -> impl Fn(usize) -> Option<usize> + 'a {
+    |i| (!free[i]).then_some(running[i])
 }
 
 /// The greedy joint macro-action of a centralized net's `scores` (Q-values or an actor's
@@ -139,13 +105,12 @@ pub fn conditioned_argmax(
     n_actions: &[usize],
     actions: &mut [usize],
 ) {
-    let allowed = (0..scores.len()).filter(|&j| keeps_busy_agents(j, free, running, n_actions));
-    let Some(mut j) = super::argmax::first_argmax(allowed.map(|j| (j, scores[j]))) else {
-        return;
-    };
-    for i in (0..n_actions.len()).rev() {
-        actions[i] = j % n_actions[i];
-        j /= n_actions[i];
+    let mut best = FirstArgmax::default();
+    for_each_allowed(n_actions, busy_part(free, running), None, &mut |j| {
+        best.offer(j, scores[j]);
+    });
+    if let Some(j) = best.index() {
+        unravel(j, n_actions, actions);
     }
 }
 
@@ -232,6 +197,19 @@ mod tests {
         p
     }
 
+    /// The definition: joint macro-action `joint` leaves every busy agent's part at its running
+    /// macro-action.
+    fn keeps_busy_agents(
+        joint: usize,
+        free: &[bool],
+        running: &[usize],
+        n_actions: &[usize],
+    ) -> bool {
+        let mut parts = vec![0; n_actions.len()];
+        unravel(joint, n_actions, &mut parts);
+        (0..parts.len()).all(|i| free[i] || parts[i] == running[i])
+    }
+
     #[test]
     fn the_joint_draw_equals_the_masked_whole_mixture_bit_for_bit() {
         let mut gen = ChaCha8Rng::seed_from_u64(11);
@@ -259,12 +237,8 @@ mod tests {
                 ChaCha8Rng::seed_from_u64(case as u64),
                 ChaCha8Rng::seed_from_u64(case as u64),
             );
-            let mut j = sample_weighted(&want_probs, &mut a);
             let mut want = vec![0; agents];
-            for i in (0..agents).rev() {
-                want[i] = j % n_actions[i];
-                j /= n_actions[i];
-            }
+            unravel(sample_weighted(&want_probs, &mut a), &n_actions, &mut want);
             let (mut probs, mut got) = (vec![7.0], vec![9; agents]);
             conditioned_joint(
                 &logp,
@@ -284,6 +258,28 @@ mod tests {
                 b.gen::<u64>(),
                 "case {case}: the streams diverged"
             );
+            // Greedy: the first largest allowed score (a NaN never winning), else untouched.
+            let best = crate::nn::argmax::first_argmax(
+                (0..total)
+                    .filter(|&j| keeps_busy_agents(j, &free, &running, &n_actions))
+                    .map(|j| (j, logp[j])),
+            );
+            let mut want = vec![9; agents];
+            if let Some(j) = best {
+                unravel(j, &n_actions, &mut want);
+            }
+            let mut got = vec![9; agents];
+            conditioned_joint(
+                &logp,
+                eps,
+                &free,
+                &running,
+                &n_actions,
+                Pick::MostProbable,
+                &mut probs,
+                &mut got,
+            );
+            assert_eq!(got, want, "case {case}: greedy");
         }
     }
 

@@ -9,8 +9,9 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::episode::{all_available, joint_obs};
-use super::update::{conditional_argmax, for_each_allowed_joint, masked_argmax, Dims, QNet};
+use super::update::{conditional_argmax, masked_argmax, Dims, QNet};
 use crate::envs::MacroEnv;
+use crate::nn::joint_index::{for_each_allowed, unravel};
 use crate::nn::GruActorState;
 
 /// Exploration while training: epsilon and its random stream.
@@ -84,9 +85,11 @@ pub fn act_cen<E: MacroEnv>(
             // Uniform over every available joint macro-action, not conditioned (the reference's
             // exploration; the env then ignores the busy agents' components).
             let mut joint_avail = vec![0.0f32; dims.n_joint()];
-            for_each_allowed_joint(dims, &vec![None; n], &avail, &mut |j| joint_avail[j] = 1.0);
+            for_each_allowed(&dims.n_actions, |_| None, Some(&avail), &mut |j| {
+                joint_avail[j] = 1.0
+            });
             joint = random_available(&joint_avail, e.rng);
         }
     }
-    actions.copy_from_slice(&dims.unravel(joint));
+    unravel(joint, &dims.n_actions, actions);
 }

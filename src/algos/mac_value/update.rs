@@ -34,6 +34,7 @@ use super::episode::Step;
 use super::prefetch::prefetch_batch;
 use crate::autograd::{SeqPacking, Tape, Var};
 use crate::nn::argmax::{first_argmax, FirstArgmax};
+use crate::nn::joint_index::{for_each_allowed, ravel, unravel_component};
 use crate::nn::loss::hysteretic_td_loss;
 use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig};
 
@@ -89,24 +90,6 @@ impl Dims {
     pub fn n_joint(&self) -> usize {
         self.n_actions.iter().product()
     }
-
-    /// The C-order index of a joint macro-action (`np.ravel_multi_index`).
-    pub fn ravel(&self, actions: &[usize]) -> usize {
-        actions
-            .iter()
-            .zip(&self.n_actions)
-            .fold(0, |acc, (&a, &n)| acc * n + a)
-    }
-
-    /// Each agent's macro-action of joint index `j` (`np.unravel_index`).
-    pub fn unravel(&self, mut j: usize) -> Vec<usize> {
-        let mut out = vec![0; self.n_actions.len()];
-        for (slot, &n) in out.iter_mut().zip(&self.n_actions).rev() {
-            *slot = j % n;
-            j /= n;
-        }
-        out
-    }
 }
 
 /// The joint macro-action maximizing `q` among those whose every component is available in
@@ -132,16 +115,22 @@ pub fn conditional_argmax(
     let n = dims.n_actions[last];
     let mask = &avail[dims.action_range(last)];
     let mut best = FirstArgmax::default();
-    for_each_allowed_prefix(dims, last, running, avail, &mut |prefix| {
-        let block = &q[prefix * n..(prefix + 1) * n];
-        let winner = match running[last] {
-            Some(r) => (r < n && mask[r] != 0.0).then_some(r),
-            None => block_argmax(block, mask),
-        };
-        if let Some(a) = winner {
-            best.offer(prefix * n + a, block[a]);
-        }
-    });
+    // Every allowed choice of the agents before the last, then the last one's block at once.
+    for_each_allowed(
+        &dims.n_actions[..last],
+        |i| running[i],
+        Some(avail),
+        &mut |prefix| {
+            let block = &q[prefix * n..(prefix + 1) * n];
+            let winner = match running[last] {
+                Some(r) => (r < n && mask[r] != 0.0).then_some(r),
+                None => block_argmax(block, mask),
+            };
+            if let Some(a) = winner {
+                best.offer(prefix * n + a, block[a]);
+            }
+        },
+    );
     best.index().unwrap_or(0)
 }
 
@@ -161,60 +150,6 @@ fn block_argmax(q: &[f32], mask: &[f32]) -> Option<usize> {
     q.iter()
         .zip(mask)
         .position(|(&v, &ok)| ok != 0.0 && v == top)
-}
-
-/// Calls `f` with every joint macro-action index whose every component is available in `avail`
-/// and equals `running[i]` where that is `Some`, in increasing order. The allowed joint actions
-/// are the product of each agent's allowed actions, visited in C order (agent 0 most
-/// significant), which is increasing index order; nothing else is visited or allocated.
-pub fn for_each_allowed_joint(
-    dims: &Dims,
-    running: &[Option<usize>],
-    avail: &[f32],
-    f: &mut impl FnMut(usize),
-) {
-    for_each_allowed_prefix(dims, dims.n_actions.len(), running, avail, f);
-}
-
-/// [`for_each_allowed_joint`] over the first `depth` agents only: `f` gets the C-order index of
-/// each allowed choice of their components, in increasing order (0 once for depth 0).
-fn for_each_allowed_prefix(
-    dims: &Dims,
-    depth: usize,
-    running: &[Option<usize>],
-    avail: &[f32],
-    f: &mut impl FnMut(usize),
-) {
-    /// Agent `i` on, its mask at avail[lo..], the components before it giving `prefix`.
-    fn visit(
-        n_actions: &[usize],
-        running: &[Option<usize>],
-        avail: &[f32],
-        (i, lo, prefix): (usize, usize, usize),
-        f: &mut impl FnMut(usize),
-    ) {
-        if i == n_actions.len() {
-            f(prefix);
-            return;
-        }
-        let n = n_actions[i];
-        let actions = match running[i] {
-            Some(r) => r..(r + 1).min(n),
-            None => 0..n,
-        };
-        for a in actions {
-            if avail[lo + a] != 0.0 {
-                visit(
-                    n_actions,
-                    running,
-                    avail,
-                    (i + 1, lo + n, prefix * n + a),
-                    f,
-                );
-            }
-        }
-    }
-    visit(&dims.n_actions[..depth], running, avail, (0, 0, 0), f);
 }
 
 /// Appends to `running` each agent's macro-action in `r` where it did not end there (it keeps
@@ -334,7 +269,13 @@ impl Squeezed {
             dims.obs_sizes.iter().sum(),
             Step::any_valid,
             |o| o,
-            |r| (dims.ravel(&r.actions), r.joint_reward, r.joint_gamma),
+            |r| {
+                (
+                    ravel(&r.actions, &dims.n_actions),
+                    r.joint_reward,
+                    r.joint_gamma,
+                )
+            },
             |r| &r.next_avail,
         );
         s.running.reserve(records.len() * dims.n_actions.len());
@@ -716,7 +657,7 @@ pub fn update_dec_cen(
                 .iter()
                 .zip(&joint_next)
                 .filter(|(r, _)| r.valid[i])
-                .map(|(_, &j)| dims.unravel(j)[i])
+                .map(|(_, &j)| unravel_component(j, &dims.n_actions, i))
                 .collect();
             td_step(q, s, |k, _| a_next[k], hysteresis, discount, scratch)
         })
@@ -734,8 +675,6 @@ mod tests {
             obs_sizes: vec![1, 1],
             n_actions: vec![2, 3],
         };
-        assert_eq!(dims.ravel(&[1, 2]), 5);
-        assert_eq!(dims.unravel(4), [1, 1]);
         let q = [0.0, 9.0, 1.0, 2.0, 3.0, 8.0];
         let all = [1.0; 5];
         assert_eq!(conditional_argmax(&q, &[None, None], &all, &dims), 1);
@@ -776,9 +715,12 @@ mod tests {
                 .collect();
             // The definition: every joint index, filtered, in order.
             let allowed = |j: usize| {
-                dims.unravel(j).iter().enumerate().all(|(i, &a)| {
-                    avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
-                })
+                (0..3)
+                    .map(|i| unravel_component(j, &dims.n_actions, i))
+                    .enumerate()
+                    .all(|(i, a)| {
+                        avail[dims.action_range(i)][a] != 0.0 && running[i].is_none_or(|r| r == a)
+                    })
             };
             let want = first_argmax(q.iter().copied().enumerate().filter(|&(j, _)| allowed(j)))
                 .unwrap_or(0);

@@ -1,8 +1,9 @@
 //! Choosing macro-actions: decentralized and centralized epsilon-greedy (`docs/ALGORITHMS.md` §4.2,
 //! 4.3), and the greedy policies evaluation and deployment run (epsilon = 0, state carried).
 
-use crate::algos::value::cond_argmax::{cond_argmax, unravel};
+use crate::algos::value::cond_argmax::cond_argmax;
 use crate::envs::MacroEnv;
+use crate::nn::joint_index::unravel;
 use crate::nn::{LstmState, QNet};
 use ndarray::ArrayView1;
 use rand::Rng;

@@ -1,13 +1,15 @@
-//! Joint-action indexing and the conditional argmax of the centralized Q-net (spec
-//! `algorithms.md` 2.1 and 4.5).
+//! The conditional argmax of the centralized Q-net (spec `algorithms.md` 2.1 and 4.5).
 //!
-//! Joint index = C-order ravel of `(m_0, .., m_{N-1})`, agent 0 most significant:
-//! `idx = ((m_0 * n_1) + m_1) * n_2 + m_2`. The conditional argmax maximises only over the joint
+//! Joint index = C-order ravel of `(m_0, .., m_{N-1})`, agent 0 most significant
+//! ([`crate::nn::joint_index`]): `idx = ((m_0 * n_1) + m_1) * n_2 + m_2`. The conditional argmax maximises only over the joint
 //! actions whose busy agents' components equal their running macro-actions (`c_i >= 0`), free
 //! agents (`c_i = -1`) ranging over all their actions; ties go to the first maximal flat index in
 //! C-order (quirk Q14). Only allowed combinations are visited.
 
 use ndarray::{ArrayView1, ArrayView2};
+
+use crate::nn::argmax::FirstArgmax;
+use crate::nn::joint_index::for_each_allowed;
 
 /// Why a conditional argmax was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -53,32 +55,6 @@ pub enum CondArgmaxError {
     NoAgents,
 }
 
-/// C-order joint index of `actions` (agent 0 most significant). Panics (debug) if an action is
-/// out of range or the lengths differ.
-pub fn ravel(actions: &[usize], n_actions: &[usize]) -> usize {
-    debug_assert_eq!(actions.len(), n_actions.len());
-    actions.iter().zip(n_actions).fold(0, |idx, (&a, &n)| {
-        debug_assert!(a < n, "action {a} out of range 0..{n}");
-        idx * n + a
-    })
-}
-
-/// Inverse of [`ravel`]: writes each agent's action of joint index `index` into `out` \[N\].
-pub fn unravel(index: usize, n_actions: &[usize], out: &mut [usize]) {
-    debug_assert_eq!(out.len(), n_actions.len());
-    let mut rest = index;
-    for (slot, &n) in out.iter_mut().zip(n_actions).rev() {
-        *slot = rest % n;
-        rest /= n;
-    }
-}
-
-/// Agent `agent`'s component of joint index `index` (what Our-1 Step C needs, `docs/ALGORITHMS.md` §5.3).
-pub fn unravel_component(index: usize, n_actions: &[usize], agent: usize) -> usize {
-    let stride: usize = n_actions[agent + 1..].iter().product();
-    (index / stride) % n_actions[agent]
-}
-
 /// The conditional argmax of one joint Q vector `q` \[A\] under `cond` \[N\] (-1 = free).
 ///
 /// Among allowed joint actions, returns the first (in C-order) maximal one; NaN entries never win
@@ -119,26 +95,10 @@ pub fn cond_argmax_rows(
             n_agents,
         });
     }
-    // strides[i] = prod_{j > i} n_j
-    let mut strides = vec![1usize; n_agents];
-    for i in (0..n_agents - 1).rev() {
-        strides[i] = strides[i + 1] * n_actions[i + 1];
-    }
     let mut out = Vec::with_capacity(rows);
-    // Free agents of the current row as (n_i, stride_i), most significant first; odometer digits.
-    let mut free: Vec<(usize, usize)> = Vec::with_capacity(n_agents);
-    let mut digits = vec![0usize; n_agents];
     for (row, (q_row, c)) in q.outer_iter().zip(cond.chunks(n_agents)).enumerate() {
-        free.clear();
-        let mut base = 0;
-        for (agent, (&ci, (&n, &stride))) in
-            c.iter().zip(n_actions.iter().zip(&strides)).enumerate()
-        {
-            if ci == -1 {
-                free.push((n, stride));
-            } else if ci >= 0 && (ci as usize) < n {
-                base += ci as usize * stride;
-            } else {
+        for (agent, (&ci, &n)) in c.iter().zip(n_actions).enumerate() {
+            if ci != -1 && usize::try_from(ci).map_or(true, |c| c >= n) {
                 return Err(CondArgmaxError::BadCondition {
                     row,
                     agent,
@@ -147,66 +107,14 @@ pub fn cond_argmax_rows(
                 });
             }
         }
-        let best = if free.len() == n_agents {
-            first_argmax(q_row.iter().copied().enumerate())
-        } else {
-            first_argmax(
-                AllowedIndices::new(base, &free, &mut digits[..free.len()])
-                    .map(|idx| (idx, q_row[idx])),
-            )
-        };
-        out.push(best);
+        let mut best = FirstArgmax::default();
+        let fixed = |i: usize| usize::try_from(c[i]).ok();
+        for_each_allowed(n_actions, fixed, None, &mut |idx| {
+            best.offer(idx, q_row[idx])
+        });
+        out.push(best.index().expect("at least one allowed joint action"));
     }
     Ok(out)
-}
-
-/// First index of the maximal value (strict `>`, so ties keep the earliest; NaN never wins):
-/// the crate's one rule, [`crate::nn::argmax::first_argmax`].
-fn first_argmax(items: impl Iterator<Item = (usize, f32)>) -> usize {
-    crate::nn::argmax::first_argmax(items).expect("at least one allowed joint action")
-}
-
-/// The allowed joint indices in increasing (C-order) order: an odometer over the free agents, the
-/// least significant free agent turning fastest.
-struct AllowedIndices<'a> {
-    next: Option<usize>,
-    free: &'a [(usize, usize)],
-    digits: &'a mut [usize],
-}
-
-impl<'a> AllowedIndices<'a> {
-    fn new(base: usize, free: &'a [(usize, usize)], digits: &'a mut [usize]) -> Self {
-        digits.fill(0);
-        Self {
-            next: Some(base),
-            free,
-            digits,
-        }
-    }
-}
-
-impl Iterator for AllowedIndices<'_> {
-    type Item = usize;
-    fn next(&mut self) -> Option<usize> {
-        let current = self.next?;
-        // advance the odometer
-        let mut idx = current;
-        let mut k = self.free.len();
-        self.next = loop {
-            if k == 0 {
-                break None;
-            }
-            k -= 1;
-            let (n, stride) = self.free[k];
-            if self.digits[k] + 1 < n {
-                self.digits[k] += 1;
-                break Some(idx + stride);
-            }
-            idx -= self.digits[k] * stride;
-            self.digits[k] = 0;
-        };
-        Some(current)
-    }
 }
 
 #[cfg(test)]
@@ -216,6 +124,8 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    use crate::nn::joint_index::{ravel, unravel};
+
     /// The 8x8 Box Pushing joint table Q[m0, m1] = 10 * m0 + m1 with two planted maxima.
     fn table_8x8() -> Array1<f32> {
         let mut q = Array1::from_shape_fn(64, |k| (10 * (k / 8) + k % 8) as f32 / 100.0);
@@ -223,21 +133,6 @@ mod tests {
         q[ravel(&[6, 1], &[8, 8])] = 4.0; // best with m0 = 6 ... tied below
         q[ravel(&[6, 3], &[8, 8])] = 4.0;
         q
-    }
-
-    #[test]
-    fn ravel_is_c_order_with_agent_0_most_significant() {
-        assert_eq!(ravel(&[1, 2, 3], &[3, 3, 6]), (3 + 2) * 6 + 3);
-        let mut out = [0; 3];
-        unravel(33, &[3, 3, 6], &mut out);
-        assert_eq!(out, [1, 2, 3]);
-        assert_eq!(unravel_component(33, &[3, 3, 6], 0), 1);
-        assert_eq!(unravel_component(33, &[3, 3, 6], 1), 2);
-        assert_eq!(unravel_component(33, &[3, 3, 6], 2), 3);
-        for k in 0..54 {
-            unravel(k, &[3, 3, 6], &mut out);
-            assert_eq!(ravel(&out, &[3, 3, 6]), k);
-        }
     }
 
     #[test]

@@ -10,10 +10,10 @@
 
 use ndarray::Array3;
 
-use super::cond_argmax::ravel;
 use super::record::{Episode, Layout};
 use super::replay::Batch;
 use super::ReplayError;
+use crate::nn::joint_index::ravel;
 
 /// Agent i's view of a batch (Dec-HDDRQN, Our-1, Our-2): its records with v_i = 1.
 #[derive(Debug, Clone, PartialEq)]

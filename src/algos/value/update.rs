@@ -5,7 +5,7 @@
 //! with the just-updated centralized net (Our-1, Our-2; quirk Q2); C, one TD step per agent, whose
 //! target action comes from B or from the agent's own double-Q selection.
 
-use crate::algos::value::cond_argmax::{cond_argmax_rows, unravel_component, CondArgmaxError};
+use crate::algos::value::cond_argmax::{cond_argmax_rows, CondArgmaxError};
 use crate::algos::value::method::{DecTargetAction, ValueMethod};
 use crate::algos::value::record::Layout;
 use crate::algos::value::replay::Batch;
@@ -14,6 +14,7 @@ use crate::algos::value::squeeze::{
 };
 use crate::algos::value::ReplayError;
 use crate::autograd::SeqPacking;
+use crate::nn::joint_index::unravel_component;
 use crate::nn::{flatten_padded, Adam, AdamConfig, QNet, QNetParams, TdBatch, Updater};
 use ndarray::{Array1, Array2, Array3};
 use serde::{Deserialize, Serialize};
