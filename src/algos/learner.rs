@@ -12,6 +12,7 @@
 //! list of families ([`crate::algos::families`]).
 
 use crate::algos::train_error::TrainError;
+use crate::algos::training_loop::ActingLanes;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use rand_chacha::ChaCha8Rng;
 use serde::de::DeserializeOwned;
@@ -175,6 +176,17 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
 
     /// Choose the free agents' macro-actions for the next primitive step of a training lane.
     fn act<E: MacroEnv>(&mut self, lane: &mut Self::Lane, env: &E, actions: &mut [usize]);
+    /// Choose the next macro-actions of every training lane of one lockstep step of an
+    /// [`Schedule::EpisodeBatches`] batch, before any of them steps: by default [`Self::act`]
+    /// on each lane in order. A learner may compute them together (Mac-CAC reads its wide
+    /// output layer once for all lanes) if every lane gets exactly what [`Self::act`], called
+    /// lane by lane in order, would give it; acting never depends on another lane's step.
+    fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut ActingLanes<'_, Self::Lane, E>) {
+        for i in 0..lanes.len() {
+            let (state, env, actions) = lanes.lane(i);
+            self.act(state, env, actions);
+        }
+    }
     /// Record the step `env` just took. Returns whether the episode ended; the loop then resets
     /// the environment and calls [`Self::begin_episode`].
     fn record<E: MacroEnv>(

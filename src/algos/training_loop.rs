@@ -80,6 +80,30 @@ struct Lane<E, S> {
     counts_episodes: bool,
 }
 
+/// The training lanes as [`Learner::act_lanes`] sees them: each lane's learner state, its
+/// environment and the actions it will step with (not its random stream).
+pub struct ActingLanes<'a, S, E> {
+    lanes: &'a mut [Lane<E, S>],
+}
+
+impl<S, E> ActingLanes<'_, S, E> {
+    /// How many lanes.
+    pub fn len(&self) -> usize {
+        self.lanes.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.lanes.is_empty()
+    }
+
+    /// Lane `i`'s learner state, environment and actions. Panics if `i` is out of range.
+    pub fn lane(&mut self, i: usize) -> (&mut S, &E, &mut [usize]) {
+        let lane = &mut self.lanes[i];
+        (&mut lane.state, &lane.env, &mut lane.actions)
+    }
+}
+
 /// The complete state of a training run: learner, lanes, evaluation env and counters.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(bound(serialize = "E: Serialize, L: Serialize"))]
@@ -314,9 +338,13 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         }
         let mut completed = 0u64;
         while completed < train_freq {
-            // A whole lockstep step, then the check (`while n_epi_count < n_epis: _step()`).
+            // A whole lockstep step, then the check (`while n_epi_count < n_epis: _step()`):
+            // every lane chooses, then each steps in order (acting reads only its own lane).
+            self.learner.act_lanes(&mut ActingLanes {
+                lanes: &mut self.lanes,
+            });
             for lane in 0..self.lanes.len() {
-                completed += u64::from(self.step_lane(lane)?);
+                completed += u64::from(self.step_acted_lane(lane)?);
             }
         }
         let lanes: Vec<&L::Lane> = self.lanes.iter().map(|l| &l.state).collect();
@@ -374,6 +402,12 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         let lane = &mut self.lanes[index];
         self.learner
             .act(&mut lane.state, &lane.env, &mut lane.actions);
+        self.step_acted_lane(index)
+    }
+
+    /// [`Self::step_lane`] after the lane's actions were chosen.
+    fn step_acted_lane(&mut self, index: usize) -> Result<bool, TrainError> {
+        let lane = &mut self.lanes[index];
         let outcome = lane.env.step(&lane.actions, &mut lane.rng)?;
         self.env_steps += 1;
         if !self.learner.record(&mut lane.state, &lane.env, outcome)? {

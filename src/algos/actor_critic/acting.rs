@@ -17,6 +17,12 @@ pub struct ActBuffers {
     pub probs: Vec<f64>,
     /// Mac-CAC's joint observation.
     pub joint: Vec<f32>,
+    /// Mac-CAC over the lanes of one lockstep step: which lanes have a free agent.
+    pub deciding: Vec<bool>,
+    /// Their actor outputs before the output layer, one row per deciding lane.
+    pub hidden: Vec<f32>,
+    /// Their log-probabilities, one row per deciding lane.
+    pub logp: Vec<f32>,
 }
 
 impl Clone for ActBuffers {
@@ -94,11 +100,162 @@ pub fn act_centralized(
     );
 }
 
+/// One lane of a lockstep step as [`act_centralized_lanes`] reads it.
+pub struct CentralizedLane<'a> {
+    /// The actor's recurrent state on this lane.
+    pub state: &'a mut GruActorState,
+    /// Which agents are free.
+    pub free: &'a [bool],
+    /// The agents' running macro-actions.
+    pub running: &'a [usize],
+    /// The joint observation's writer (called only if some agent is free).
+    pub write_joint_obs: &'a dyn Fn(&mut [f32]),
+    /// Where the lane's actions go.
+    pub actions: &'a mut [usize],
+}
+
+/// Visits lane `i` of a lockstep step: calls the given function with its [`CentralizedLane`].
+pub type VisitLane<'a> = dyn FnMut(usize, &mut dyn FnMut(CentralizedLane<'_>)) + 'a;
+
+/// [`act_centralized`] on every lane of one lockstep step, lane by lane in order, each lane's
+/// choice and the stream's draws exactly as there: the lanes with a free agent go through the
+/// layers before the output layer one by one, then through the output layer together (read
+/// once, [`GruActor::log_probs_rows`]), then draw in lane order. `lane(i, f)` calls `f` with lane
+/// i's view; `n_lanes` lanes; `joint_len` is the joint observation's length.
+#[allow(clippy::too_many_arguments)]
+pub fn act_centralized_lanes(
+    actor: &GruActor,
+    n_lanes: usize,
+    lane: &mut VisitLane<'_>,
+    joint_len: usize,
+    n_actions: &[usize],
+    eps: Option<f64>,
+    rng: &mut ChaCha8Rng,
+    buffers: &mut ActBuffers,
+) {
+    let ActBuffers {
+        probs,
+        joint,
+        deciding,
+        hidden,
+        logp,
+    } = buffers;
+    joint.resize(joint_len, 0.0);
+    deciding.clear();
+    hidden.clear();
+    for i in 0..n_lanes {
+        lane(i, &mut |l| {
+            let free = l.free.iter().any(|&f| f);
+            deciding.push(free);
+            if free {
+                (l.write_joint_obs)(joint);
+                hidden.extend_from_slice(actor.hidden_step(joint, l.state));
+            }
+        });
+    }
+    let out = actor.config().output;
+    logp.resize(hidden.len() / actor.config().mlp[1] * out, 0.0);
+    actor.log_probs_rows(hidden, logp);
+    let mut rows = logp.chunks_exact(out);
+    for (i, &decides) in deciding.iter().enumerate() {
+        lane(i, &mut |l| {
+            if !decides {
+                l.actions.copy_from_slice(l.running);
+                return;
+            }
+            let row = rows.next().expect("one row per deciding lane");
+            conditioned_joint(
+                row,
+                eps,
+                l.free,
+                l.running,
+                n_actions,
+                Pick::Sample(rng),
+                probs,
+                l.actions,
+            );
+        });
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::nn::GruActorConfig;
     use rand::SeedableRng;
+
+    #[test]
+    fn all_lanes_at_once_act_exactly_as_lane_by_lane() {
+        use rand::Rng;
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let n_actions = [3, 4, 2];
+        let cfg = GruActorConfig {
+            input: 6,
+            mlp: [8, 8],
+            hidden: 5,
+            output: 24,
+        };
+        let actor = GruActor::new(cfg, &mut rng);
+        let n_lanes = 5;
+        let mut states_a = vec![actor.zero_state(); n_lanes];
+        let mut states_b = states_a.clone();
+        let (mut rng_a, mut rng_b) = (ChaCha8Rng::seed_from_u64(9), ChaCha8Rng::seed_from_u64(9));
+        let mut buffers = ActBuffers::default();
+        let mut probs = Vec::new();
+        for step in 0..30 {
+            // Each lane: who is free (sometimes nobody), the running macro-actions, an obs.
+            let free: Vec<Vec<bool>> = (0..n_lanes)
+                .map(|_| (0..3).map(|_| rng.gen_bool(0.4)).collect())
+                .collect();
+            let running: Vec<Vec<usize>> = (0..n_lanes)
+                .map(|_| n_actions.iter().map(|&n| rng.gen_range(0..n)).collect())
+                .collect();
+            let obs: Vec<Vec<f32>> = (0..n_lanes)
+                .map(|_| (0..6).map(|_| rng.gen_range(-1.0..1.0)).collect())
+                .collect();
+            let eps = Some(0.1 + 0.01 * step as f64);
+            let mut want = vec![[0usize; 3]; n_lanes];
+            for l in 0..n_lanes {
+                act_centralized(
+                    &actor,
+                    &mut states_a[l],
+                    &obs[l],
+                    &free[l],
+                    &running[l],
+                    &n_actions,
+                    eps,
+                    &mut rng_a,
+                    &mut probs,
+                    &mut want[l],
+                );
+            }
+            let mut got = vec![[7usize; 3]; n_lanes];
+            act_centralized_lanes(
+                &actor,
+                n_lanes,
+                &mut |l, f| {
+                    let o = &obs[l];
+                    f(CentralizedLane {
+                        state: &mut states_b[l],
+                        free: &free[l],
+                        running: &running[l],
+                        write_joint_obs: &|out| out.copy_from_slice(o),
+                        actions: &mut got[l],
+                    })
+                },
+                6,
+                &n_actions,
+                eps,
+                &mut rng_b,
+                &mut buffers,
+            );
+            assert_eq!(got, want, "step {step}");
+            for (a, b) in states_a.iter().zip(&states_b) {
+                assert_eq!(a.h(), b.h(), "step {step}");
+            }
+        }
+        assert_eq!(rng_a.gen::<u64>(), rng_b.gen::<u64>(), "the same draws");
+    }
 
     #[test]
     fn the_centralized_actor_keeps_busy_agents_on_their_running_macro_actions() {

@@ -8,7 +8,9 @@ use std::collections::VecDeque;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::acting::{act_centralized, act_decentralized, ActBuffers};
+use super::acting::{
+    act_centralized, act_centralized_lanes, act_decentralized, ActBuffers, CentralizedLane,
+};
 use super::config::AcConfig;
 use super::episode::{Episode, EpisodeRecorder};
 use super::lockstep_eval::lockstep_episodes;
@@ -21,7 +23,7 @@ use crate::algos::learner::{
     COMPLETED_EPISODE_STEPS,
 };
 use crate::algos::scratch::Scratch;
-use crate::algos::training_loop::TrainError;
+use crate::algos::training_loop::{ActingLanes, TrainError};
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -300,6 +302,37 @@ impl Learner for AcLearner {
             &mut self.explore_rng,
             &mut self.buffers,
             actions,
+        );
+    }
+
+    fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut ActingLanes<'_, AcLane, E>) {
+        if self.script.is_some() || self.design().actor != AcActor::Centralized || lanes.is_empty()
+        {
+            for i in 0..lanes.len() {
+                let (lane, env, actions) = lanes.lane(i);
+                self.act(lane, env, actions);
+            }
+            return;
+        }
+        let joint_len = lanes.lane(0).1.joint_obs_size();
+        act_centralized_lanes(
+            &self.nets.actors[0].net,
+            lanes.len(),
+            &mut |i, f| {
+                let (lane, env, actions) = lanes.lane(i);
+                f(CentralizedLane {
+                    state: &mut lane.states[0],
+                    free: lane.recorder.free(),
+                    running: env.executed(),
+                    write_joint_obs: &|out| env.write_joint_obs(out),
+                    actions,
+                })
+            },
+            joint_len,
+            &self.sizes.n_actions,
+            Some(self.eps),
+            &mut self.explore_rng,
+            &mut self.buffers,
         );
     }
 
