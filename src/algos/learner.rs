@@ -12,7 +12,6 @@
 //! list of families ([`crate::algos::families`]).
 
 use crate::algos::train_error::TrainError;
-use crate::algos::training_loop::ActingLanes;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
 use rand_chacha::ChaCha8Rng;
 use serde::de::DeserializeOwned;
@@ -133,6 +132,19 @@ pub trait FamilyConfig:
 /// them with ACAC's published curves; files of runs trained before a family wrote it lack it.
 pub const COMPLETED_EPISODE_STEPS: &str = "acac_timesteps";
 
+/// The training lanes as [`Learner::act_lanes`] sees them: each lane's learner state, its
+/// environment and the actions it will step with (not its random stream).
+pub trait ActingLanes<S, E> {
+    /// How many lanes.
+    fn len(&self) -> usize;
+    /// Whether there are none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Lane `i`'s learner state, environment and actions. Panics if `i` is out of range.
+    fn lane(&mut self, i: usize) -> (&mut S, &E, &mut [usize]);
+}
+
 /// A method family, as the training loop drives it. The learner is saved inside every checkpoint
 /// (with its lanes' state), so a resumed run continues with exactly the numbers of an
 /// uninterrupted one.
@@ -181,7 +193,7 @@ pub trait Learner: Sized + Clone + std::fmt::Debug + Serialize + DeserializeOwne
     /// on each lane in order. A learner may compute them together (Mac-CAC reads its wide
     /// output layer once for all lanes) if every lane gets exactly what [`Self::act`], called
     /// lane by lane in order, would give it; acting never depends on another lane's step.
-    fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut ActingLanes<'_, Self::Lane, E>) {
+    fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut dyn ActingLanes<Self::Lane, E>) {
         for i in 0..lanes.len() {
             let (state, env, actions) = lanes.lane(i);
             self.act(state, env, actions);

@@ -5,7 +5,9 @@
 //! The whole loop is one serializable value, so a checkpoint is the loop itself and a resumed run
 //! continues with exactly the numbers of an uninterrupted one.
 
-use crate::algos::learner::{FamilyConfig, Learner, LearnerRngs, MethodName, SavedNets, Schedule};
+use crate::algos::learner::{
+    ActingLanes, FamilyConfig, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+};
 use crate::envs::{EnvError, EnvRng, MacroEnv};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -80,26 +82,16 @@ struct Lane<E, S> {
     counts_episodes: bool,
 }
 
-/// The training lanes as [`Learner::act_lanes`] sees them: each lane's learner state, its
-/// environment and the actions it will step with (not its random stream).
-pub struct ActingLanes<'a, S, E> {
-    lanes: &'a mut [Lane<E, S>],
-}
+/// The loop's lanes as [`Learner::act_lanes`] reads them.
+struct LanesForActing<'a, E, S>(&'a mut [Lane<E, S>]);
 
-impl<S, E> ActingLanes<'_, S, E> {
-    /// How many lanes.
-    pub fn len(&self) -> usize {
-        self.lanes.len()
+impl<E, S> ActingLanes<S, E> for LanesForActing<'_, E, S> {
+    fn len(&self) -> usize {
+        self.0.len()
     }
 
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.lanes.is_empty()
-    }
-
-    /// Lane `i`'s learner state, environment and actions. Panics if `i` is out of range.
-    pub fn lane(&mut self, i: usize) -> (&mut S, &E, &mut [usize]) {
-        let lane = &mut self.lanes[i];
+    fn lane(&mut self, i: usize) -> (&mut S, &E, &mut [usize]) {
+        let lane = &mut self.0[i];
         (&mut lane.state, &lane.env, &mut lane.actions)
     }
 }
@@ -340,9 +332,7 @@ impl<L: Learner, E: MacroEnv> TrainingLoop<L, E> {
         while completed < train_freq {
             // A whole lockstep step, then the check (`while n_epi_count < n_epis: _step()`):
             // every lane chooses, then each steps in order (acting reads only its own lane).
-            self.learner.act_lanes(&mut ActingLanes {
-                lanes: &mut self.lanes,
-            });
+            self.learner.act_lanes(&mut LanesForActing(&mut self.lanes));
             for lane in 0..self.lanes.len() {
                 completed += u64::from(self.step_acted_lane(lane)?);
             }

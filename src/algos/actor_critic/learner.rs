@@ -19,11 +19,11 @@ use super::nets::{AcNets, NetSizes};
 use super::scripted::{ActingCall, ActionScript};
 use super::update::{update, UpdateParams, UpdateTrace};
 use crate::algos::learner::{
-    EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
+    ActingLanes, EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
     COMPLETED_EPISODE_STEPS,
 };
 use crate::algos::scratch::Scratch;
-use crate::algos::training_loop::{ActingLanes, TrainError};
+use crate::algos::training_loop::TrainError;
 use crate::algos::update_means::UpdateMeans;
 use crate::autograd::Tape;
 use crate::envs::{EnvError, EnvRng, MacroEnv, StepOutcome};
@@ -305,7 +305,7 @@ impl Learner for AcLearner {
         );
     }
 
-    fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut ActingLanes<'_, AcLane, E>) {
+    fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut dyn ActingLanes<AcLane, E>) {
         if self.script.is_some() || self.design().actor != AcActor::Centralized || lanes.is_empty()
         {
             for i in 0..lanes.len() {
