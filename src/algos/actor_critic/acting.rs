@@ -17,9 +17,8 @@ pub struct ActBuffers {
     pub probs: Vec<f64>,
     /// Mac-CAC's joint observation.
     pub joint: Vec<f32>,
-    /// Mac-CAC over the lanes of one lockstep step: which lanes have a free agent.
-    pub deciding: Vec<bool>,
-    /// Their actor outputs before the output layer, one row per deciding lane.
+    /// Mac-CAC over the lanes of one lockstep step: the actor outputs before the output layer,
+    /// one row per lane with a free agent.
     pub hidden: Vec<f32>,
     /// Their log-probabilities, one row per deciding lane.
     pub logp: Vec<f32>,
@@ -121,13 +120,12 @@ pub type VisitLane<'a> = dyn FnMut(usize, &mut dyn FnMut(CentralizedLane<'_>)) +
 /// choice and the stream's draws exactly as there: the lanes with a free agent go through the
 /// layers before the output layer one by one, then through the output layer together (read
 /// once, [`GruActor::log_probs_rows`]), then draw in lane order. `lane(i, f)` calls `f` with lane
-/// i's view; `n_lanes` lanes; `joint_len` is the joint observation's length.
+/// i's view; `n_lanes` lanes.
 #[allow(clippy::too_many_arguments)]
 pub fn act_centralized_lanes(
     actor: &GruActor,
     n_lanes: usize,
     lane: &mut VisitLane<'_>,
-    joint_len: usize,
     n_actions: &[usize],
     eps: Option<f64>,
     rng: &mut ChaCha8Rng,
@@ -136,30 +134,27 @@ pub fn act_centralized_lanes(
     let ActBuffers {
         probs,
         joint,
-        deciding,
         hidden,
         logp,
     } = buffers;
-    joint.resize(joint_len, 0.0);
-    deciding.clear();
+    let cfg = actor.config();
+    joint.resize(cfg.input, 0.0);
     hidden.clear();
+    let decides = |l: &CentralizedLane<'_>| l.free.iter().any(|&f| f);
     for i in 0..n_lanes {
         lane(i, &mut |l| {
-            let free = l.free.iter().any(|&f| f);
-            deciding.push(free);
-            if free {
+            if decides(&l) {
                 (l.write_joint_obs)(joint);
                 hidden.extend_from_slice(actor.hidden_step(joint, l.state));
             }
         });
     }
-    let out = actor.config().output;
-    logp.resize(hidden.len() / actor.config().mlp[1] * out, 0.0);
+    logp.resize(hidden.len() / cfg.mlp[1] * cfg.output, 0.0);
     actor.log_probs_rows(hidden, logp);
-    let mut rows = logp.chunks_exact(out);
-    for (i, &decides) in deciding.iter().enumerate() {
+    let mut rows = logp.chunks_exact(cfg.output);
+    for i in 0..n_lanes {
         lane(i, &mut |l| {
-            if !decides {
+            if !decides(&l) {
                 l.actions.copy_from_slice(l.running);
                 return;
             }
@@ -243,7 +238,6 @@ mod tests {
                         actions: &mut got[l],
                     })
                 },
-                6,
                 &n_actions,
                 eps,
                 &mut rng_b,

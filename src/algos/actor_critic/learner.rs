@@ -306,15 +306,13 @@ impl Learner for AcLearner {
     }
 
     fn act_lanes<E: MacroEnv>(&mut self, lanes: &mut dyn ActingLanes<AcLane, E>) {
-        if self.script.is_some() || self.design().actor != AcActor::Centralized || lanes.is_empty()
-        {
+        if self.script.is_some() || self.design().actor != AcActor::Centralized {
             for i in 0..lanes.len() {
                 let (lane, env, actions) = lanes.lane(i);
                 self.act(lane, env, actions);
             }
             return;
         }
-        let joint_len = lanes.lane(0).1.joint_obs_size();
         act_centralized_lanes(
             &self.nets.actors[0].net,
             lanes.len(),
@@ -328,7 +326,6 @@ impl Learner for AcLearner {
                     actions,
                 })
             },
-            joint_len,
             &self.sizes.n_actions,
             Some(self.eps),
             &mut self.explore_rng,
