@@ -26,6 +26,7 @@ use super::linear::LinearVars;
 use super::params::{flat, flat_mut, GruParams, LinearParams, Params};
 use super::safetensors_io::{read_exact, tensor_shape, WeightsError};
 use crate::autograd::kernels::dense::{linear_forward, matvec_act_rows};
+use crate::autograd::kernels::exp::{sum_exp_f32, sum_exp_f32_rows4};
 use crate::autograd::kernels::gru::{gru_step, GruWeights};
 use crate::autograd::{Activation, GruVars, SeqPacking, Tape, Var};
 
@@ -254,9 +255,7 @@ impl GruActor {
             1.0,
             logp,
         );
-        for row in logp.chunks_exact_mut(cfg.output) {
-            log_softmax_in_place(row);
-        }
+        log_softmax_rows_in_place(logp, cfg.output);
     }
 
     /// One acting step like [`Self::act_step`] but giving fc4's raw outputs (no log_softmax):
@@ -448,10 +447,37 @@ fn take_linear(
 }
 
 /// x <- x - max - log(sum(exp(x - max))), as `torch.log_softmax` computes it (ACAC's acting
-/// actors use it too).
+/// actors use it too): the sum in f32, in order, of glibc's `expf` of each difference.
 pub(crate) fn log_softmax_in_place(x: &mut [f32]) {
     let max = x.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-    let sum: f32 = x.iter().map(|v| (v - max).exp()).sum();
+    finish_log_softmax(x, max, sum_exp_f32(x, max));
+}
+
+/// [`log_softmax_in_place`] on each row of `rows` (rows of `n`), four rows' sums side by side
+/// (each row's additions in its own order, so each row's bits are the one-row function's).
+pub(crate) fn log_softmax_rows_in_place(rows: &mut [f32], n: usize) {
+    if n == 0 {
+        return;
+    }
+    let mut quads = rows.chunks_exact_mut(4 * n);
+    for quad in &mut quads {
+        let (a, rest) = quad.split_at_mut(n);
+        let (b, rest) = rest.split_at_mut(n);
+        let (c, d) = rest.split_at_mut(n);
+        let max = |r: &[f32]| r.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        let maxes = [max(a), max(b), max(c), max(d)];
+        let sums = sum_exp_f32_rows4([a, b, c, d], maxes);
+        for (k, row) in [a, b, c, d].into_iter().enumerate() {
+            finish_log_softmax(row, maxes[k], sums[k]);
+        }
+    }
+    for row in quads.into_remainder().chunks_exact_mut(n) {
+        log_softmax_in_place(row);
+    }
+}
+
+/// x <- x - max - ln(sum).
+fn finish_log_softmax(x: &mut [f32], max: f32, sum: f32) {
     let lse = sum.ln();
     for v in x.iter_mut() {
         *v = *v - max - lse;
@@ -525,6 +551,35 @@ mod tests {
         assert_ne!(second, first);
         s.reset();
         assert_eq!(a.act_step(&x, &mut s), first.as_slice());
+    }
+
+    #[test]
+    fn log_softmax_rows_are_the_definition_with_the_platform_expf() {
+        use rand::Rng;
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        for (n_rows, n) in [(1, 1), (3, 15), (4, 15), (7, 37), (9, 3375)] {
+            let x: Vec<f32> = (0..n_rows * n)
+                .map(|k| match k % 97 {
+                    5 => f32::NEG_INFINITY,
+                    9 => -150.0,
+                    _ => rng.gen_range(-30.0..30.0),
+                })
+                .collect();
+            let mut want = x.clone();
+            for row in want.chunks_exact_mut(n) {
+                let max = row.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                let sum: f32 = row.iter().map(|v| (v - max).exp()).sum();
+                let lse = sum.ln();
+                row.iter_mut().for_each(|v| *v = *v - max - lse);
+            }
+            let mut got = x.clone();
+            log_softmax_rows_in_place(&mut got, n);
+            let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "{n_rows} rows of {n}");
+            let mut one = x[..n].to_vec();
+            log_softmax_in_place(&mut one);
+            assert_eq!(bits(&one), bits(&want[..n]), "one row of {n}");
+        }
     }
 
     #[test]

@@ -7,6 +7,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::argmax::FirstArgmax;
 use super::joint_index::{for_each_allowed, unravel};
+use crate::autograd::kernels::exp::exp_f64_in_place;
 
 /// Sample index a from weights p_a (not necessarily normalized; zero weights never drawn).
 pub fn sample_weighted(weights: &[f64], rng: &mut ChaCha8Rng) -> usize {
@@ -37,16 +38,20 @@ fn weighted_pick(weights: &[f64], u: f64) -> Option<usize> {
 /// (`None` when evaluated), into `out`.
 pub fn mixture(logp: &[f32], eps: Option<f64>, out: &mut Vec<f64>) {
     out.clear();
-    let n = logp.len() as f64;
-    out.extend(logp.iter().map(|&l| mixture_weight(l, eps, n)));
+    out.extend(logp.iter().map(|&l| f64::from(l)));
+    mix_in_place(out, eps, logp.len() as f64);
 }
 
-/// One entry of [`mixture`]: (1 - eps) exp(l) + eps / n, or exp(l) without exploration.
-#[inline]
-fn mixture_weight(l: f32, eps: Option<f64>, n: f64) -> f64 {
-    match eps {
-        Some(eps) => (1.0 - eps) * f64::from(l).exp() + eps / n,
-        None => f64::from(l).exp(),
+/// Each log-probability `l` of `probs` becomes its weight in the mixture over `n` entries:
+/// (1 - eps) e^l + eps / n, or e^l without exploration (e^l in f64, glibc's `exp` bit for bit,
+/// four at a time; then one rounded multiply and one rounded add, as written).
+fn mix_in_place(probs: &mut [f64], eps: Option<f64>, n: f64) {
+    exp_f64_in_place(probs);
+    if let Some(eps) = eps {
+        let (keep, floor) = (1.0 - eps, eps / n);
+        for p in probs {
+            *p = keep * *p + floor;
+        }
     }
 }
 
@@ -85,21 +90,35 @@ pub fn conditioned_joint(
     // The draw of `sample_weighted` over the whole masked mixture (the other entries zero),
     // computed on the allowed entries only, in increasing order: adding zeros changes no sum
     // and a zero is never picked, so the total, the draw and the pick are the same bit for bit.
-    // With one agent free of three, 15 of 3 375 joint macro-actions are allowed.
-    let n = logp.len() as f64;
+    // With one agent free of three, 15 of 3 375 joint macro-actions are allowed. They come in
+    // runs: the last agent's allowed part (all of its macro-actions, or its running one) after
+    // each allowed part of the others.
     let busy = busy_part(free, running);
+    let (last, n_last) = (n_actions.len() - 1, n_actions[n_actions.len() - 1]);
+    let run = match busy(last) {
+        Some(r) => r.min(n_last)..(r + 1).min(n_last),
+        None => 0..n_last,
+    };
     probs.clear();
-    for_each_allowed(n_actions, &busy, None, &mut |j| {
-        probs.push(mixture_weight(logp[j], eps, n));
+    for_each_allowed(&n_actions[..last], &busy, None, &mut |prefix| {
+        let at = prefix * n_last;
+        probs.extend(
+            logp[at + run.start..at + run.end]
+                .iter()
+                .map(|&l| f64::from(l)),
+        );
     });
+    mix_in_place(probs, eps, logp.len() as f64);
     let total: f64 = probs.iter().sum();
     let u = rng.gen::<f64>() * total;
     let mut joint = 0;
     if let Some(k) = weighted_pick(probs, u) {
+        // Entry k is the (k mod run length)-th of the (k / run length)-th run.
+        let (nth, offset) = (k / run.len(), k % run.len());
         let mut seen = 0;
-        for_each_allowed(n_actions, &busy, None, &mut |j| {
-            if seen == k {
-                joint = j;
+        for_each_allowed(&n_actions[..last], &busy, None, &mut |prefix| {
+            if seen == nth {
+                joint = prefix * n_last + run.start + offset;
             }
             seen += 1;
         });
@@ -209,8 +228,15 @@ mod tests {
         running: &[usize],
         n_actions: &[usize],
     ) -> Vec<f64> {
-        let mut p = Vec::new();
-        mixture(logp, eps, &mut p);
+        // The definition, with the platform's exp (the kernel must give its bits).
+        let n = logp.len() as f64;
+        let mut p: Vec<f64> = logp
+            .iter()
+            .map(|&l| match eps {
+                Some(eps) => (1.0 - eps) * f64::from(l).exp() + eps / n,
+                None => f64::from(l).exp(),
+            })
+            .collect();
         for (j, w) in p.iter_mut().enumerate() {
             if !keeps_busy_agents(j, free, running, n_actions) {
                 *w = 0.0;

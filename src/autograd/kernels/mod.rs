@@ -2,6 +2,7 @@
 
 pub mod activations;
 pub mod dense;
+pub mod exp;
 pub mod gemm;
 pub mod gru;
 pub mod lstm;

@@ -5,17 +5,56 @@
 //! results (e^(x - max) <= 1, and the row's sum is >= 1). A row whose maximum is not finite is
 //! not shifted: all -inf gives log-sum-exp -inf and a NaN softmax, as in PyTorch.
 
-use ndarray::{Array2, ArrayView1, Axis, Zip};
+use ndarray::{Array2, ArrayView1, ArrayView2, Axis, Zip};
 
 use super::{put, Op};
+use crate::autograd::kernels::exp::{
+    exp_f32, exp_f32_into, exp_f64, sum_exp_f64, sum_exp_f64_rows4,
+};
 use crate::autograd::tape::{GradCx, Tape, Var};
 
-/// The row's maximum if finite, else 0 (see the module docs), and ln(sum e^(x - shift)).
-fn shift_and_log_sum(row: ArrayView1<f32>) -> (f32, f32) {
-    let max = row.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-    let shift = if max.is_finite() { max } else { 0.0 };
-    let sum: f64 = row.iter().map(|&v| ((v - shift) as f64).exp()).sum();
-    (shift, sum.ln() as f32)
+/// The row's maximum if finite, else 0 (see the module docs).
+fn row_shift<'a>(row: impl IntoIterator<Item = &'a f32>) -> f32 {
+    let max = row.into_iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    if max.is_finite() {
+        max
+    } else {
+        0.0
+    }
+}
+
+/// Each row's shift ([`row_shift`]) and ln(sum e^(x - shift)), the differences in f32 and the
+/// exponentials (glibc's `exp`, bit for bit) and the sum in f64, added in column order; four
+/// rows' sums side by side where the rows are contiguous.
+fn shifts_and_log_sums(x: ArrayView2<f32>) -> Vec<(f32, f32)> {
+    let n = x.ncols();
+    let log = |s: f64| s.ln() as f32;
+    let (Some(flat), true) = (x.as_slice(), n > 0) else {
+        return x
+            .rows()
+            .into_iter()
+            .map(|row| {
+                let shift = row_shift(row);
+                let sum = row
+                    .iter()
+                    .fold(-0.0, |s, &v| s + exp_f64(f64::from(v - shift)));
+                (shift, log(sum))
+            })
+            .collect();
+    };
+    let rows: Vec<&[f32]> = flat.chunks_exact(n).collect();
+    let mut out: Vec<(f32, f32)> = Vec::with_capacity(rows.len());
+    let mut quads = rows.chunks_exact(4);
+    for q in &mut quads {
+        let shifts = [q[0], q[1], q[2], q[3]].map(row_shift);
+        let sums = sum_exp_f64_rows4([q[0], q[1], q[2], q[3]], shifts);
+        out.extend((0..4).map(|k| (shifts[k], log(sums[k]))));
+    }
+    for row in quads.remainder() {
+        let shift = row_shift(*row);
+        out.push((shift, log(sum_exp_f64(row, shift))));
+    }
+    out
 }
 
 impl Tape {
@@ -24,16 +63,16 @@ impl Tape {
     pub fn softmax(&mut self, x: Var) -> Var {
         let (m, n) = self.shape(x);
         let mut y = self.pool().array(m, n);
-        Zip::from(y.rows_mut())
-            .and(self.value(x).rows())
-            .for_each(|mut yr, xr| {
-                // x - shift first: it is exact near the maximum, where x - lse would round
-                // at the magnitude of x.
-                let (shift, log_sum) = shift_and_log_sum(xr);
-                Zip::from(&mut yr).and(&xr).for_each(|y, &x| {
-                    *y = ((x - shift) - log_sum).exp();
-                });
+        let xv = self.value(x);
+        let stats = shifts_and_log_sums(xv.view());
+        for ((mut yr, xr), &(shift, log_sum)) in y.rows_mut().into_iter().zip(xv.rows()).zip(&stats)
+        {
+            // x - shift first: it is exact near the maximum, where x - lse would round at the
+            // magnitude of x.
+            Zip::from(&mut yr).and(&xr).for_each(|y, &x| {
+                *y = exp_f32((x - shift) - log_sum);
             });
+        }
         self.push_op(y, Op::Softmax { x }, &[x])
     }
 
@@ -43,14 +82,14 @@ impl Tape {
     pub fn log_softmax(&mut self, x: Var) -> Var {
         let (m, n) = self.shape(x);
         let mut y = self.pool().array(m, n);
-        Zip::from(y.rows_mut())
-            .and(self.value(x).rows())
-            .for_each(|mut yr, xr| {
-                let (shift, log_sum) = shift_and_log_sum(xr);
-                Zip::from(&mut yr).and(&xr).for_each(|y, &x| {
-                    *y = (x - shift) - log_sum;
-                });
+        let xv = self.value(x);
+        let stats = shifts_and_log_sums(xv.view());
+        for ((mut yr, xr), &(shift, log_sum)) in y.rows_mut().into_iter().zip(xv.rows()).zip(&stats)
+        {
+            Zip::from(&mut yr).and(&xr).for_each(|y, &x| {
+                *y = (x - shift) - log_sum;
             });
+        }
         self.push_op(y, Op::LogSoftmax { x }, &[x])
     }
 
@@ -59,12 +98,10 @@ impl Tape {
     pub fn logsumexp(&mut self, x: Var) -> Var {
         let m = self.shape(x).0;
         let mut y = self.pool().array(m, 1);
-        Zip::from(y.rows_mut())
-            .and(self.value(x).rows())
-            .for_each(|mut yr, xr| {
-                let (shift, log_sum) = shift_and_log_sum(xr);
-                yr[0] = shift + log_sum;
-            });
+        let stats = shifts_and_log_sums(self.value(x).view());
+        for (yi, &(shift, log_sum)) in y.iter_mut().zip(&stats) {
+            *yi = shift + log_sum;
+        }
         self.push_op(y, Op::LogSumExp { x }, &[x])
     }
 }
@@ -86,13 +123,21 @@ pub(super) fn softmax_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mu
 // y = x - lse(x): dx_j = g_j - softmax_j sum_k g_k, with softmax_j = e^(y_j)
 pub(super) fn log_softmax_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
+        let mut exps: Vec<f32> = Vec::new();
         for ((mut dr, gr), yr) in d
             .axis_iter_mut(Axis(0))
             .zip(g.axis_iter(Axis(0)))
             .zip(y.axis_iter(Axis(0)))
         {
             let total: f32 = gr.sum();
-            put!(mode, &mut dr, &gr, &yr; |g, y| g - y.exp() * total);
+            // e^y a row at a time (glibc's `expf`, bit for bit, four at a time).
+            exps.resize(yr.len(), 0.0);
+            match yr.as_slice() {
+                Some(ys) => exp_f32_into(ys, &mut exps),
+                None => exps.iter_mut().zip(&yr).for_each(|(e, &y)| *e = exp_f32(y)),
+            }
+            let e = ArrayView1::from(&exps[..]);
+            put!(mode, &mut dr, &gr, &e; |g, e| g - e * total);
         }
     }
 }
@@ -118,6 +163,56 @@ mod tests {
 
     use super::super::grad_check::{grad_check, Inputs};
     use crate::autograd::Tape;
+
+    /// The definitions with the platform's exp and expf, per row in column order; the kernels
+    /// (four rows side by side, four values at a time) must give their bits.
+    #[test]
+    fn the_forwards_and_the_log_softmax_gradient_are_the_definitions_bit_for_bit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        for (m, n) in [(1, 1), (3, 15), (4, 16), (7, 37), (9, 3375)] {
+            let x = ndarray::Array2::from_shape_fn((m, n), |(i, j)| match (i * n + j) % 89 {
+                3 => f32::NEG_INFINITY,
+                7 => -900.0,
+                _ => rng.gen_range(-40.0..40.0),
+            });
+            let g = ndarray::Array2::from_shape_fn((m, n), |_| rng.gen_range(-1.0f32..1.0));
+            let mut t = Tape::new();
+            let xv = t.param(x.view());
+            let (y, p, l) = (t.log_softmax(xv), t.softmax(xv), t.logsumexp(xv));
+            let w = t.constant(g.view());
+            let prod = t.mul(y, w);
+            let loss = t.sum(prod);
+            t.backward(loss);
+            let bits =
+                |a: ndarray::ArrayView2<f32>| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            let mut want_y = x.clone();
+            let mut want_p = x.clone();
+            let mut want_l = ndarray::Array2::<f32>::zeros((m, 1));
+            let mut want_dx = x.clone();
+            for i in 0..m {
+                let row = x.row(i);
+                let max = row.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                let shift = if max.is_finite() { max } else { 0.0 };
+                let sum: f64 = row.iter().map(|&v| ((v - shift) as f64).exp()).sum();
+                let log_sum = sum.ln() as f32;
+                want_l[[i, 0]] = shift + log_sum;
+                for j in 0..n {
+                    want_y[[i, j]] = (x[[i, j]] - shift) - log_sum;
+                    want_p[[i, j]] = ((x[[i, j]] - shift) - log_sum).exp();
+                }
+                let total: f32 = g.row(i).sum();
+                for j in 0..n {
+                    want_dx[[i, j]] = g[[i, j]] - want_y[[i, j]].exp() * total;
+                }
+            }
+            assert_eq!(bits(t.value(y)), bits(want_y.view()), "log_softmax {m}x{n}");
+            assert_eq!(bits(t.value(p)), bits(want_p.view()), "softmax {m}x{n}");
+            assert_eq!(bits(t.value(l)), bits(want_l.view()), "logsumexp {m}x{n}");
+            let dx = t.grad(xv).expect("x's gradient");
+            assert_eq!(bits(dx), bits(want_dx.view()), "d log_softmax {m}x{n}");
+        }
+    }
 
     #[test]
     fn softmax_matches_finite_differences() {
