@@ -440,7 +440,7 @@ mod avx2 {
     use super::Mode;
     use ndarray::{ArrayView2, ArrayViewMut2};
 
-    const MR: usize = 4;
+    const MR: usize = 6;
     const KC: usize = super::K_BLOCK;
 
     /// Whether this CPU runs the kernel (checked once).
@@ -503,7 +503,8 @@ mod avx2 {
             let mut i = 0;
             while i < m {
                 let rows = (m - i).min(MR);
-                // Vectors per tile row: 2 for 3-4 rows, 4 for 1-2 (enough independent chains).
+                // Vectors per tile row: 2 for 3-6 rows, 4 for 1-2 (enough independent chains;
+                // 6 x 2 accumulators, 2 B vectors and a broadcast fill the 16 registers).
                 let nr = if rows >= 3 { 16 } else { 32 };
                 let (ai, ci) = (ak.offset(i as isize * rsa), c.offset(i as isize * rsc));
                 let mut j = 0;
@@ -521,6 +522,8 @@ mod avx2 {
                         cols,
                     };
                     match rows {
+                        6 => t.run::<6, 2>(acc),
+                        5 => t.run::<5, 2>(acc),
                         4 => t.run::<4, 2>(acc),
                         3 => t.run::<3, 2>(acc),
                         2 => t.run::<2, 4>(acc),
@@ -746,7 +749,7 @@ mod tests {
 
     #[test]
     fn every_kernel_gives_the_portable_arithmetic_bit_for_bit() {
-        // Shapes around every kernel's tiles (4 x 16, 8 x 32, 16 x 16) and the k block, values
+        // Shapes around every kernel's tiles (6 x 16, 2 x 32, 8 x 32, 16 x 16) and the k block, values
         // whose products round, overwrite then accumulate (a second k block adds into c).
         let shapes = [
             (1, 1, 1),
@@ -760,6 +763,8 @@ mod tests {
             (16, 5, 8),
             (45, 390, 16),
             (64, 64, 96),
+            (8, 20, 40),
+            (2, 5, 33),
         ];
         let kernels = kernels();
         for (m, k, n) in shapes {
