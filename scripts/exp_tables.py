@@ -43,7 +43,8 @@ def expf_table():
 
 
 def rust_array(name, doc, words):
-    lines = [f"/// {doc}", f"pub(super) const {name}: [u64; {len(words)}] = ["]
+    # rustfmt::skip keeps the file exactly what this script prints (four words a line).
+    lines = [f"/// {doc}", "#[rustfmt::skip]", f"pub(super) const {name}: [u64; {len(words)}] = ["]
     for k in range(0, len(words), 4):
         lines.append("    " + " ".join(f"0x{w:016x}," for w in words[k : k + 4]))
     lines.append("];")
