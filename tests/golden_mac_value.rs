@@ -268,11 +268,19 @@ fn run_case(name: &str) {
             .collect();
         let h = u["hysteresis"].as_f64().unwrap();
         let updated = match alg {
-            "MacCenQ" => {
-                update_cen(&mut nets[0], &batch, &dims, h, discount, 1, &mut scratch).is_some()
-            }
+            "MacCenQ" => update_cen(
+                &mut nets[0],
+                &batch,
+                None,
+                &dims,
+                h,
+                discount,
+                1,
+                &mut scratch,
+            )
+            .is_some(),
             "MacDecQ" => {
-                update_dec(&mut nets, &batch, &dims, h, discount, 1, &mut scratch).is_some()
+                update_dec(&mut nets, &batch, None, &dims, h, discount, 1, &mut scratch).is_some()
             }
             _ => {
                 let (decs, cen) = nets.split_at_mut(2);

@@ -25,7 +25,7 @@ use super::init::LEAKY_RELU_GAIN;
 use super::linear::LinearVars;
 use super::params::{flat, flat_mut, GruParams, LinearParams, Params};
 use super::safetensors_io::{read_exact, tensor_shape, WeightsError};
-use crate::autograd::kernels::dense::{linear_forward, matvec_act_rows};
+use crate::autograd::kernels::dense::{linear_forward, linear_forward_at, matvec_act_rows};
 use crate::autograd::kernels::exp::{sum_exp_f32, sum_exp_f32_rows4};
 use crate::autograd::kernels::gru::{gru_step, GruWeights};
 use crate::autograd::{Activation, GruVars, SeqPacking, Tape, Var};
@@ -347,11 +347,38 @@ impl GruActor {
         x: Var,
         packing: &SeqPacking,
     ) -> (Var, Var) {
+        let (a3, h) = self.features(tape, vars, x, packing);
+        (vars.fc4.forward(tape, a3, Activation::Identity), h)
+    }
+
+    /// fc4's output at column `col` for one row `a3` of [`Self::features`]: the bits
+    /// [`Self::forward`] gives there, at the cost of one dot product instead of the layer.
+    pub fn output_at(&self, a3: &[f32], col: usize) -> f32 {
+        let p = &self.fc4;
+        linear_forward_at(
+            a3,
+            p.weight.view(),
+            flat(&p.bias),
+            Activation::Identity,
+            col,
+        )
+    }
+
+    /// What fc4 reads, leaky(fc3(h)): [K, m1], and the GRU's output h: [K, H] (packed order):
+    /// [`Self::forward_with_hidden`] short of its last layer, for a caller that needs fc4 at one
+    /// column per row ([`crate::autograd::kernels::dense::linear_forward_at`] gives the same
+    /// bits as the whole layer there).
+    pub fn features(
+        &self,
+        tape: &mut Tape,
+        vars: &GruActorVars,
+        x: Var,
+        packing: &SeqPacking,
+    ) -> (Var, Var) {
         let a1 = vars.fc1.forward(tape, x, LEAKY);
         let a2 = vars.fc2.forward(tape, a1, LEAKY);
         let h = vars.gru.forward_packed(tape, a2, packing);
-        let a3 = vars.fc3.forward(tape, h, LEAKY);
-        (vars.fc4.forward(tape, a3, Activation::Identity), h)
+        (vars.fc3.forward(tape, h, LEAKY), h)
     }
 
     /// fc4's output [n, out] one step past the ends of n sequences, values only (no tape): x:

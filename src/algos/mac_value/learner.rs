@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::acting::{act_cen, act_dec, Explore};
 use super::config::MacValueConfig;
-use super::episode::Recorder;
+use super::episode::{Recorder, Step};
 use super::memory::Memory;
 use super::method::{MacValueMethod, QNets};
 use super::update::{update_cen, update_dec, update_dec_cen, Dims, QNet, UpdateScratch};
@@ -295,14 +295,22 @@ impl Learner for MacValueLearner {
                 Some(m) => Some(m.sample(c.batch_size, &mut self.replay).map_err(sampling)?),
                 None => None,
             };
-            let batch = self
+            let picks = self
                 .memory
-                .sample(c.batch_size, &mut self.replay)
+                .sample_indices(c.batch_size, &mut self.replay)
                 .map_err(sampling)?;
+            let batch: Vec<&[Step]> = picks.iter().map(|&i| self.memory.entry(i)).collect();
+            let ids = self.memory.episode_ids(&picks, self.episodes);
+            if ids.is_some() {
+                // A whole-episode memory keeps the last `len` of the episodes stored.
+                let oldest = self.episodes - self.memory.len() as u64;
+                self.scratch.0.forget_episodes_before(oldest);
+            }
             let losses: Vec<f32> = match self.method.nets() {
                 QNets::Decentralized => update_dec(
                     &mut self.nets,
                     &batch,
+                    ids.as_deref(),
                     &self.dims,
                     self.hysteresis,
                     c.discount,
@@ -314,6 +322,7 @@ impl Learner for MacValueLearner {
                 QNets::Centralized => update_cen(
                     &mut self.nets[0],
                     &batch,
+                    ids.as_deref(),
                     &self.dims,
                     self.hysteresis,
                     c.discount,
@@ -365,6 +374,7 @@ impl Learner for MacValueLearner {
         for q in &mut self.nets {
             q.target.copy_values_from(&q.net);
         }
+        self.scratch.0.targets_changed();
     }
 
     /// One greedy episode (`evaluate(n_episode=1)`), the nets' states carried through it; the

@@ -149,6 +149,19 @@ impl Memory {
         batch_size: usize,
         rng: &mut ChaCha8Rng,
     ) -> Result<Vec<&[Step]>, TooFewToSample> {
+        Ok(self
+            .sample_indices(batch_size, rng)?
+            .into_iter()
+            .map(|i| self.entry(i))
+            .collect())
+    }
+
+    /// The entries [`Self::sample`] draws, as indices for [`Self::entry`] (the same draws).
+    pub fn sample_indices(
+        &self,
+        batch_size: usize,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Vec<usize>, TooFewToSample> {
         let held = self.len();
         if held < batch_size {
             return Err(TooFewToSample {
@@ -160,10 +173,20 @@ impl Memory {
                 batch_size,
             });
         }
-        Ok(rand::seq::index::sample(rng, held, batch_size)
-            .into_iter()
-            .map(|i| self.entry(i))
-            .collect())
+        Ok(rand::seq::index::sample(rng, held, batch_size).into_vec())
+    }
+
+    /// Whole-episode memories: the ids of `entries` (indices for [`Self::entry`]) when `pushed`
+    /// episodes were stored in all, episode n having id n, so an id names one episode for as long
+    /// as it is kept. `None` for window memories, whose entries overlap.
+    pub fn episode_ids(&self, entries: &[usize], pushed: u64) -> Option<Vec<u64>> {
+        match self {
+            Memory::Windows { .. } => None,
+            Memory::Episodes { episodes, .. } => {
+                let first = pushed - episodes.len() as u64;
+                Some(entries.iter().map(|&i| first + i as u64).collect())
+            }
+        }
     }
 }
 

@@ -27,6 +27,8 @@
 //! centralized net's batch from the memory its own exploration filled and the agents' batch from
 //! the memory the agents' exploration filled.
 
+use std::collections::HashMap;
+
 use ndarray::{Array2, ArrayView1, ArrayView2};
 use serde::{Deserialize, Serialize};
 
@@ -178,6 +180,8 @@ pub fn masked_argmax(q: &[f32], avail: &[f32]) -> usize {
 #[derive(Debug, Clone, Default)]
 struct Squeezed {
     lengths: Vec<usize>,
+    /// Each sequence's position in the batch (a batch entry gives one sequence or none).
+    entries: Vec<usize>,
     width: usize,
     /// [sum lengths, width]: the observations the macro-actions were chosen on.
     x: Vec<f32>,
@@ -230,7 +234,7 @@ impl Squeezed {
             s.avail_width = avail(r).len();
             s.next_avail.reserve(most * s.avail_width);
         }
-        for seq in batch {
+        for (entry, seq) in batch.iter().enumerate() {
             let first = records.len();
             records.extend(seq.iter().filter(|r| keep(r)));
             let n = records.len() - first;
@@ -239,6 +243,7 @@ impl Squeezed {
                 continue;
             }
             s.lengths.push(n);
+            s.entries.push(entry);
             s.x_next.extend_from_slice(input(&records[first].obs));
             for r in &records[first..] {
                 s.x.extend_from_slice(input(&r.obs));
@@ -340,7 +345,43 @@ pub struct UpdateScratch {
     tape: Tape,
     grads: Vec<GruActor>,
     online_next: Vec<f32>,
+    /// [records, m1]: the target's last hidden layer at each record's next position.
     target_next: Vec<f32>,
+    target_rows: TargetRows,
+}
+
+impl UpdateScratch {
+    /// The targets were synced: rows kept from the old ones no longer hold.
+    pub fn targets_changed(&mut self) {
+        self.target_rows.rows.clear();
+    }
+
+    /// Episodes before id `oldest` left the memory: drop their rows.
+    pub fn forget_episodes_before(&mut self, oldest: u64) {
+        self.target_rows.rows.retain(|&(_, id), _| id >= oldest);
+    }
+}
+
+/// The target nets' last hidden layer (what fc4 reads) at every kept record's next position of
+/// stored whole episodes, from one update to the next while the targets do not change: the
+/// published Overcooked and Warehouse rows sample 64 of 500-2 000 stored episodes an update and
+/// sync the targets every 5 000 steps (some 40-80 updates), so most sampled episodes were
+/// unrolled by the same target before. Rows are a function of the target's weights and the
+/// episode alone (every kernel computes a row whatever other rows it runs with), so a kept row
+/// is the bits a new unroll gives: the learner clears them at every sync, a resumed run starts
+/// with none, and neither changes a number.
+#[derive(Debug, Default)]
+struct TargetRows {
+    /// (net slot, episode id) -> [records, m1].
+    rows: HashMap<(usize, u64), Vec<f32>>,
+}
+
+/// What a TD step may keep its target's rows under: the net's slot and each batch entry's
+/// episode id (whole-episode memories only).
+struct RowKeys<'a> {
+    /// 0 for the centralized net, 1 + i for agent i's.
+    slot: usize,
+    ids: &'a [u64],
 }
 
 /// The gradient buffer for nets of `cfg`'s shape (made on first use).
@@ -365,6 +406,13 @@ fn packed_outputs(
     packing: &SeqPacking,
 ) -> (Var, Var, crate::nn::GruActorVars) {
     let vars = net.bind(tape);
+    let packed = packed_input(tape, x, width, packing);
+    let (out, h) = net.forward_with_hidden(tape, &vars, packed, packing);
+    (out, h, vars)
+}
+
+/// Flat rows `x` of `width` on `tape` in `packing`'s order.
+fn packed_input(tape: &mut Tape, x: &[f32], width: usize, packing: &SeqPacking) -> Var {
     let mut packed = tape.pool().array(packing.total(), width);
     let rows = packed
         .as_slice_mut()
@@ -373,9 +421,7 @@ fn packed_outputs(
     for (row, &f) in rows.zip(packing.packed_to_flat()) {
         row.copy_from_slice(&x[f * width..(f + 1) * width]);
     }
-    let packed = tape.constant_owned(packed);
-    let (out, h) = net.forward_with_hidden(tape, &vars, packed, packing);
-    (out, h, vars)
+    tape.constant_owned(packed)
 }
 
 /// Row `i` of a standard-layout `a` as a slice (a copy of it is one `memcpy`, not an element-wise
@@ -405,6 +451,69 @@ fn next_values(tape: &mut Tape, net: &GruActor, s: &Squeezed, into: &mut Vec<f32
         start += l + 1;
     }
     tape.reset();
+}
+
+/// `target`'s last hidden layer at each record's next position (its continuation unrolled, as
+/// [`next_values`] does, short of fc4), into `into` as [records, m1]; with `keys`, from `rows`
+/// where they hold the sequence's episode and kept there otherwise. The tape is left empty.
+fn target_features(
+    tape: &mut Tape,
+    target: &GruActor,
+    s: &Squeezed,
+    keys: Option<RowKeys>,
+    rows: &mut TargetRows,
+    into: &mut Vec<f32>,
+) {
+    let m1 = target.config().mlp[1];
+    let key = |seq: usize| keys.as_ref().map(|k| (k.slot, k.ids[s.entries[seq]]));
+    // Each sequence's first record and first continuation row.
+    let mut starts = Vec::with_capacity(s.lengths.len());
+    let mut at = 0;
+    for (seq, &l) in s.lengths.iter().enumerate() {
+        starts.push((at, at + seq));
+        at += l;
+    }
+    let missing: Vec<usize> = (0..s.lengths.len())
+        .filter(|&seq| key(seq).is_none_or(|k| !rows.rows.contains_key(&k)))
+        .collect();
+    into.clear();
+    if !missing.is_empty() {
+        let w = s.width;
+        let lengths: Vec<usize> = missing.iter().map(|&seq| s.lengths[seq] + 1).collect();
+        let mut x = Vec::with_capacity(lengths.iter().sum::<usize>() * w);
+        for (&seq, &l) in missing.iter().zip(&lengths) {
+            let c = starts[seq].1;
+            x.extend_from_slice(&s.x_next[c * w..(c + l) * w]);
+        }
+        let packing = SeqPacking::new(&lengths);
+        let vars = target.bind(tape);
+        let packed = packed_input(tape, &x, w, &packing);
+        let (a3, _) = target.features(tape, &vars, packed, &packing);
+        let a3 = tape.value(a3);
+        let mut c = 0;
+        for (&seq, &l) in missing.iter().zip(&lengths) {
+            // Record k of the sequence is continuation position k + 1.
+            let mut seq_rows = Vec::with_capacity((l - 1) * m1);
+            for f in c + 1..c + l {
+                seq_rows.extend_from_slice(row_slice(&a3, packing.flat_to_packed()[f]));
+            }
+            match key(seq) {
+                Some(k) => {
+                    rows.rows.insert(k, seq_rows);
+                }
+                // Without keys every sequence is missing, in order.
+                None => into.extend_from_slice(&seq_rows),
+            }
+            c += l;
+        }
+        tape.reset();
+    }
+    if keys.is_some() {
+        for seq in 0..s.lengths.len() {
+            let k = key(seq).expect("keys are given");
+            into.extend_from_slice(&rows.rows[&k]);
+        }
+    }
 }
 
 /// The online net's next values when `s` [`Squeezed::continues`], into `into` as [records,
@@ -467,6 +576,7 @@ fn td_step(
     mut pick: impl FnMut(usize, &[f32]) -> usize,
     hysteresis: f64,
     discount: f64,
+    keys: Option<RowKeys>,
     scratch: &mut UpdateScratch,
 ) -> TdTrace {
     let UpdateScratch {
@@ -474,6 +584,7 @@ fn td_step(
         grads,
         online_next,
         target_next,
+        target_rows,
     } = scratch;
     let n_out = q.net.config().output;
     // One online unroll gives both Q(h, a) and the next values when the continuation repeats
@@ -482,7 +593,7 @@ fn td_step(
     if !continues {
         next_values(tape, &q.net, s, online_next);
     }
-    next_values(tape, &q.target, s, target_next);
+    target_features(tape, &q.target, s, keys, target_rows, target_next);
     let packing = SeqPacking::new(&s.lengths);
     let (values, h, vars) = packed_outputs(tape, &q.net, &s.x, s.width, &packing);
     if continues {
@@ -495,9 +606,12 @@ fn td_step(
         .map(|(k, row)| pick(k, row))
         .collect();
     let d = discount as f32;
+    let m1 = q.target.config().mlp[1];
     let targets: Vec<f32> = (0..s.total())
         .map(|k| {
-            let boot = target_next[k * n_out + next_actions[k]];
+            let boot = q
+                .target
+                .output_at(&target_next[k * m1..(k + 1) * m1], next_actions[k]);
             s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
         })
         .collect();
@@ -535,10 +649,14 @@ fn agent_squeeze(batch: &[&[Step]], sub_trace_len: usize, dims: &Dims, i: usize)
 }
 
 /// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
-/// (then no net changes). `scratch` is reused memory (see [`UpdateScratch`]).
+/// (then no net changes). `ids`: each batch entry's episode id when the batch is of whole stored
+/// episodes, under which the targets' rows are kept until [`UpdateScratch::targets_changed`].
+/// `scratch` is reused memory (see [`UpdateScratch`]).
+#[allow(clippy::too_many_arguments)]
 pub fn update_dec(
     nets: &mut [QNet],
     batch: &[&[Step]],
+    ids: Option<&[u64]>,
     dims: &Dims,
     hysteresis: f64,
     discount: f64,
@@ -555,13 +673,18 @@ pub fn update_dec(
     Some(
         nets.iter_mut()
             .zip(&squeezed)
-            .map(|(q, s)| {
+            .enumerate()
+            .map(|(slot, (q, s))| {
                 td_step(
                     q,
                     s,
                     |k, row| masked_argmax(row, s.next_avail(k)),
                     hysteresis,
                     discount,
+                    ids.map(|ids| RowKeys {
+                        slot: 1 + slot,
+                        ids,
+                    }),
                     scratch,
                 )
             })
@@ -569,11 +692,13 @@ pub fn update_dec(
     )
 }
 
-/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing. `scratch`
-/// is reused memory (see [`UpdateScratch`]).
+/// MacCen-Q's iteration on the centralized net; `None` when the squeeze kept nothing. `ids` as
+/// for [`update_dec`]; `scratch` is reused memory (see [`UpdateScratch`]).
+#[allow(clippy::too_many_arguments)]
 pub fn update_cen(
     q: &mut QNet,
     batch: &[&[Step]],
+    ids: Option<&[u64]>,
     dims: &Dims,
     hysteresis: f64,
     discount: f64,
@@ -591,6 +716,7 @@ pub fn update_cen(
         |k, row| s.conditional_argmax(k, row, dims),
         hysteresis,
         discount,
+        ids.map(|ids| RowKeys { slot: 0, ids }),
         scratch,
     ))
 }
@@ -627,6 +753,7 @@ pub fn update_dec_cen(
         |k, row| s.conditional_argmax(k, row, dims),
         1.0,
         discount,
+        None,
         scratch,
     );
     prefetch_batch(dec_batch);
@@ -659,7 +786,7 @@ pub fn update_dec_cen(
                 .filter(|(r, _)| r.valid[i])
                 .map(|(_, &j)| unravel_component(j, &dims.n_actions, i))
                 .collect();
-            td_step(q, s, |k, _| a_next[k], hysteresis, discount, scratch)
+            td_step(q, s, |k, _| a_next[k], hysteresis, discount, None, scratch)
         })
         .collect();
     Some((cen_trace, dec_traces))
@@ -784,6 +911,124 @@ mod tests {
             assert_eq!(apart.len(), s.total() * cfg.output, "squeeze {k}");
             assert_eq!(bits(&shared), bits(&apart), "squeeze {k}");
         }
+    }
+
+    #[test]
+    fn the_targets_rows_give_its_values_bits_at_every_column() {
+        use rand::SeedableRng;
+        let episode = held_episode(9);
+        let batch: Vec<&[Step]> = vec![&episode[..], &episode[2..7], &episode[5..6]];
+        let s = Squeezed::joint(&batch, 1, &dims()).0;
+        let cfg = GruActorConfig {
+            input: s.width,
+            mlp: [17, 9],
+            hidden: 21,
+            output: 6,
+        };
+        let net = GruActor::new(cfg, &mut rand_chacha::ChaCha8Rng::seed_from_u64(4));
+        let mut tape = Tape::new();
+        let (mut values, mut rows) = (Vec::new(), Vec::new());
+        next_values(&mut tape, &net, &s, &mut values);
+        target_features(
+            &mut tape,
+            &net,
+            &s,
+            None,
+            &mut TargetRows::default(),
+            &mut rows,
+        );
+        assert_eq!(rows.len(), s.total() * cfg.mlp[1]);
+        for k in 0..s.total() {
+            for a in 0..cfg.output {
+                let one = net.output_at(&rows[k * 9..(k + 1) * 9], a);
+                assert_eq!(
+                    one.to_bits(),
+                    values[k * 6 + a].to_bits(),
+                    "record {k} action {a}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn kept_target_rows_change_no_number() {
+        use crate::nn::Params;
+        use rand::{Rng, SeedableRng};
+        // Five stored episodes, each its own numbers; batches of three drawn with repeats.
+        let episodes: Vec<Vec<Step>> = (0..5)
+            .map(|e| {
+                let mut ep = held_episode(6 + e);
+                for r in &mut ep {
+                    r.obs
+                        .iter_mut()
+                        .chain(&mut r.next_obs)
+                        .for_each(|o| *o += e as f32 * 0.1);
+                }
+                ep
+            })
+            .collect();
+        let cfg = |input, output| GruActorConfig {
+            input,
+            mlp: [8, 5],
+            hidden: 7,
+            output,
+        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let dec = vec![
+            QNet::new(cfg(1, 2), 1e-2, &mut rng),
+            QNet::new(cfg(1, 3), 1e-2, &mut rng),
+        ];
+        let cen = QNet::new(cfg(2, 6), 1e-2, &mut rng);
+        let (mut dec_kept, mut cen_kept) = (dec.clone(), cen.clone());
+        let (mut dec_fresh, mut cen_fresh) = (dec, cen);
+        let (mut kept, mut fresh) = (UpdateScratch::default(), UpdateScratch::default());
+        for update in 0..12 {
+            let picks: Vec<usize> = rand::seq::index::sample(&mut rng, 5, 3).into_vec();
+            let ids: Vec<u64> = picks.iter().map(|&p| p as u64).collect();
+            let batch: Vec<&[Step]> = picks.iter().map(|&p| &episodes[p][..]).collect();
+            let h = rng.gen_range(0.2..1.0);
+            let a = update_dec(
+                &mut dec_kept,
+                &batch,
+                Some(&ids),
+                &dims(),
+                h,
+                0.9,
+                1,
+                &mut kept,
+            );
+            let b = update_dec(&mut dec_fresh, &batch, None, &dims(), h, 0.9, 1, &mut fresh);
+            assert_eq!(a, b, "update {update}");
+            let a = update_cen(
+                &mut cen_kept,
+                &batch,
+                Some(&ids),
+                &dims(),
+                h,
+                0.9,
+                1,
+                &mut kept,
+            );
+            let b = update_cen(&mut cen_fresh, &batch, None, &dims(), h, 0.9, 1, &mut fresh);
+            assert_eq!(a, b, "update {update}");
+            if update == 5 {
+                for q in dec_kept.iter_mut().chain(dec_fresh.iter_mut()) {
+                    q.target.copy_values_from(&q.net);
+                }
+                for q in [&mut cen_kept, &mut cen_fresh] {
+                    q.target.copy_values_from(&q.net);
+                }
+                kept.targets_changed();
+            }
+        }
+        let bytes = |q: &QNet| bincode::serialize(q).unwrap();
+        for (x, y) in dec_kept.iter().zip(&dec_fresh) {
+            assert_eq!(bytes(x), bytes(y));
+        }
+        assert_eq!(bytes(&cen_kept), bytes(&cen_fresh));
+        assert!(!kept.target_rows.rows.is_empty());
+        kept.forget_episodes_before(3);
+        assert!(kept.target_rows.rows.keys().all(|&(_, id)| id >= 3));
     }
 
     #[test]

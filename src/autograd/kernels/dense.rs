@@ -58,6 +58,45 @@ pub fn linear_forward(
     bias_act_rows(out, b, slope);
 }
 
+/// Column `col` of [`linear_forward`]'s output for one input row: act(x · w\[col, :\] + b\[col\])
+/// with the bits the whole layer gives there, whatever the CPU (the product's arithmetic, see
+/// [`super::gemm`]: per block of `K_BLOCK` consecutive k a chain of fused multiply-adds from 0,
+/// each block's sum added to the ones before, then the bias). For a caller that needs a layer at
+/// one column per row (a Q-net's value of one chosen action) instead of all of them. Panics if
+/// `col` is out of range or `x` is not a row of `w`'s width.
+pub fn linear_forward_at(
+    x: &[f32],
+    w: ArrayView2<f32>,
+    b: &[f32],
+    act: Activation,
+    col: usize,
+) -> f32 {
+    assert_eq!(x.len(), w.ncols(), "linear_at: input width");
+    let row = w.row(col);
+    let mut sum = 0.0f32;
+    let mut k0 = 0;
+    while k0 < x.len() {
+        let end = (k0 + super::gemm::K_BLOCK).min(x.len());
+        let mut acc = 0.0f32;
+        for k in k0..end {
+            acc = x[k].mul_add(row[k], acc);
+        }
+        sum = if k0 == 0 { acc } else { acc + sum };
+        k0 = end;
+    }
+    let z = sum + b[col];
+    match act {
+        Activation::Identity => 1.0 * z,
+        Activation::LeakyRelu(slope) => {
+            if z > 0.0 {
+                z
+            } else {
+                slope * z
+            }
+        }
+    }
+}
+
 simd_dispatch! {
     /// Each row of `rows` (rows of b.len() values): z = row + b, then z for z > 0, slope * z
     /// otherwise (slope 1 is the identity).
@@ -276,6 +315,31 @@ simd_dispatch! {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_column_is_the_whole_layers_bits() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        // Widths inside one product block, on its edge and across two and three blocks.
+        for k in [1, 7, 64, 384, 385, 800, 1200] {
+            let (m, n) = (5, 19);
+            let mut r = |len| -> Vec<f32> { (0..len).map(|_| rng.gen_range(-2.0..2.0)).collect() };
+            let x = ndarray::Array2::from_shape_vec((m, k), r(m * k)).unwrap();
+            let w = ndarray::Array2::from_shape_vec((n, k), r(n * k)).unwrap();
+            let b = r(n);
+            for act in [Activation::Identity, Activation::LEAKY_001] {
+                let mut y = ndarray::Array2::zeros((m, n));
+                linear_forward(x.view(), w.view(), &b, act, y.view_mut());
+                for i in 0..m {
+                    let row = x.row(i).to_vec();
+                    for j in 0..n {
+                        let one = linear_forward_at(&row, w.view(), &b, act, j);
+                        assert_eq!(one.to_bits(), y[[i, j]].to_bits(), "k {k} row {i} col {j}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn dot_handles_lengths_that_are_not_multiples_of_eight() {
