@@ -364,6 +364,34 @@ impl GruActor {
         )
     }
 
+    /// fc4's output at column `cols[r]` of each row r of `a3` ([`Self::features`] on `tape`):
+    /// [r, 1], [`Tape::linear_at`] (the value of the action taken, whose gradient reaches one
+    /// row of fc4 per row instead of all of them).
+    pub fn output_taken(
+        &self,
+        tape: &mut Tape,
+        vars: &GruActorVars,
+        a3: Var,
+        cols: &[usize],
+    ) -> Var {
+        tape.linear_at(a3, vars.fc4.weight, vars.fc4.bias, cols)
+    }
+
+    /// fc4's output over rows `a3` of [`Self::features`] without the tape: the bits of
+    /// [`Self::forward`].
+    pub fn output_rows(&self, a3: ArrayView2<f32>) -> Array2<f32> {
+        let p = &self.fc4;
+        let mut y = Array2::zeros((a3.nrows(), p.output()));
+        linear_forward(
+            a3,
+            p.weight.view(),
+            flat(&p.bias),
+            Activation::Identity,
+            y.view_mut(),
+        );
+        y
+    }
+
     /// What fc4 reads, leaky(fc3(h)): [K, m1], and the GRU's output h: [K, H] (packed order):
     /// [`Self::forward_with_hidden`] short of its last layer, for a caller that needs fc4 at one
     /// column per row ([`crate::autograd::kernels::dense::linear_forward_at`] gives the same

@@ -16,6 +16,11 @@ pub fn hysteretic_td_loss(
     h: f32,
 ) -> Var {
     let q_taken = tape.gather_cols(q, actions);
+    hysteretic_td_loss_taken(tape, q_taken, y, h)
+}
+
+/// [`hysteretic_td_loss`] given the values of the actions taken, q_taken: [K, 1].
+pub fn hysteretic_td_loss_taken(tape: &mut Tape, q_taken: Var, y: ArrayView1<f32>, h: f32) -> Var {
     let y = tape.constant(y.insert_axis(Axis(1)));
     let delta = tape.sub(y, q_taken);
     let delta = if h == 1.0 {

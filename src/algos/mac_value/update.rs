@@ -37,7 +37,7 @@ use super::prefetch::prefetch_batch;
 use crate::autograd::{SeqPacking, Tape, Var};
 use crate::nn::argmax::{first_argmax, FirstArgmax};
 use crate::nn::joint_index::{for_each_allowed, ravel, unravel_component};
-use crate::nn::loss::hysteretic_td_loss;
+use crate::nn::loss::hysteretic_td_loss_taken;
 use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig};
 
 /// A Q-net (MacroMARL's `DDRQN`: fc1, fc2, GRU, fc3, fc4, the actor's layers), its target and
@@ -595,10 +595,12 @@ fn td_step(
     }
     target_features(tape, &q.target, s, keys, target_rows, target_next);
     let packing = SeqPacking::new(&s.lengths);
-    let (values, h, vars) = packed_outputs(tape, &q.net, &s.x, s.width, &packing);
+    let vars = q.net.bind(tape);
+    let packed = packed_input(tape, &s.x, s.width, &packing);
+    let (a3, h) = q.net.features(tape, &vars, packed, &packing);
     if continues {
-        let (out, h) = (tape.value(values), tape.value(h));
-        next_values_from_unroll(&q.net, out, h, &packing, s, online_next);
+        let out = q.net.output_rows(tape.value(a3));
+        next_values_from_unroll(&q.net, out.view(), tape.value(h), &packing, s, online_next);
     }
     let next_actions: Vec<usize> = online_next
         .chunks_exact(n_out)
@@ -615,9 +617,15 @@ fn td_step(
             s.rewards[k] + d * s.gammas[k] * boot * (1.0 - s.terminals[k])
         })
         .collect();
+    // Q(h, a) of the action taken, in packed order, then in the records' order.
+    let mut taken = vec![0; s.total()];
+    for (&p, &a) in packing.flat_to_packed().iter().zip(&s.actions) {
+        taken[p] = a;
+    }
+    let values = q.net.output_taken(tape, &vars, a3, &taken);
     let values = tape.gather_rows(values, packing.flat_to_packed());
     let y = ArrayView1::from(&targets[..]);
-    let loss = hysteretic_td_loss(tape, values, &s.actions, y, hysteresis as f32);
+    let loss = hysteretic_td_loss_taken(tape, values, y, hysteresis as f32);
     let loss_value = tape.scalar(loss);
     tape.backward(loss);
     let grads = grads_for(grads, q.net.config());

@@ -73,6 +73,57 @@ pub fn linear_forward_at(
 ) -> f32 {
     assert_eq!(x.len(), w.ncols(), "linear_at: input width");
     let row = w.row(col);
+    let row = row.as_slice().expect("weights are contiguous rows");
+    #[cfg(target_arch = "x86_64")]
+    if has_fma() {
+        // SAFETY: the CPU has FMA (checked just above).
+        return unsafe { linear_forward_at_fma(x, row, b[col], act) };
+    }
+    linear_forward_at_imp(x, row, b[col], act)
+}
+
+/// acc\[i\] = fma(g, x\[i\], acc\[i\]) for every i: one row's term of a product's chains (the
+/// fused multiply-add `mul_add` computes, as an instruction where the CPU has one). Panics if
+/// the lengths differ.
+pub fn fma_row_into(g: f32, x: &[f32], acc: &mut [f32]) {
+    assert_eq!(x.len(), acc.len(), "fma_row_into: lengths");
+    #[cfg(target_arch = "x86_64")]
+    if has_fma() {
+        // SAFETY: the CPU has FMA (checked just above).
+        return unsafe { fma_row_into_fma(g, x, acc) };
+    }
+    fma_row_into_imp(g, x, acc)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn fma_row_into_fma(g: f32, x: &[f32], acc: &mut [f32]) {
+    fma_row_into_imp(g, x, acc)
+}
+
+#[inline(always)]
+fn fma_row_into_imp(g: f32, x: &[f32], acc: &mut [f32]) {
+    for (a, &v) in acc.iter_mut().zip(x) {
+        *a = g.mul_add(v, *a);
+    }
+}
+
+/// Whether the CPU has FMA (checked once): `mul_add` is then one instruction instead of a call
+/// into libm's `fmaf`, with the same result.
+#[cfg(target_arch = "x86_64")]
+fn has_fma() -> bool {
+    static HAS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *HAS.get_or_init(|| std::arch::is_x86_feature_detected!("fma"))
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+unsafe fn linear_forward_at_fma(x: &[f32], row: &[f32], b: f32, act: Activation) -> f32 {
+    linear_forward_at_imp(x, row, b, act)
+}
+
+#[inline(always)]
+fn linear_forward_at_imp(x: &[f32], row: &[f32], b: f32, act: Activation) -> f32 {
     let mut sum = 0.0f32;
     let mut k0 = 0;
     while k0 < x.len() {
@@ -84,7 +135,7 @@ pub fn linear_forward_at(
         sum = if k0 == 0 { acc } else { acc + sum };
         k0 = end;
     }
-    let z = sum + b[col];
+    let z = sum + b;
     match act {
         Activation::Identity => 1.0 * z,
         Activation::LeakyRelu(slope) => {

@@ -4,8 +4,10 @@
 use ndarray::{Array2, ArrayView2, Axis};
 
 use super::{put, Op};
-use crate::autograd::kernels::dense::{act_backward_rows, add_column_sums, linear_forward};
-use crate::autograd::kernels::gemm::{gemm, Mode};
+use crate::autograd::kernels::dense::{
+    act_backward_rows, add_column_sums, fma_row_into, linear_forward, linear_forward_at,
+};
+use crate::autograd::kernels::gemm::{gemm, Mode, K_BLOCK};
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 use crate::autograd::kernels::dense::Activation;
@@ -74,6 +76,32 @@ impl Tape {
             y.view_mut(),
         );
         self.push_op(y, Op::Linear { x, w, b, act }, &[x, w, b])
+    }
+
+    /// The fused linear layer without activation at one column per row: y[r, 0] = (x · w^T +
+    /// b)[r, cols\[r\]] with x: [m, k], w: [n, k], b: [1, n] (a Q-net's value of the action
+    /// taken, whose loss reads no other column). Values have the bits of `linear` then
+    /// `gather_cols`; so do the gradients, but for the sign of a zero result (the composition
+    /// also adds the other columns' zero gradients, which turns -0 into +0), which no number
+    /// downstream can show: a gradient only enters products and sums. The backward reads one
+    /// row of w per row of x instead of all n. Panics on mismatched shapes or a column out of
+    /// range.
+    pub fn linear_at(&mut self, x: Var, w: Var, b: Var, cols: &[usize]) -> Var {
+        let ((m, k), (n, k2), bs) = (self.shape(x), self.shape(w), self.shape(b));
+        assert_eq!(k, k2, "linear_at: x [{m}, {k}] vs weight [{n}, {k2}]");
+        assert_eq!(bs, (1, n), "linear_at: bias must be [1, {n}], got {bs:?}");
+        assert_eq!(cols.len(), m, "linear_at: one column per row");
+        let mut y = self.pool().array(m, 1);
+        let (vx, vw, vb) = (self.value(x), self.value(w), self.value(b));
+        let bias = vb.as_slice().expect("tape arrays are contiguous");
+        for (r, &c) in cols.iter().enumerate() {
+            assert!(c < n, "linear_at: column {c} out of range 0..{n}");
+            let row = vx.row(r);
+            let row = row.as_slice().expect("tape arrays are contiguous");
+            y[[r, 0]] = linear_forward_at(row, vw, bias, Activation::Identity, c);
+        }
+        let cols = cols.to_vec();
+        self.push_op(y, Op::LinearAt { x, w, b, cols }, &[x, w, b])
     }
 }
 
@@ -197,10 +225,139 @@ pub(super) fn linear_backward(
     }
 }
 
+// y[r] = x[r] · w[c_r] + b[c_r]: the dense backward of `linear` with a gradient that is zero
+// outside column c_r of each row, term by term in the same order (the products' blocks of
+// K_BLOCK rows included), the zero terms left out.
+pub(super) fn linear_at_backward(
+    x: Var,
+    w: Var,
+    b: Var,
+    cols: &[usize],
+    g: &Array2<f32>,
+    cx: &mut GradCx,
+) {
+    let (vx, vw) = (cx.value(x), cx.value(w));
+    let g = g.as_slice().expect("tape arrays are contiguous");
+    let (n, k) = vw.dim();
+    let mut sums = cx.pool.zeros(1, n);
+    for (&c, &gr) in cols.iter().zip(g) {
+        sums[[0, c]] += gr;
+    }
+    if let Some((d, mode)) = cx.slot(b) {
+        put!(mode, d, &sums; |s| s);
+    }
+    cx.pool.give_array(sums);
+    let mut acc_rows = cx.pool.zeros(n, k);
+    if let Some((d, mode)) = cx.slot(w) {
+        if mode == Mode::Overwrite {
+            d.fill(0.0);
+        }
+        let d = d.as_slice_mut().expect("tape arrays are contiguous");
+        let acc = acc_rows.as_slice_mut().expect("pool arrays are contiguous");
+        let mut touched = vec![false; n];
+        for start in (0..cols.len()).step_by(K_BLOCK) {
+            let end = (start + K_BLOCK).min(cols.len());
+            for r in start..end {
+                let c = cols[r];
+                touched[c] = true;
+                let xr = vx.row(r);
+                let xr = xr.as_slice().expect("tape arrays are contiguous");
+                fma_row_into(g[r], xr, &mut acc[c * k..(c + 1) * k]);
+            }
+            for c in 0..n {
+                if std::mem::take(&mut touched[c]) {
+                    let (a, dst) = (&mut acc[c * k..(c + 1) * k], &mut d[c * k..(c + 1) * k]);
+                    for (av, dv) in a.iter_mut().zip(dst) {
+                        *dv += *av;
+                        *av = 0.0;
+                    }
+                }
+            }
+        }
+    }
+    cx.pool.give_array(acc_rows);
+    if let Some((d, mode)) = cx.slot(x) {
+        // fma(g, w, 0) then, accumulating, + d: the dense chain's one nonzero term.
+        let mut row = vec![0.0f32; k];
+        for (r, &c) in cols.iter().enumerate() {
+            let wr = vw.row(c);
+            row.fill(0.0);
+            fma_row_into(
+                g[r],
+                wr.as_slice().expect("tape arrays are contiguous"),
+                &mut row,
+            );
+            let mut dr = d.row_mut(r);
+            let dr = dr.as_slice_mut().expect("tape arrays are contiguous");
+            match mode {
+                Mode::Overwrite => dr.copy_from_slice(&row),
+                Mode::Accumulate => dr.iter_mut().zip(&row).for_each(|(dv, &v)| *dv += v),
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::grad_check::{grad_check, Inputs};
     use super::*;
+
+    #[test]
+    fn linear_at_matches_finite_differences() {
+        grad_check(
+            |t, v| t.linear_at(v[0], v[1], v[2], &[2, 0, 2, 1, 3]),
+            &[(5, 3), (4, 3), (1, 4)],
+            Inputs::Any,
+        );
+    }
+
+    #[test]
+    fn linear_at_is_linear_then_gather_cols() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        // Rows across two product blocks, outputs across two (the input gradient's blocks), and
+        // x used twice so its gradient also accumulates.
+        for (m, k, n) in [(7, 5, 3), (900, 64, 225), (50, 9, 400)] {
+            let mut r =
+                |rows, cols| Array2::from_shape_fn((rows, cols), |_| rng.gen_range(-1.0f32..1.0));
+            let (x, w, b, other) = (r(m, k), r(n, k), r(1, n), r(m, k));
+            let cols: Vec<usize> = (0..m).map(|_| rng.gen_range(0..n)).collect();
+            let run = |sparse: bool| {
+                let mut t = Tape::new();
+                let (vx, vw, vb) = (t.param(x.view()), t.param(w.view()), t.param(b.view()));
+                let q = if sparse {
+                    t.linear_at(vx, vw, vb, &cols)
+                } else {
+                    let all = t.linear(vx, vw, vb, Activation::Identity);
+                    t.gather_cols(all, &cols)
+                };
+                let o = t.constant(other.view());
+                let xo = t.mul(vx, o);
+                let xs = t.mean(xo);
+                let sq = t.square(q);
+                let l = t.mean(sq);
+                let total = t.add(l, xs);
+                t.backward(total);
+                let grads: Vec<Array2<f32>> = [vx, vw, vb]
+                    .iter()
+                    .map(|&v| t.grad(v).unwrap().to_owned())
+                    .collect();
+                (t.value(q).to_owned(), grads)
+            };
+            let (dense, sparse) = (run(false), run(true));
+            let bits = |a: &Array2<f32>| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&dense.0), bits(&sparse.0), "values, {m}x{k}x{n}");
+            for (i, (d, s)) in dense.1.iter().zip(&sparse.1).enumerate() {
+                // Equal as numbers (a zero's sign may differ), and bit for bit where not zero.
+                assert_eq!(d, s, "gradient {i}, {m}x{k}x{n}");
+                for (a, b) in d.iter().zip(s) {
+                    if *a != 0.0 {
+                        assert_eq!(a.to_bits(), b.to_bits(), "gradient {i}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn matmul_matches_finite_differences() {

@@ -6,7 +6,7 @@
 //! | file | ops |
 //! | --- | --- |
 //! | `elementwise.rs` | `add`, `sub`, `mul`, `scale`, `sigmoid`, `tanh`, `leaky_relu`, `square`, `exp`, `log` |
-//! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `matmul_bias` and `linear` (fused) |
+//! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `matmul_bias`, `linear` (fused) and `linear_at` (one column per row) |
 //! | `softmax.rs` | `softmax`, `log_softmax`, `logsumexp` (row-wise) |
 //! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows`, `reshape` |
 //! | `reduce.rs` | `sum`, `mean`, `masked_mean` |
@@ -68,6 +68,12 @@ pub(crate) enum Op {
         w: Var,
         b: Var,
         act: Activation,
+    },
+    LinearAt {
+        x: Var,
+        w: Var,
+        b: Var,
+        cols: Vec<usize>,
     },
     Add {
         a: Var,
@@ -179,6 +185,7 @@ impl Op {
             Op::AddBias { x, bias } => matmul::add_bias_backward(*x, *bias, g, cx),
             Op::MatMulBias { a, b, bias } => matmul::matmul_bias_backward(*a, *b, *bias, g, cx),
             Op::Linear { x, w, b, act } => matmul::linear_backward(*x, *w, *b, *act, y, g, cx),
+            Op::LinearAt { x, w, b, cols } => matmul::linear_at_backward(*x, *w, *b, cols, g, cx),
             Op::Add { a, b } => elementwise::add_backward(*a, *b, g, cx),
             Op::Sub { a, b } => elementwise::sub_backward(*a, *b, g, cx),
             Op::Mul { a, b } => elementwise::mul_backward(*a, *b, g, cx),
