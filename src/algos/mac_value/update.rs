@@ -466,12 +466,12 @@ fn target_features(
 ) {
     let m1 = target.config().mlp[1];
     let key = |seq: usize| keys.as_ref().map(|k| (k.slot, k.ids[s.entries[seq]]));
-    // Each sequence's first record and first continuation row.
+    // Each sequence's first continuation row in x_next (L + 1 rows a sequence).
     let mut starts = Vec::with_capacity(s.lengths.len());
     let mut at = 0;
-    for (seq, &l) in s.lengths.iter().enumerate() {
-        starts.push((at, at + seq));
-        at += l;
+    for &l in &s.lengths {
+        starts.push(at);
+        at += l + 1;
     }
     let missing: Vec<usize> = (0..s.lengths.len())
         .filter(|&seq| key(seq).is_none_or(|k| !rows.rows.contains_key(&k)))
@@ -482,7 +482,7 @@ fn target_features(
         let lengths: Vec<usize> = missing.iter().map(|&seq| s.lengths[seq] + 1).collect();
         let mut x = Vec::with_capacity(lengths.iter().sum::<usize>() * w);
         for (&seq, &l) in missing.iter().zip(&lengths) {
-            let c = starts[seq].1;
+            let c = starts[seq];
             x.extend_from_slice(&s.x_next[c * w..(c + l) * w]);
         }
         let packing = SeqPacking::new(&lengths);
