@@ -380,16 +380,7 @@ impl GruActor {
     /// fc4's output over rows `a3` of [`Self::features`] without the tape: the bits of
     /// [`Self::forward`].
     pub fn output_rows(&self, a3: ArrayView2<f32>) -> Array2<f32> {
-        let p = &self.fc4;
-        let mut y = Array2::zeros((a3.nrows(), p.output()));
-        linear_forward(
-            a3,
-            p.weight.view(),
-            flat(&p.bias),
-            Activation::Identity,
-            y.view_mut(),
-        );
-        y
+        layer_rows(&self.fc4, a3, Activation::Identity)
     }
 
     /// What fc4 reads, leaky(fc3(h)): [K, m1], and the GRU's output h: [K, H] (packed order):
@@ -415,14 +406,8 @@ impl GruActor {
     /// its own, so row i has the bits [`Self::forward`] gives sequence i made one step longer
     /// with that input. Panics if the sizes do not match the net.
     pub fn continue_rows(&self, x: ArrayView2<f32>, h: ArrayView2<f32>) -> Array2<f32> {
-        let n = x.nrows();
-        let layer = |p: &LinearParams, input: ArrayView2<f32>, act| {
-            let mut y = Array2::zeros((n, p.output()));
-            linear_forward(input, p.weight.view(), flat(&p.bias), act, y.view_mut());
-            y
-        };
-        let a1 = layer(&self.fc1, x, LEAKY);
-        let a2 = layer(&self.fc2, a1.view(), LEAKY);
+        let a1 = layer_rows(&self.fc1, x, LEAKY);
+        let a2 = layer_rows(&self.fc2, a1.view(), LEAKY);
         let g = &self.gru;
         let weights = GruWeights {
             w_ih: g.weight_ih.view(),
@@ -430,11 +415,18 @@ impl GruActor {
             b_ih: flat(&g.bias_ih),
             b_hh: flat(&g.bias_hh),
         };
-        let mut h_next = Array2::zeros((n, self.config().hidden));
+        let mut h_next = Array2::zeros((x.nrows(), self.config().hidden));
         gru_step(a2.view(), &weights, h, &mut h_next);
-        let a3 = layer(&self.fc3, h_next.view(), LEAKY);
-        layer(&self.fc4, a3.view(), Activation::Identity)
+        let a3 = layer_rows(&self.fc3, h_next.view(), LEAKY);
+        self.output_rows(a3.view())
     }
+}
+
+/// Layer `p` over rows `x` without the tape (the taped layer's kernel, so its bits).
+fn layer_rows(p: &LinearParams, x: ArrayView2<f32>, act: Activation) -> Array2<f32> {
+    let mut y = Array2::zeros((x.nrows(), p.output()));
+    linear_forward(x, p.weight.view(), flat(&p.bias), act, y.view_mut());
+    y
 }
 
 impl GruActorVars {

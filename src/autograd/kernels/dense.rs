@@ -135,17 +135,7 @@ fn linear_forward_at_imp(x: &[f32], row: &[f32], b: f32, act: Activation) -> f32
         sum = if k0 == 0 { acc } else { acc + sum };
         k0 = end;
     }
-    let z = sum + b;
-    match act {
-        Activation::Identity => 1.0 * z,
-        Activation::LeakyRelu(slope) => {
-            if z > 0.0 {
-                z
-            } else {
-                slope * z
-            }
-        }
-    }
+    act.apply(sum + b)
 }
 
 simd_dispatch! {
