@@ -93,6 +93,20 @@ macromarl_value_lane() {
             train_macromarl_value "$block" --seeds "$first..$((first + 5))"
         done
     done
+    # A run a previous session left with a checkpoint (the machine outlived it) goes first.
+    for dir in "$OUT"/macromarl_value/*/*/seed-*; do
+        if [[ -f $dir/checkpoint.bin && ! -f $dir/finished ]]; then
+            seed=${dir##*/seed-}
+            method=$(basename "$(dirname "$dir")")
+            block=$(basename "$(dirname "$(dirname "$dir")")")
+            train_macromarl_value "$block" --seeds "$seed" --methods "$method" </dev/null
+        fi
+    done
+    # MacDec-Q on Overcooked next (about an hour of a core a run: it finishes within a session
+    # on a fresh machine), then MacCen-Q and the Warehouse (several hours a run).
+    for block in overcooked_a overcooked_b; do
+        train_macromarl_value "$block" --seeds 0..5 --methods mac-dec-q
+    done
     for block in overcooked_a overcooked_b wh_a wh_b wh_c; do
         train_macromarl_value "$block" --seeds 0..5
     done
