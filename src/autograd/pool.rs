@@ -41,7 +41,7 @@ impl Pool {
     /// A [rows, cols] array of zeros.
     pub fn zeros(&mut self, rows: usize, cols: usize) -> Array2<f32> {
         let mut a = self.array(rows, cols);
-        a.fill(0.0);
+        zero(&mut a);
         a
     }
 
@@ -65,6 +65,15 @@ impl Pool {
     /// Number of buffers held.
     pub fn buffers_held(&self) -> usize {
         self.free.values().map(Vec::len).sum()
+    }
+}
+
+/// a = 0 everywhere: one `memset` for a contiguous array (ndarray's `fill` stores element by
+/// element).
+pub(crate) fn zero(a: &mut Array2<f32>) {
+    match a.as_slice_mut() {
+        Some(s) => s.fill(0.0),
+        None => a.fill(0.0),
     }
 }
 

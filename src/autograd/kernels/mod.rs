@@ -2,6 +2,7 @@
 
 pub mod activations;
 pub mod dense;
+pub mod elementwise;
 pub mod exp;
 pub mod gemm;
 pub mod gru;

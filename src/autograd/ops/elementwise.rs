@@ -5,6 +5,8 @@ use ndarray::{Array2, Zip};
 
 use super::{put, Op};
 use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace};
+use crate::autograd::kernels::elementwise::{add_into, mul_into, put_copy, put_mul};
+use crate::autograd::kernels::gemm::Mode;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 impl Tape {
@@ -28,9 +30,30 @@ impl Tape {
         y
     }
 
+    /// y = kernel(a, b) over the (contiguous) values; panics if the shapes differ.
+    fn binary_slices(
+        &mut self,
+        a: Var,
+        b: Var,
+        what: &str,
+        kernel: fn(&[f32], &[f32], &mut [f32]),
+    ) -> Array2<f32> {
+        let shape = self.shape(a);
+        assert_eq!(shape, self.shape(b), "{what}: shapes differ");
+        let mut y = self.pool().array(shape.0, shape.1);
+        let contiguous = "tape arrays are contiguous";
+        let (va, vb) = (self.value(a), self.value(b));
+        kernel(
+            va.as_slice().expect(contiguous),
+            vb.as_slice().expect(contiguous),
+            y.as_slice_mut().expect(contiguous),
+        );
+        y
+    }
+
     /// y = a + b (same shapes; see [`Tape::add_bias`] for broadcasting a row).
     pub fn add(&mut self, a: Var, b: Var) -> Var {
-        let y = self.binary(a, b, "add", |a, b| a + b);
+        let y = self.binary_slices(a, b, "add", add_into);
         self.push_op(y, Op::Add { a, b }, &[a, b])
     }
 
@@ -42,7 +65,7 @@ impl Tape {
 
     /// y = a * b elementwise (same shapes).
     pub fn mul(&mut self, a: Var, b: Var) -> Var {
-        let y = self.binary(a, b, "mul", |a, b| a * b);
+        let y = self.binary_slices(a, b, "mul", mul_into);
         self.push_op(y, Op::Mul { a, b }, &[a, b])
     }
 
@@ -103,9 +126,11 @@ impl Tape {
 
 // d(a + b) = da + db
 pub(super) fn add_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
+    let gs = g.as_slice().expect("tape arrays are contiguous");
     for v in [a, b] {
         if let Some((d, mode)) = cx.slot(v) {
-            put!(mode, d, g; |g| g);
+            let ds = d.as_slice_mut().expect("tape arrays are contiguous");
+            put_copy(ds, gs, mode == Mode::Accumulate);
         }
     }
 }
@@ -123,11 +148,25 @@ pub(super) fn sub_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
 // d(a * b) = b da + a db (a fan-out mul(x, x) gets both terms: 2 x dx)
 pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     let (va, vb) = (cx.value(a), cx.value(b));
+    let contiguous = "tape arrays are contiguous";
+    let gs = g.as_slice().expect(contiguous);
     if let Some((d, mode)) = cx.slot(a) {
-        put!(mode, d, g, vb; |g, b| g * b);
+        let ds = d.as_slice_mut().expect(contiguous);
+        put_mul(
+            ds,
+            gs,
+            vb.as_slice().expect(contiguous),
+            mode == Mode::Accumulate,
+        );
     }
     if let Some((d, mode)) = cx.slot(b) {
-        put!(mode, d, g, va; |g, a| g * a);
+        let ds = d.as_slice_mut().expect(contiguous);
+        put_mul(
+            ds,
+            gs,
+            va.as_slice().expect(contiguous),
+            mode == Mode::Accumulate,
+        );
     }
 }
 

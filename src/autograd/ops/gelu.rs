@@ -15,13 +15,9 @@ use ndarray::Array2;
 
 use super::Op;
 use crate::autograd::kernels::activations::tanh_inplace;
+use crate::autograd::kernels::elementwise::{gelu_argument, gelu_backward, gelu_output};
 use crate::autograd::kernels::gemm::Mode;
 use crate::autograd::tape::{GradCx, Tape, Var};
-
-/// sqrt(2 / pi), as `math.sqrt(2.0 / math.pi)` rounded to f32.
-const SQRT_2_OVER_PI: f32 = 0.797_884_6;
-/// The cubic term's coefficient.
-const CUBIC: f32 = 0.044_715;
 /// Elements per block of the forward.
 const BLOCK: usize = 512;
 
@@ -46,13 +42,9 @@ impl Tape {
                 .zip(ys.chunks_mut(BLOCK))
                 .zip(xs.chunks(BLOCK))
             {
-                for (t, &x) in tb.iter_mut().zip(xb) {
-                    *t = SQRT_2_OVER_PI * (x + CUBIC * (x * x * x));
-                }
+                gelu_argument(xb, tb);
                 tanh_inplace(tb);
-                for ((y, &x), &t) in yb.iter_mut().zip(xb).zip(tb.iter()) {
-                    *y = 0.5 * x * (1.0 + t);
-                }
+                gelu_output(xb, tb, yb);
             }
         }
         let t = self.push_aux(t);
@@ -70,15 +62,8 @@ pub(super) fn gelu_tanh_backward(x: Var, t: Var, g: &Array2<f32>, cx: &mut GradC
             vx.as_slice().expect(contiguous),
             vt.as_slice().expect(contiguous),
         );
-        let dydx = |x: f32, t: f32| {
-            0.5 * (1.0 + t) + 0.5 * x * (1.0 - t * t) * SQRT_2_OVER_PI * (1.0 + 3.0 * CUBIC * x * x)
-        };
         let ds = d.as_slice_mut().expect(contiguous);
-        let rows = ds.iter_mut().zip(gs).zip(xs).zip(ts);
-        match mode {
-            Mode::Overwrite => rows.for_each(|(((d, &g), &x), &t)| *d = g * dydx(x, t)),
-            Mode::Accumulate => rows.for_each(|(((d, &g), &x), &t)| *d += g * dydx(x, t)),
-        }
+        gelu_backward(ds, gs, xs, ts, mode == Mode::Accumulate);
     }
 }
 
@@ -88,6 +73,7 @@ mod tests {
 
     use super::super::grad_check::{assert_close, grad_check, random_inputs, Inputs};
     use super::*;
+    use crate::autograd::kernels::elementwise::{GELU_CUBIC, GELU_SQRT_2_OVER_PI};
 
     #[test]
     fn gelu_tanh_matches_finite_differences() {
@@ -127,9 +113,9 @@ mod tests {
             } else {
                 let sq = t.square(xv);
                 let cube = t.mul(sq, xv);
-                let c = t.scale(cube, CUBIC);
+                let c = t.scale(cube, GELU_CUBIC);
                 let inner = t.add(xv, c);
-                let u = t.scale(inner, SQRT_2_OVER_PI);
+                let u = t.scale(inner, GELU_SQRT_2_OVER_PI);
                 let th = t.tanh(u);
                 let one = t.constant(Array2::ones(x.dim()).view());
                 let opt = t.add(one, th);

@@ -7,7 +7,9 @@ use super::{put, Op};
 use crate::autograd::kernels::dense::{
     act_backward_rows, add_column_sums, fma_row_into, linear_forward, linear_forward_at,
 };
+use crate::autograd::kernels::elementwise;
 use crate::autograd::kernels::gemm::{gemm, Mode, K_BLOCK};
+use crate::autograd::pool::zero;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 use crate::autograd::kernels::dense::Activation;
@@ -107,20 +109,11 @@ impl Tape {
 
 /// y += bias row by row (y: [m, n] from the pool, bias: [1, n]).
 fn add_bias_rows(y: &mut Array2<f32>, bias: ArrayView2<f32>) {
-    let n = y.ncols();
     let b = bias.as_slice().expect("tape arrays are contiguous");
-    if n == 0 {
+    if y.ncols() == 0 {
         return;
     }
-    for row in y
-        .as_slice_mut()
-        .expect("pool arrays are contiguous")
-        .chunks_exact_mut(n)
-    {
-        for (v, &b) in row.iter_mut().zip(b) {
-            *v += b;
-        }
-    }
+    elementwise::add_bias_rows(y.as_slice_mut().expect("pool arrays are contiguous"), b);
 }
 
 // y = a b + 1 bias: as add_bias (bias) then matmul (a, b), with g for the product's gradient.
@@ -250,7 +243,7 @@ pub(super) fn linear_at_backward(
     let mut acc_rows = cx.pool.zeros(n, k);
     if let Some((d, mode)) = cx.slot(w) {
         if mode == Mode::Overwrite {
-            d.fill(0.0);
+            zero(d);
         }
         let d = d.as_slice_mut().expect("tape arrays are contiguous");
         let acc = acc_rows.as_slice_mut().expect("pool arrays are contiguous");

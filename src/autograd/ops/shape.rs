@@ -7,6 +7,7 @@ use ndarray::{s, Array2, Axis};
 use super::put;
 use super::Op;
 use crate::autograd::kernels::gemm::Mode;
+use crate::autograd::pool::zero;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 impl Tape {
@@ -180,7 +181,7 @@ pub(super) fn concat_cols_backward(parts: &[Var], g: &Array2<f32>, cx: &mut Grad
 pub(super) fn slice_cols_backward(x: Var, start: usize, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         if mode == Mode::Overwrite {
-            d.fill(0.0);
+            zero(d);
         }
         let mut block = d.slice_mut(s![.., start..start + g.ncols()]);
         block += g;
@@ -200,7 +201,7 @@ pub(super) fn reshape_backward(x: Var, g: &Array2<f32>, cx: &mut GradCx) {
 pub(super) fn gather_cols_backward(x: Var, index: &[usize], g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         if mode == Mode::Overwrite {
-            d.fill(0.0);
+            zero(d);
         }
         for (k, &a) in index.iter().enumerate() {
             d[[k, a]] += g[[k, 0]];
@@ -212,7 +213,7 @@ pub(super) fn gather_cols_backward(x: Var, index: &[usize], g: &Array2<f32>, cx:
 pub(super) fn gather_rows_backward(x: Var, index: &[usize], g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(x) {
         if mode == Mode::Overwrite {
-            d.fill(0.0);
+            zero(d);
         }
         for (k, &r) in index.iter().enumerate() {
             let mut row = d.index_axis_mut(Axis(0), r);
