@@ -1,6 +1,6 @@
 //! Elementwise loops over contiguous slices for the taped ops (sums, products, gradient
 //! accumulation, GPT-2's GELU), compiled for AVX-512 and AVX2 besides the baseline target and
-//! chosen at run time ([`simd_dispatch`]). Each element's arithmetic is the same separate
+//! chosen at run time (`simd_dispatch`). Each element's arithmetic is the same separate
 //! IEEE operations in the same order on every path (no fused multiply-add), so the path
 //! changes no bit; it only decides how many elements one instruction handles (the baseline
 //! x86-64 build has 4 lanes, AVX-512 16), which mattered for ACAC's critic, whose GPT-2 block
