@@ -150,23 +150,12 @@ pub(super) fn mul_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     let (va, vb) = (cx.value(a), cx.value(b));
     let contiguous = "tape arrays are contiguous";
     let gs = g.as_slice().expect(contiguous);
-    if let Some((d, mode)) = cx.slot(a) {
-        let ds = d.as_slice_mut().expect(contiguous);
-        put_mul(
-            ds,
-            gs,
-            vb.as_slice().expect(contiguous),
-            mode == Mode::Accumulate,
-        );
-    }
-    if let Some((d, mode)) = cx.slot(b) {
-        let ds = d.as_slice_mut().expect(contiguous);
-        put_mul(
-            ds,
-            gs,
-            va.as_slice().expect(contiguous),
-            mode == Mode::Accumulate,
-        );
+    for (v, other) in [(a, vb), (b, va)] {
+        if let Some((d, mode)) = cx.slot(v) {
+            let ds = d.as_slice_mut().expect(contiguous);
+            let os = other.as_slice().expect(contiguous);
+            put_mul(ds, gs, os, mode == Mode::Accumulate);
+        }
     }
 }
 
