@@ -19,6 +19,16 @@ simd_dispatch! {
 }
 
 simd_dispatch! {
+    /// out\[i\] = a\[i\] - b\[i\]. Panics if the lengths differ.
+    pub fn sub_into(a: &[f32], b: &[f32], out: &mut [f32]) {
+        assert!(a.len() == out.len() && b.len() == out.len(), "sub_into: length mismatch");
+        for ((o, &a), &b) in out.iter_mut().zip(a).zip(b) {
+            *o = a - b;
+        }
+    }
+}
+
+simd_dispatch! {
     /// out\[i\] = a\[i\] * b\[i\]. Panics if the lengths differ.
     pub fn mul_into(a: &[f32], b: &[f32], out: &mut [f32]) {
         assert!(a.len() == out.len() && b.len() == out.len(), "mul_into: length mismatch");
@@ -168,6 +178,11 @@ mod tests {
             same_bits(
                 &out,
                 &a.iter().zip(&b).map(|(a, b)| a + b).collect::<Vec<_>>(),
+            );
+            sub_into(&a, &b, &mut out);
+            same_bits(
+                &out,
+                &a.iter().zip(&b).map(|(a, b)| a - b).collect::<Vec<_>>(),
             );
             mul_into(&a, &b, &mut out);
             same_bits(

@@ -1,11 +1,11 @@
 //! Elementwise ops on same-shaped arrays: add, sub, mul, scale, the activations (sigmoid, tanh,
 //! leaky ReLU), square (the TD loss), exp and log.
 
-use ndarray::{Array2, Zip};
+use ndarray::Array2;
 
 use super::{put, Op};
 use crate::autograd::kernels::activations::{sigmoid_inplace, tanh_inplace};
-use crate::autograd::kernels::elementwise::{add_into, mul_into, put_copy, put_mul};
+use crate::autograd::kernels::elementwise::{add_into, mul_into, put_copy, put_mul, sub_into};
 use crate::autograd::kernels::gemm::Mode;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
@@ -18,20 +18,8 @@ impl Tape {
         y
     }
 
-    /// y = f(a, b) elementwise; panics if the shapes differ.
-    fn binary(&mut self, a: Var, b: Var, what: &str, f: impl Fn(f32, f32) -> f32) -> Array2<f32> {
-        let shape = self.shape(a);
-        assert_eq!(shape, self.shape(b), "{what}: shapes differ");
-        let mut y = self.pool().array(shape.0, shape.1);
-        Zip::from(&mut y)
-            .and(&self.value(a))
-            .and(&self.value(b))
-            .for_each(|y, &a, &b| *y = f(a, b));
-        y
-    }
-
     /// y = kernel(a, b) over the (contiguous) values; panics if the shapes differ.
-    fn binary_slices(
+    fn binary(
         &mut self,
         a: Var,
         b: Var,
@@ -53,19 +41,19 @@ impl Tape {
 
     /// y = a + b (same shapes; see [`Tape::add_bias`] for broadcasting a row).
     pub fn add(&mut self, a: Var, b: Var) -> Var {
-        let y = self.binary_slices(a, b, "add", add_into);
+        let y = self.binary(a, b, "add", add_into);
         self.push_op(y, Op::Add { a, b }, &[a, b])
     }
 
     /// y = a - b (same shapes).
     pub fn sub(&mut self, a: Var, b: Var) -> Var {
-        let y = self.binary(a, b, "sub", |a, b| a - b);
+        let y = self.binary(a, b, "sub", sub_into);
         self.push_op(y, Op::Sub { a, b }, &[a, b])
     }
 
     /// y = a * b elementwise (same shapes).
     pub fn mul(&mut self, a: Var, b: Var) -> Var {
-        let y = self.binary_slices(a, b, "mul", mul_into);
+        let y = self.binary(a, b, "mul", mul_into);
         self.push_op(y, Op::Mul { a, b }, &[a, b])
     }
 
@@ -138,7 +126,9 @@ pub(super) fn add_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
 // d(a - b) = da - db
 pub(super) fn sub_backward(a: Var, b: Var, g: &Array2<f32>, cx: &mut GradCx) {
     if let Some((d, mode)) = cx.slot(a) {
-        put!(mode, d, g; |g| g);
+        let gs = g.as_slice().expect("tape arrays are contiguous");
+        let ds = d.as_slice_mut().expect("tape arrays are contiguous");
+        put_copy(ds, gs, mode == Mode::Accumulate);
     }
     if let Some((d, mode)) = cx.slot(b) {
         put!(mode, d, g; |g| -g);

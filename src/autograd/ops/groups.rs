@@ -7,6 +7,7 @@ use ndarray::Array2;
 
 use super::Op;
 use crate::autograd::kernels::gemm::Mode;
+use crate::autograd::pool::zero;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 const CONTIGUOUS: &str = "tape arrays are contiguous";
@@ -103,7 +104,7 @@ pub(super) fn row_group_max_backward(x: Var, n: usize, arg: Var, g: &Array2<f32>
     let args = cx.value(arg).as_slice().expect(CONTIGUOUS);
     if let Some((dst, mode)) = cx.slot(x) {
         if mode == Mode::Overwrite {
-            dst.fill(0.0);
+            zero(dst);
         }
         let d = g.ncols();
         let gs = g.as_slice().expect(CONTIGUOUS);

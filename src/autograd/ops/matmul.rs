@@ -110,9 +110,6 @@ impl Tape {
 /// y += bias row by row (y: [m, n] from the pool, bias: [1, n]).
 fn add_bias_rows(y: &mut Array2<f32>, bias: ArrayView2<f32>) {
     let b = bias.as_slice().expect("tape arrays are contiguous");
-    if y.ncols() == 0 {
-        return;
-    }
     elementwise::add_bias_rows(y.as_slice_mut().expect("pool arrays are contiguous"), b);
 }
 
