@@ -12,7 +12,8 @@
 //!
 //! The data flow: lanes record primitive steps as the reference's runner does ([`episode`]); two
 //! memories ([`memory`]: windows of `trace_len` or whole episodes) hand out batches of record
-//! ranges; [`update`] squeezes them and takes one Adam step; [`learner`] ties it to the training
+//! ranges; `squeeze` cuts them down to the records each net learns from, and [`update`] takes
+//! one Adam step on them; [`learner`] ties it to the training
 //! loop and acts ([`acting`]).
 
 pub mod acting;
@@ -24,4 +25,5 @@ pub mod memory;
 pub mod method;
 mod prefetch;
 pub mod published;
+mod squeeze;
 pub mod update;

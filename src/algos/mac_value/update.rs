@@ -34,9 +34,10 @@ use serde::{Deserialize, Serialize};
 
 use super::episode::Step;
 use super::prefetch::prefetch_batch;
+use super::squeeze::{agent_squeeze, EpisodeKeys, KeptSqueezes, Squeezed};
 use crate::autograd::{SeqPacking, Tape, Var};
 use crate::nn::argmax::{first_argmax, FirstArgmax};
-use crate::nn::joint_index::{for_each_allowed, ravel, unravel_component};
+use crate::nn::joint_index::{for_each_allowed, unravel_component};
 use crate::nn::loss::hysteretic_td_loss_taken;
 use crate::nn::{Adam, AdamConfig, GruActor, GruActorConfig};
 
@@ -78,12 +79,12 @@ pub struct Dims {
 }
 
 impl Dims {
-    fn obs_range(&self, agent: usize) -> std::ops::Range<usize> {
+    pub(super) fn obs_range(&self, agent: usize) -> std::ops::Range<usize> {
         let lo: usize = self.obs_sizes[..agent].iter().sum();
         lo..lo + self.obs_sizes[agent]
     }
 
-    fn action_range(&self, agent: usize) -> std::ops::Range<usize> {
+    pub(super) fn action_range(&self, agent: usize) -> std::ops::Range<usize> {
         let lo: usize = self.n_actions[..agent].iter().sum();
         lo..lo + self.n_actions[agent]
     }
@@ -154,17 +155,6 @@ fn block_argmax(q: &[f32], mask: &[f32]) -> Option<usize> {
         .position(|(&v, &ok)| ok != 0.0 && v == top)
 }
 
-/// Appends to `running` each agent's macro-action in `r` where it did not end there (it keeps
-/// running), `None` where it ended.
-fn push_running_actions(r: &Step, running: &mut Vec<Option<usize>>) {
-    running.extend(
-        r.valid
-            .iter()
-            .zip(&r.actions)
-            .map(|(&v, &a)| (!v).then_some(a)),
-    );
-}
-
 /// The available macro-action with the largest value (`get_masked_Q` then `max`); 0 when none is.
 pub fn masked_argmax(q: &[f32], avail: &[f32]) -> usize {
     first_argmax(
@@ -176,170 +166,11 @@ pub fn masked_argmax(q: &[f32], avail: &[f32]) -> usize {
     .unwrap_or(0)
 }
 
-/// One net's squeezed batch: sequences of kept records, flat (sequence-major).
-#[derive(Debug, Clone, Default)]
-struct Squeezed {
-    lengths: Vec<usize>,
-    /// Each sequence's position in the batch (a batch entry gives one sequence or none).
-    entries: Vec<usize>,
-    width: usize,
-    /// [sum lengths, width]: the observations the macro-actions were chosen on.
-    x: Vec<f32>,
-    /// [sum (lengths + 1), width]: each sequence's first observation, then every next one.
-    x_next: Vec<f32>,
-    actions: Vec<usize>,
-    rewards: Vec<f32>,
-    gammas: Vec<f32>,
-    terminals: Vec<f32>,
-    /// [sum lengths, avail_width]: the availability after each kept record (the net's own
-    /// masks). Copied out while the squeeze has the records in cache: choosing a' comes after the
-    /// unrolls, whose buffers evict the scattered records, and reading them again there cost more
-    /// than the choice itself.
-    next_avail: Vec<f32>,
-    avail_width: usize,
-    /// [sum lengths, n_agents] for the joint squeeze (empty otherwise): each agent's running
-    /// macro-action at each kept record, `None` where it ended (read by the conditional argmax).
-    running: Vec<Option<usize>>,
-}
-
-impl Squeezed {
-    /// Keep the records `keep` accepts, reading each with `obs`/`next_obs` (the net's input
-    /// slice), `fields` (action, reward, gamma) and `avail` (the net's slice of `next_avail`);
-    /// sequences shorter than `sub_trace_len` go. Also gives the kept records, in the same (flat)
-    /// order.
-    fn of<'a>(
-        batch: &[&'a [Step]],
-        sub_trace_len: usize,
-        width: usize,
-        keep: impl Fn(&Step) -> bool,
-        input: impl Fn(&'a [f32]) -> &'a [f32],
-        fields: impl Fn(&Step) -> (usize, f32, f32),
-        avail: impl Fn(&'a Step) -> &'a [f32],
-    ) -> (Squeezed, Vec<&'a Step>) {
-        let mut s = Squeezed {
-            width,
-            ..Squeezed::default()
-        };
-        // At most every record is kept: room for all of them up front.
-        let most: usize = batch.iter().map(|seq| seq.len()).sum();
-        let mut records: Vec<&'a Step> = Vec::with_capacity(most);
-        s.x.reserve(most * width);
-        s.x_next.reserve((most + batch.len()) * width);
-        for v in [&mut s.rewards, &mut s.gammas, &mut s.terminals] {
-            v.reserve(most);
-        }
-        s.actions.reserve(most);
-        // Every record of a net has a mask of the same width.
-        if let Some(r) = batch.iter().find_map(|seq| seq.first()) {
-            s.avail_width = avail(r).len();
-            s.next_avail.reserve(most * s.avail_width);
-        }
-        for (entry, seq) in batch.iter().enumerate() {
-            let first = records.len();
-            records.extend(seq.iter().filter(|r| keep(r)));
-            let n = records.len() - first;
-            if n == 0 || n < sub_trace_len {
-                records.truncate(first);
-                continue;
-            }
-            s.lengths.push(n);
-            s.entries.push(entry);
-            s.x_next.extend_from_slice(input(&records[first].obs));
-            for r in &records[first..] {
-                s.x.extend_from_slice(input(&r.obs));
-                s.x_next.extend_from_slice(input(&r.next_obs));
-                let (a, rew, g) = fields(r);
-                s.actions.push(a);
-                s.rewards.push(rew);
-                s.gammas.push(g);
-                s.terminals.push(if r.terminal { 1.0 } else { 0.0 });
-                let mask = avail(r);
-                debug_assert_eq!(mask.len(), s.avail_width);
-                s.next_avail.extend_from_slice(mask);
-            }
-        }
-        (s, records)
-    }
-
-    /// The joint squeeze (the centralized net's): records where any agent's macro-action ended,
-    /// the joint observation, joint macro-action, reward and gamma.
-    fn joint<'a>(
-        batch: &[&'a [Step]],
-        sub_trace_len: usize,
-        dims: &Dims,
-    ) -> (Squeezed, Vec<&'a Step>) {
-        let (mut s, records) = Squeezed::of(
-            batch,
-            sub_trace_len,
-            dims.obs_sizes.iter().sum(),
-            Step::any_valid,
-            |o| o,
-            |r| {
-                (
-                    ravel(&r.actions, &dims.n_actions),
-                    r.joint_reward,
-                    r.joint_gamma,
-                )
-            },
-            |r| &r.next_avail,
-        );
-        s.running.reserve(records.len() * dims.n_actions.len());
-        for r in &records {
-            push_running_actions(r, &mut s.running);
-        }
-        (s, records)
-    }
-
-    /// Record k's availability after it (the net's masks).
-    fn next_avail(&self, k: usize) -> &[f32] {
-        &self.next_avail[k * self.avail_width..(k + 1) * self.avail_width]
-    }
-
-    /// Record k's running macro-actions (joint squeezes only), `n_agents` of them.
-    fn running(&self, k: usize, n_agents: usize) -> &[Option<usize>] {
-        &self.running[k * n_agents..(k + 1) * n_agents]
-    }
-
-    /// The joint conditional argmax of record k's next values `row` (`get_conditional_action`:
-    /// agents whose macro-action did not end keep it).
-    fn conditional_argmax(&self, k: usize, row: &[f32], dims: &Dims) -> usize {
-        let running = self.running(k, dims.n_actions.len());
-        conditional_argmax(row, running, self.next_avail(k), dims)
-    }
-
-    /// Whether every sequence's continuation starts with its observations, bit for bit
-    /// ([o_0, o'_0, ..., o'_{L-2}] = [o_0, o_1, ..., o_{L-1}]: a record's next observation is the
-    /// following record's, as when observations are held between an agent's decisions). Then the
-    /// online net's next values are its training unroll's outputs one position on, and one step
-    /// past each sequence's end.
-    fn continues(&self) -> bool {
-        let w = self.width;
-        let mut at = 0;
-        for (seq, &l) in self.lengths.iter().enumerate() {
-            // The continuation of sequence `seq` starts at row at + seq of x_next.
-            let observed = &self.x[at * w..(at + l) * w];
-            let continued = &self.x_next[(at + seq) * w..(at + seq + l) * w];
-            if observed
-                .iter()
-                .zip(continued)
-                .any(|(a, b)| a.to_bits() != b.to_bits())
-            {
-                return false;
-            }
-            at += l;
-        }
-        true
-    }
-
-    fn total(&self) -> usize {
-        self.actions.len()
-    }
-}
-
 /// Memory the TD steps reuse from one update to the next (the learner keeps it as
 /// [`crate::algos::scratch::Scratch`]): the autodiff tape, reset after every pass, one gradient
-/// buffer per net shape, and the next values. Every buffer is overwritten before it is read, so
-/// a fresh one gives the same numbers.
+/// buffer per net shape, the next values, and what is kept per stored episode (its squeezes, the
+/// targets' rows). Every buffer is overwritten before it is read and every kept value is the bits
+/// a recomputation gives, so a fresh one gives the same numbers.
 #[derive(Debug, Default)]
 pub struct UpdateScratch {
     tape: Tape,
@@ -348,6 +179,7 @@ pub struct UpdateScratch {
     /// [records, m1]: the target's last hidden layer at each record's next position.
     target_next: Vec<f32>,
     target_rows: TargetRows,
+    squeezes: KeptSqueezes,
 }
 
 impl UpdateScratch {
@@ -356,9 +188,10 @@ impl UpdateScratch {
         self.target_rows.rows.clear();
     }
 
-    /// Episodes before id `oldest` left the memory: drop their rows.
+    /// Episodes before id `oldest` left the memory: drop their rows and squeezes.
     pub fn forget_episodes_before(&mut self, oldest: u64) {
         self.target_rows.rows.retain(|&(_, id), _| id >= oldest);
+        self.squeezes.forget_episodes_before(oldest);
     }
 }
 
@@ -374,14 +207,6 @@ impl UpdateScratch {
 struct TargetRows {
     /// (net slot, episode id) -> [records, m1].
     rows: HashMap<(usize, u64), Vec<f32>>,
-}
-
-/// What a TD step may keep its target's rows under: the net's slot and each batch entry's
-/// episode id (whole-episode memories only).
-struct RowKeys<'a> {
-    /// 0 for the centralized net, 1 + i for agent i's.
-    slot: usize,
-    ids: &'a [u64],
 }
 
 /// The gradient buffer for nets of `cfg`'s shape (made on first use).
@@ -460,7 +285,7 @@ fn target_features(
     tape: &mut Tape,
     target: &GruActor,
     s: &Squeezed,
-    keys: Option<RowKeys>,
+    keys: Option<EpisodeKeys>,
     rows: &mut TargetRows,
     into: &mut Vec<f32>,
 ) {
@@ -576,7 +401,7 @@ fn td_step(
     mut pick: impl FnMut(usize, &[f32]) -> usize,
     hysteresis: f64,
     discount: f64,
-    keys: Option<RowKeys>,
+    keys: Option<EpisodeKeys>,
     scratch: &mut UpdateScratch,
 ) -> TdTrace {
     let UpdateScratch {
@@ -585,6 +410,7 @@ fn td_step(
         online_next,
         target_next,
         target_rows,
+        ..
     } = scratch;
     let n_out = q.net.config().output;
     // One online unroll gives both Q(h, a) and the next values when the continuation repeats
@@ -640,26 +466,10 @@ fn td_step(
     }
 }
 
-/// Agent i's squeeze (MacDec-Q's): the records where its macro-action ended, its observation,
-/// macro-action, reward, gamma and availability masks.
-fn agent_squeeze(batch: &[&[Step]], sub_trace_len: usize, dims: &Dims, i: usize) -> Squeezed {
-    let (obs, masks) = (dims.obs_range(i), dims.action_range(i));
-    Squeezed::of(
-        batch,
-        sub_trace_len,
-        obs.len(),
-        |r| r.valid[i],
-        |o| &o[obs.clone()],
-        |r| (r.actions[i], r.rewards[i], r.gammas[i]),
-        |r| &r.next_avail[masks.clone()],
-    )
-    .0
-}
-
 /// MacDec-Q's iteration on every agent's net; `None` when some agent's squeeze kept nothing
 /// (then no net changes). `ids`: each batch entry's episode id when the batch is of whole stored
-/// episodes, under which the targets' rows are kept until [`UpdateScratch::targets_changed`].
-/// `scratch` is reused memory (see [`UpdateScratch`]).
+/// episodes, under which the episodes' squeezes are kept, and the targets' rows until
+/// [`UpdateScratch::targets_changed`]. `scratch` is reused memory (see [`UpdateScratch`]).
 #[allow(clippy::too_many_arguments)]
 pub fn update_dec(
     nets: &mut [QNet],
@@ -671,9 +481,16 @@ pub fn update_dec(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<Vec<TdTrace>> {
-    prefetch_batch(batch);
+    let keys = |i: usize| ids.map(|ids| EpisodeKeys { slot: 1 + i, ids });
+    if ids.is_none() {
+        prefetch_batch(batch);
+    }
     let squeezed: Vec<_> = (0..nets.len())
-        .map(|i| agent_squeeze(batch, sub_trace_len, dims, i))
+        .map(|i| {
+            scratch
+                .squeezes
+                .squeeze(batch, keys(i), |b| agent_squeeze(b, sub_trace_len, dims, i))
+        })
         .collect();
     if squeezed.iter().any(|s| s.lengths.is_empty()) {
         return None;
@@ -682,17 +499,14 @@ pub fn update_dec(
         nets.iter_mut()
             .zip(&squeezed)
             .enumerate()
-            .map(|(slot, (q, s))| {
+            .map(|(i, (q, s))| {
                 td_step(
                     q,
                     s,
                     |k, row| masked_argmax(row, s.next_avail(k)),
                     hysteresis,
                     discount,
-                    ids.map(|ids| RowKeys {
-                        slot: 1 + slot,
-                        ids,
-                    }),
+                    keys(i),
                     scratch,
                 )
             })
@@ -713,8 +527,13 @@ pub fn update_cen(
     sub_trace_len: usize,
     scratch: &mut UpdateScratch,
 ) -> Option<TdTrace> {
-    prefetch_batch(batch);
-    let (s, _) = Squeezed::joint(batch, sub_trace_len, dims);
+    let keys = ids.map(|ids| EpisodeKeys { slot: 0, ids });
+    if ids.is_none() {
+        prefetch_batch(batch);
+    }
+    let s = scratch
+        .squeezes
+        .squeeze(batch, keys, |b| Squeezed::joint(b, sub_trace_len, dims).0);
     if s.lengths.is_empty() {
         return None;
     }
@@ -724,7 +543,7 @@ pub fn update_cen(
         |k, row| s.conditional_argmax(k, row, dims),
         hysteresis,
         discount,
-        ids.map(|ids| RowKeys { slot: 0, ids }),
+        keys,
         scratch,
     ))
 }
