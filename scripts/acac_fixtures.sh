@@ -9,6 +9,10 @@ mkdir -p $F
 $PY $S --acac $A --setting ovcA7 --np-seed 0 --random-seed 0 --out $F/ovc_a7_random0
 $PY $S --acac $A --setting ovcB7 --np-seed 0 --random-seed 1 --out $F/ovc_b7_random1
 $PY $S --acac $A --setting ovcC7 --np-seed 0 --random-seed 2 --out $F/ovc_c7_random2
+# Map C, the whole task: the macro-actions of the greedy episode of our ovcC7 seed 2 policy
+# (reproduction/acac/ovcC7/acac/seed-2, `macdec eval --trajectories`: each agent's macro-actions
+# in the order it started them), delivered at step 40 for 226.
+$PY $S --acac $A --setting ovcC7 --np-seed 0 --plan '[[1, 7, 9, 13, 7, 7, 7, 6, 6, 6, 6, 6, 6, 6, 6, 6], [3, 13, 6, 9, 3, 9, 3, 10, 14, 9, 14, 9, 9, 14, 14, 14, 14, 9, 9], [2, 7, 9, 2, 5, 7, 3, 8]]' --out $F/ovc_c7_policy
 # Random starts: numpy's draws after np.random.seed(S), and the grid they produced.
 $PY $S --acac $A --setting ovcAR7 --np-seed 3 --random-seed 3 --out $F/ovc_ar7_np3_random3
 $PY $S --acac $A --setting ovcBR7 --np-seed 4 --random-seed 4 --out $F/ovc_br7_np4_random4

@@ -188,10 +188,17 @@ fn overcooked_ma_v1_replays_the_reference() {
 
 #[test]
 fn acac_overcooked_ma_v1_replays_acacs_code() {
-    // Fixed starts: ACAC numbers agents and plates column by column.
+    // Fixed starts: ACAC numbers agents and plates column by column. *_policy: the greedy
+    // episode of our trained ovcC7 policy (seed 2), its macro-actions through ACAC's env: the
+    // whole task, delivered at step 40 for 226.
     in_folder(
         "acac",
-        &["ovc_a7_random0", "ovc_b7_random1", "ovc_c7_random2"],
+        &[
+            "ovc_a7_random0",
+            "ovc_b7_random1",
+            "ovc_c7_random2",
+            "ovc_c7_policy",
+        ],
     );
 }
 
