@@ -20,10 +20,11 @@
 
 use std::path::Path;
 
+use macdec::algos::mac_value::choice::Dims;
 use macdec::algos::mac_value::episode::{Episode, Recorder, Step, StepParts};
 use macdec::algos::mac_value::memory::Memory;
 use macdec::algos::mac_value::update::{
-    update_cen, update_dec, update_dec_cen, Dims, QNet, UpdateScratch,
+    update_cen, update_dec, update_dec_cen, QNet, UpdateScratch,
 };
 use macdec::envs::StepOutcome;
 use macdec::nn::{GruActor, GruActorConfig, Params};

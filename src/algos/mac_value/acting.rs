@@ -8,8 +8,9 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
+use super::choice::{conditional_argmax, masked_argmax, Dims};
 use super::episode::{all_available, joint_obs};
-use super::update::{conditional_argmax, masked_argmax, Dims, QNet};
+use super::update::QNet;
 use crate::envs::MacroEnv;
 use crate::nn::joint_index::{for_each_allowed, unravel};
 use crate::nn::GruActorState;

@@ -10,11 +10,12 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::acting::{act_cen, act_dec, Explore};
+use super::choice::Dims;
 use super::config::MacValueConfig;
 use super::episode::{Recorder, Step};
 use super::memory::Memory;
 use super::method::{MacValueMethod, QNets};
-use super::update::{update_cen, update_dec, update_dec_cen, Dims, QNet, UpdateScratch};
+use super::update::{update_cen, update_dec, update_dec_cen, QNet, UpdateScratch};
 use crate::algos::learner::{
     EvalReturns, LanePlan, Learner, LearnerRngs, MethodName, SavedNets, Schedule,
 };

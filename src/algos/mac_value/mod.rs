@@ -17,6 +17,7 @@
 //! loop and acts ([`acting`]).
 
 pub mod acting;
+pub mod choice;
 pub mod config;
 pub mod episode;
 pub mod family;

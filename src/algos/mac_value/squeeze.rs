@@ -6,9 +6,9 @@
 
 use std::collections::HashMap;
 
+use super::choice::{conditional_argmax, Dims};
 use super::episode::Step;
 use super::prefetch::prefetch_batch;
-use super::update::{conditional_argmax, Dims};
 use crate::nn::joint_index::ravel;
 
 /// What a squeeze or a target's rows may be kept under between updates: the net's slot (0 for
