@@ -614,9 +614,10 @@ fn actor_step(
     let net = &actor.net;
     let vars = net.bind(tape);
     let out = history_outputs(tape, net, &vars, &inputs.seqs);
-    let logp = tape.log_softmax(out);
     let n_actions = net.config().output;
-    let taken_logp = tape.gather_cols(logp, &inputs.actions);
+    // log pi(a|h) of the taken macro-actions only (the bits of gathering them from the whole
+    // log-softmax; nothing else reads the other entries).
+    let taken_logp = tape.log_softmax_at(out, &inputs.actions);
     // The mixture of the taken macro-actions only: the loss reads no other entry, and each
     // entry's arithmetic is its own, so these are the whole mixture's taken entries bit for bit
     // (Mac-CAC's joint actor has 3 375 entries a row on 3-agent Overcooked).

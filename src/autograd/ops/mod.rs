@@ -7,7 +7,7 @@
 //! | --- | --- |
 //! | `elementwise.rs` | `add`, `sub`, `mul`, `scale`, `sigmoid`, `tanh`, `leaky_relu`, `square`, `exp`, `log` |
 //! | `matmul.rs` | `matmul`, `matmul_nt`, `add_bias`, `matmul_bias`, `linear` (fused) and `linear_at` (one column per row) |
-//! | `softmax.rs` | `softmax`, `log_softmax`, `logsumexp` (row-wise) |
+//! | `softmax.rs` | `softmax`, `log_softmax`, `logsumexp` (row-wise), `log_softmax_at` (one column per row) |
 //! | `shape.rs` | `concat_rows`, `concat_cols`, `slice_cols`, `gather_cols`, `gather_rows`, `reshape` |
 //! | `reduce.rs` | `sum`, `mean`, `masked_mean` |
 //! | `groups.rs` | `row_group_mean`, `row_group_max` (pool each sample's n agent rows) |
@@ -119,6 +119,12 @@ pub(crate) enum Op {
     LogSumExp {
         x: Var,
     },
+    LogSoftmaxAt {
+        x: Var,
+        index: Vec<usize>,
+        /// Each row's shift and log-sum, as the forward computed them.
+        stats: Vec<(f32, f32)>,
+    },
     ConcatRows {
         parts: Vec<Var>,
     },
@@ -199,6 +205,9 @@ impl Op {
             Op::Softmax { x } => softmax::softmax_backward(*x, y, g, cx),
             Op::LogSoftmax { x } => softmax::log_softmax_backward(*x, y, g, cx),
             Op::LogSumExp { x } => softmax::logsumexp_backward(*x, y, g, cx),
+            Op::LogSoftmaxAt { x, index, stats } => {
+                softmax::log_softmax_at_backward(*x, index, stats, g, cx)
+            }
             Op::ConcatRows { parts } => shape::concat_rows_backward(parts, g, cx),
             Op::ConcatCols { parts } => shape::concat_cols_backward(parts, g, cx),
             Op::SliceCols { x, start } => shape::slice_cols_backward(*x, *start, g, cx),

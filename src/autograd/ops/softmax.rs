@@ -11,6 +11,7 @@ use super::{put, Op};
 use crate::autograd::kernels::exp::{
     exp_f32, exp_f32_into, exp_f64, sum_exp_f64, sum_exp_f64_rows4,
 };
+use crate::autograd::kernels::gemm::Mode;
 use crate::autograd::tape::{GradCx, Tape, Var};
 
 /// The row's maximum if finite, else 0 (see the module docs).
@@ -93,6 +94,26 @@ impl Tape {
         self.push_op(y, Op::LogSoftmax { x }, &[x])
     }
 
+    /// y[k, 0] = log_softmax(x)[k, index\[k\]]: the log-probability of one column per row (the
+    /// macro-action taken), x: [m, n] -> [m, 1]. The bits of `gather_cols(log_softmax(x),
+    /// index)`, value and gradient, without the [m, n] log-probabilities, their [m, n] gradient
+    /// (zeros but one entry a row) or its row sums: on Mac-CAC's 3 375 joint macro-actions
+    /// those passes over memory were most of the actor loss's cost. Panics if `index` does not
+    /// have one entry per row or an entry is out of range.
+    pub fn log_softmax_at(&mut self, x: Var, index: &[usize]) -> Var {
+        let (m, n) = self.shape(x);
+        assert_eq!(index.len(), m, "log_softmax_at: one index per row");
+        let mut y = self.pool().array(m, 1);
+        let xv = self.value(x);
+        let stats = shifts_and_log_sums(xv.view());
+        for (k, (&a, &(shift, log_sum))) in index.iter().zip(&stats).enumerate() {
+            assert!(a < n, "log_softmax_at: index {a} out of range 0..{n}");
+            y[[k, 0]] = (xv[[k, a]] - shift) - log_sum;
+        }
+        let index = index.to_vec();
+        self.push_op(y, Op::LogSoftmaxAt { x, index, stats }, &[x])
+    }
+
     /// y[i, 0] = ln sum_k e^x[i, k] = max_i + ln sum_k e^(x[i, k] - max_i): x: [m, n] ->
     /// [m, 1]. A row with no columns gives -inf.
     pub fn logsumexp(&mut self, x: Var) -> Var {
@@ -138,6 +159,62 @@ pub(super) fn log_softmax_backward(x: Var, y: &Array2<f32>, g: &Array2<f32>, cx:
             }
             let e = ArrayView1::from(&exps[..]);
             put!(mode, &mut dr, &gr, &e; |g, e| g - e * total);
+        }
+    }
+}
+
+// y_k = log_softmax(x)[k, a_k]: the backward of `gather_cols` then `log_softmax`, step for step.
+// The gather's gradient row is +0 everywhere but g_a = +0 + g_k at a_k, so its sum (ndarray's
+// eight partial sums from +0: every other term adds +0, exactly) is g_a; then dx_j = g_j - e^(y_j)
+// g_a with y_j = (x_j - shift) - log_sum recomputed as the forward computes it.
+pub(super) fn log_softmax_at_backward(
+    x: Var,
+    index: &[usize],
+    stats: &[(f32, f32)],
+    g: &Array2<f32>,
+    cx: &mut GradCx,
+) {
+    let vx = cx.value(x);
+    if let Some((d, mode)) = cx.slot(x) {
+        let n = vx.ncols();
+        let (mut ys, mut exps) = (vec![0.0f32; n], vec![0.0f32; n]);
+        for (k, ((mut dr, xr), (&a, &(shift, log_sum)))) in d
+            .axis_iter_mut(Axis(0))
+            .zip(vx.axis_iter(Axis(0)))
+            .zip(index.iter().zip(stats))
+            .enumerate()
+        {
+            for (y, &x) in ys.iter_mut().zip(&xr) {
+                *y = (x - shift) - log_sum;
+            }
+            exp_f32_into(&ys, &mut exps);
+            let ga = 0.0 + g[[k, 0]];
+            let dr = dr.as_slice_mut().expect("gradient arrays are contiguous");
+            let (before, rest) = dr.split_at_mut(a);
+            let (at, after) = rest.split_first_mut().expect("a < n");
+            let (e_before, rest) = exps.split_at(a);
+            let (e_at, e_after) = rest.split_first().expect("a < n");
+            let at_value = ga - e_at * ga;
+            match mode {
+                Mode::Overwrite => {
+                    for (dj, &e) in before.iter_mut().zip(e_before) {
+                        *dj = 0.0 - e * ga;
+                    }
+                    *at = at_value;
+                    for (dj, &e) in after.iter_mut().zip(e_after) {
+                        *dj = 0.0 - e * ga;
+                    }
+                }
+                Mode::Accumulate => {
+                    for (dj, &e) in before.iter_mut().zip(e_before) {
+                        *dj += 0.0 - e * ga;
+                    }
+                    *at += at_value;
+                    for (dj, &e) in after.iter_mut().zip(e_after) {
+                        *dj += 0.0 - e * ga;
+                    }
+                }
+            }
         }
     }
 }
@@ -212,6 +289,73 @@ mod tests {
             let dx = t.grad(xv).expect("x's gradient");
             assert_eq!(bits(dx), bits(want_dx.view()), "d log_softmax {m}x{n}");
         }
+    }
+
+    /// `log_softmax_at` against `gather_cols(log_softmax(x))`, values and gradients bit for bit:
+    /// -inf and -900 logits, a taken column at either end, a gradient of -0 and of 0, and x
+    /// also feeding the loss directly (the accumulating gradient).
+    #[test]
+    fn log_softmax_at_is_the_gathered_log_softmax_bit_for_bit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        for (m, n) in [(1, 1), (5, 15), (9, 37), (6, 3375)] {
+            let x = ndarray::Array2::from_shape_fn((m, n), |(i, j)| match (i * n + j) % 89 {
+                3 => f32::NEG_INFINITY,
+                7 => -900.0,
+                _ => rng.gen_range(-40.0..40.0),
+            });
+            let index: Vec<usize> = (0..m)
+                .map(|i| match i {
+                    0 => 0,
+                    1 => n - 1,
+                    _ => rng.gen_range(0..n),
+                })
+                .collect();
+            let weights = ndarray::Array2::from_shape_fn((m, 1), |(i, _)| match i {
+                2 => -0.0,
+                3 => 0.0,
+                _ => rng.gen_range(-1.0f32..1.0),
+            });
+            let direct = ndarray::Array2::from_shape_fn((m, n), |_| rng.gen_range(-1.0f32..1.0));
+            let bits =
+                |a: ndarray::ArrayView2<f32>| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            for fan_out in [false, true] {
+                let run = |fused: bool| {
+                    let mut t = Tape::new();
+                    let xv = t.param(x.view());
+                    let taken = if fused {
+                        t.log_softmax_at(xv, &index)
+                    } else {
+                        let l = t.log_softmax(xv);
+                        t.gather_cols(l, &index)
+                    };
+                    let w = t.constant(weights.view());
+                    let weighted = t.mul(taken, w);
+                    let mut loss = t.sum(weighted);
+                    if fan_out {
+                        let d = t.constant(direct.view());
+                        let dx = t.mul(xv, d);
+                        let s = t.sum(dx);
+                        loss = t.add(loss, s);
+                    }
+                    t.backward(loss);
+                    let dx = t.grad(xv).expect("x's gradient");
+                    (bits(t.value(taken)), bits(dx))
+                };
+                let (fused, plain) = (run(true), run(false));
+                assert_eq!(fused.0, plain.0, "values {m}x{n}");
+                assert_eq!(fused.1, plain.1, "gradients {m}x{n}, fan-out {fan_out}");
+            }
+        }
+    }
+
+    #[test]
+    fn log_softmax_at_matches_finite_differences() {
+        grad_check(
+            |t, v| t.log_softmax_at(v[0], &[2, 0, 3]),
+            &[(3, 4)],
+            Inputs::Any,
+        );
     }
 
     #[test]
