@@ -84,12 +84,14 @@ fn dx_rows<const N: usize>(
     for r in 0..N {
         let (mean_dxhat, mean_dxhat_xhat) = (sum_dxhat[r] / d as f32, sum_dxhat_xhat[r] / d as f32);
         let dr = &mut db[r * d..(r + 1) * d];
-        for j in 0..d {
-            let v = rstd[r] * (gr[r][j] * gain[j] - mean_dxhat - xr[r][j] * mean_dxhat_xhat);
-            match mode {
-                Mode::Overwrite => dr[j] = v,
-                Mode::Accumulate => dr[j] += v,
-            }
+        let (rs, g, x) = (rstd[r], gr[r], xr[r]);
+        let v = |g: f32, gain: f32, x: f32| rs * (g * gain - mean_dxhat - x * mean_dxhat_xhat);
+        // Zipped slices and the mode outside the loop, so it runs vector-wide (each element's
+        // operations are the same, in the same order).
+        let lanes = dr.iter_mut().zip(g).zip(gain).zip(x);
+        match mode {
+            Mode::Overwrite => lanes.for_each(|(((d, &g), &gain), &x)| *d = v(g, gain, x)),
+            Mode::Accumulate => lanes.for_each(|(((d, &g), &gain), &x)| *d += v(g, gain, x)),
         }
     }
 }
