@@ -14,8 +14,8 @@
 #                                 # a time so every block fills evenly
 #   scripts/campaign.sh macromarl-value # MacroMARL's value-based blocks (issue 44) into
 #                                 # reproduction/macromarl_value: Box Pushing 8, 10, 12, 20, 30
-#                                 # at 20 seeds, then seeds 0..5 of Overcooked A, B and
-#                                 # Warehouse A, B, C
+#                                 # at 20 seeds, then seeds 0..5 of Overcooked A, B MacDec-Q,
+#                                 # Warehouse A, B, C, Overcooked A, B MacCen-Q
 #   scripts/campaign.sh acac      # ACAC's own method on its settings (issue 41) into
 #                                 # reproduction/acac: Box Pushing 6, 8, 10 at 5 seeds, then
 #                                 # Overcooked A, B, C one seed at a time, then their random-start
@@ -103,11 +103,13 @@ macromarl_value_lane() {
         fi
     done
     # MacDec-Q on Overcooked next (about an hour of a core a run: it finishes within a session
-    # on a fresh machine), then MacCen-Q and the Warehouse (several hours a run).
+    # on a fresh machine), then the Warehouse blocks (both methods; about 13 ms of a core an
+    # update on current builds, so well under an hour a run), and MacCen-Q on Overcooked last
+    # (some 310 000 updates of its 225-wide joint net: about six hours of a core a run).
     for block in overcooked_a overcooked_b; do
         train_macromarl_value "$block" --seeds 0..5 --methods mac-dec-q
     done
-    for block in overcooked_a overcooked_b wh_a wh_b wh_c; do
+    for block in wh_a wh_b wh_c overcooked_a overcooked_b; do
         train_macromarl_value "$block" --seeds 0..5
     done
 }
