@@ -85,9 +85,8 @@ macromarl_value_lane() {
     for block in bp8 bp10 bp12 bp20 bp30; do
         train_macromarl_value "$block" --seeds 0..5
     done
-    # Box Pushing's published 20 seeds, five at a time (minutes a run), before the Warehouse
-    # (about six hours a run: a run finishes only where a machine outlives a session, since
-    # checkpoints are never committed).
+    # Box Pushing's published 20 seeds, five at a time (minutes a run), before Overcooked and
+    # the Warehouse.
     for first in 5 10 15; do
         for block in bp8 bp10 bp12 bp20 bp30; do
             train_macromarl_value "$block" --seeds "$first..$((first + 5))"
@@ -103,9 +102,10 @@ macromarl_value_lane() {
         fi
     done
     # MacDec-Q on Overcooked next (about an hour of a core a run: it finishes within a session
-    # on a fresh machine), then the Warehouse blocks (both methods; about 13 ms of a core an
-    # update on current builds, so well under an hour a run), and MacCen-Q on Overcooked last
-    # (some 310 000 updates of its 225-wide joint net: about six hours of a core a run).
+    # on a fresh machine), then the Warehouse blocks (both methods; Warehouse A MacDec-Q's first
+    # 10 000 episodes took 180 CPU s for 12 494 updates on a Zen 3, so about a quarter of an
+    # hour of a core a run), and MacCen-Q on Overcooked last (some 310 000 updates of its
+    # 225-wide joint net: about six hours of a core a run).
     for block in overcooked_a overcooked_b; do
         train_macromarl_value "$block" --seeds 0..5 --methods mac-dec-q
     done
