@@ -14,11 +14,11 @@ evaluation return at that budget (each run's last evaluation at or before it).
 Reads only the Python standard library.
 """
 import argparse
-import csv
 import glob
-import gzip
 import os
 import statistics
+
+from acac_curves import ours, theirs
 
 BUDGET = 500_000
 BIG_BOX = 250.0
@@ -32,20 +32,6 @@ ASSUMPTIONS = [
     ("_acac_keys", "ACAC's keys, history critics", 1),
     ("_state_acac_keys", "ACAC's keys, state critics", 2),
 ]
-
-
-def ours(run_dir):
-    path = os.path.join(run_dir, "metrics.csv")
-    opener = open
-    if not os.path.exists(path):
-        path, opener = path + ".gz", gzip.open
-    with opener(path, "rt") as f:
-        return [(float(r["acac_timesteps"]), float(r["eval_return_undiscounted"])) for r in csv.DictReader(f)]
-
-
-def theirs(path):
-    with open(path) as f:
-        return [(float(r["Timesteps"]), float(r["Eval/Return"])) for r in csv.DictReader(f)]
 
 
 def row(label, runs):

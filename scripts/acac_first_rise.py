@@ -15,45 +15,28 @@ the numbers docs/REPRODUCTION.md reads ("ACAC: campaign in progress").
 """
 
 import argparse
-import csv
-import gzip
 import itertools
 import math
 import sys
 from collections import Counter
 from pathlib import Path
 
-
-def read_rows(path):
-    opener = gzip.open if path.suffix == ".gz" else open
-    with opener(path, "rt", newline="") as f:
-        return list(csv.DictReader(f))
+import acac_curves
 
 
-def first_above(rows, x, y, threshold):
-    """The first x at which y exceeds the threshold, or infinity if it never does."""
-    for row in rows:
-        if float(row[y]) > threshold:
-            return float(row[x])
-    return math.inf
+def first_above(curve, threshold):
+    """The first counted step at which the return exceeds the threshold, or infinity if never."""
+    return next((steps for steps, value in curve if value > threshold), math.inf)
 
 
 def ours(results, env, threshold):
-    times = []
-    for seed_dir in sorted((results / env / "acac").glob("seed-*")):
-        if not (seed_dir / "finished").exists():
-            continue
-        metrics = seed_dir / "metrics.csv"
-        if not metrics.exists():
-            metrics = seed_dir / "metrics.csv.gz"
-        rows = read_rows(metrics)
-        times.append(first_above(rows, "acac_timesteps", "eval_return_undiscounted", threshold))
-    return times
+    seed_dirs = sorted((results / env / "acac").glob("seed-*"))
+    return [first_above(acac_curves.ours(d), threshold) for d in seed_dirs if (d / "finished").exists()]
 
 
 def theirs(logs, env, threshold):
     files = sorted((logs / env / "acac").glob("*.csv"), key=lambda p: int(p.stem))
-    return [first_above(read_rows(p), "Timesteps", "Eval/Return", threshold) for p in files]
+    return [first_above(acac_curves.theirs(p), threshold) for p in files]
 
 
 def millions(times):
