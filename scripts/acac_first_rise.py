@@ -5,13 +5,18 @@ For each setting, the first ACAC `Timesteps` (steps of finished training episode
 run's undiscounted evaluation return exceeds the threshold, for our runs
 (`reproduction/acac/<env>/acac/seed-*/metrics.csv[.gz]`, columns `acac_timesteps`,
 `eval_return_undiscounted`) and for ACAC's committed logs (`docs/reference_runs/acac/log/<env>/
-acac/*.csv`, columns `Timesteps`, `Eval/Return`); then the exact one-sided rank-sum test that
+acac/*.csv`, columns `Timesteps`, `Eval/Return`), or of a baseline's (`--method mac-iaicc` reads
+`<results>/<env><suffix>/mac-iaicc/` against the logs' `mac_iaicc/`, `--method naive-mac-iacc`
+against `mac_niacc/`); then the exact one-sided rank-sum test that
 ours rise later (the share of all splits of the pooled times whose "ours" rank sum is at least
-the observed one; average ranks for ties, a run that never rises ranks last), per setting and
+the observed one; average ranks for ties, a run that never rises, or rises only after the
+shortest of ACAC's logs ends, ranks last), per setting and
 pooled over the settings (the rank sums' exact distribution, stratified by setting). These are
 the numbers docs/REPRODUCTION.md reads ("ACAC: campaign in progress").
 
     python3 scripts/acac_first_rise.py ovcA7 ovcB7 ovcC7
+    python3 scripts/acac_first_rise.py ovcA7 ovcB7 ovcC7 --results reproduction/acac_baselines \
+        --suffix _acac_keys --method mac-iaicc
 """
 
 import argparse
@@ -23,20 +28,24 @@ from pathlib import Path
 
 import acac_curves
 
-
-def first_above(curve, threshold):
-    """The first counted step at which the return exceeds the threshold, or infinity if never."""
-    return next((steps for steps, value in curve if value > threshold), math.inf)
+# Our method name -> the folder of ACAC's logs that holds the same method's runs.
+LOG_FOLDERS = {"acac": "acac", "mac-iaicc": "mac_iaicc", "naive-mac-iacc": "mac_niacc"}
 
 
-def ours(results, env, threshold):
-    seed_dirs = sorted((results / env / "acac").glob("seed-*"))
-    return [first_above(acac_curves.ours(d), threshold) for d in seed_dirs if (d / "finished").exists()]
+def first_above(curve, threshold, budget):
+    """The first counted step at which the return exceeds the threshold, or infinity if it does
+    not by the budget."""
+    return next((steps for steps, value in curve if steps <= budget and value > threshold), math.inf)
 
 
-def theirs(logs, env, threshold):
-    files = sorted((logs / env / "acac").glob("*.csv"), key=lambda p: int(p.stem))
-    return [first_above(acac_curves.theirs(p), threshold) for p in files]
+def our_curves(run_root):
+    seed_dirs = sorted(run_root.glob("seed-*"), key=lambda d: int(d.name.removeprefix("seed-")))
+    return [acac_curves.ours(d) for d in seed_dirs if (d / "finished").exists()]
+
+
+def their_curves(log_root):
+    files = sorted(log_root.glob("*.csv"), key=lambda p: int(p.stem))
+    return [acac_curves.theirs(p) for p in files]
 
 
 def millions(times):
@@ -77,15 +86,21 @@ def main():
     parser.add_argument("--results", type=Path, default=Path("reproduction/acac"))
     parser.add_argument("--logs", type=Path, default=Path("docs/reference_runs/acac/log"))
     parser.add_argument("--threshold", type=float, default=200.0)
+    parser.add_argument("--method", choices=sorted(LOG_FOLDERS), default="acac")
+    parser.add_argument("--suffix", default="", help="our experiment is <env><suffix>, e.g. _acac_keys")
     args = parser.parse_args()
 
     pooled_observed = 0
     pooled = Counter({0: 1})
     for env in args.envs:
-        mine = ours(args.results, env, args.threshold)
-        logs = theirs(args.logs, env, args.threshold)
+        mine = our_curves(args.results / f"{env}{args.suffix}" / args.method)
+        logs = their_curves(args.logs / env / LOG_FOLDERS[args.method])
         if not mine or not logs:
             sys.exit(f"{env}: no finished runs of ours ({len(mine)}) or no logs ({len(logs)})")
+        # Equal budgets: a rise after the shortest of ACAC's logs ends counts as none.
+        budget = min(curve[-1][0] for curve in logs)
+        mine = [first_above(curve, args.threshold, budget) for curve in mine]
+        logs = [first_above(curve, args.threshold, budget) for curve in logs]
         observed, counts = rank_sum_distribution(mine, logs)
         at_least, total = upper_tail(observed, counts)
         print(f"{env}: ours [{millions(mine)}] M, ACAC's logs [{millions(logs)}] M, "
