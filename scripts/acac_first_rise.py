@@ -12,7 +12,8 @@ ours rise later (the share of all splits of the pooled times whose "ours" rank s
 the observed one; average ranks for ties, a run that never rises, or rises only after the
 shortest of ACAC's logs ends, ranks last), per setting and
 pooled over the settings (the rank sums' exact distribution, stratified by setting). These are
-the numbers docs/REPRODUCTION.md reads ("ACAC: campaign in progress").
+the numbers docs/REPRODUCTION.md reads ("ACAC: campaign in progress" for `acac`, "ACAC's
+baselines beside ours" for the baselines).
 
     python3 scripts/acac_first_rise.py ovcA7 ovcB7 ovcC7
     python3 scripts/acac_first_rise.py ovcA7 ovcB7 ovcC7 --results reproduction/acac_baselines \
