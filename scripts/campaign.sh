@@ -120,7 +120,7 @@ train_acac() {
 }
 
 # ACAC's Overcooked runs in campaign order, one "<env> <seed>" a line: the fixed-start maps
-# (20M primitive steps, about 100-110 minutes of a core) at every seed, then the random-start
+# (20M counted steps, 52-78 minutes of a core at seed 4 on the Zen 3) at every seed, then the random-start
 # maps (40M: about two hours of a core on a Zen 3, ovcAR7 seed 0 122 minutes, so one fits in a
 # session only when it starts near the session's beginning).
 acac_overcooked_runs() {
