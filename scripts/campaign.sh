@@ -120,9 +120,9 @@ train_acac() {
 }
 
 # ACAC's Overcooked runs in campaign order, one "<env> <seed>" a line: the fixed-start maps
-# (20M counted steps, 52-78 minutes of a core at seed 4 on the Zen 3) at every seed, then the random-start
-# maps (40M: about two hours of a core on a Zen 3, ovcAR7 seed 0 122 minutes, so one fits in a
-# session only when it starts near the session's beginning).
+# (20M counted steps, 52-78 minutes of a core at seed 4 on the Zen 3) at every seed, then the
+# random-start maps (40M: about two hours of a core on the Zen 3, ovcAR7 seed 0 122 minutes, so
+# one fits in a session only when it starts near the session's beginning).
 acac_overcooked_runs() {
     for envs in "ovcA7 ovcB7 ovcC7" "ovcAR7 ovcBR7 ovcCR7"; do
         for seed in 0 1 2 3 4; do
