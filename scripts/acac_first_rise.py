@@ -18,6 +18,12 @@ baselines beside ours" for the baselines).
     python3 scripts/acac_first_rise.py ovcA7 ovcB7 ovcC7
     python3 scripts/acac_first_rise.py ovcA7 ovcB7 ovcC7 --results reproduction/acac_baselines \
         --suffix _acac_keys --method mac-iaicc
+
+With `--late`, the same tests on how steady a trained team is instead: each run's mean
+evaluation return over the second half of the budget (past half of the shortest log's last step,
+up to it), tested one-sided for ours lower.
+
+    python3 scripts/acac_first_rise.py ovcAR7 ovcBR7 ovcCR7 --late
 """
 
 import argparse
@@ -47,6 +53,12 @@ def our_curves(run_root):
 def their_curves(log_root):
     files = sorted(log_root.glob("*.csv"), key=lambda p: int(p.stem))
     return [acac_curves.theirs(p) for p in files]
+
+
+def late_mean(curve, budget):
+    """The mean return of the evaluations past half the budget, up to the budget."""
+    late = [value for steps, value in curve if budget / 2 < steps <= budget]
+    return sum(late) / len(late) if late else -math.inf
 
 
 def millions(times):
@@ -89,6 +101,8 @@ def main():
     parser.add_argument("--threshold", type=float, default=200.0)
     parser.add_argument("--method", choices=sorted(LOG_FOLDERS), default="acac")
     parser.add_argument("--suffix", default="", help="our experiment is <env><suffix>, e.g. _acac_keys")
+    parser.add_argument("--late", action="store_true",
+                        help="test the second half's mean return (ours lower) instead of the first rise")
     args = parser.parse_args()
 
     pooled_observed = 0
@@ -100,12 +114,22 @@ def main():
             sys.exit(f"{env}: no finished runs of ours ({len(mine)}) or no logs ({len(logs)})")
         # Equal budgets: a rise after the shortest of ACAC's logs ends counts as none.
         budget = min(curve[-1][0] for curve in logs)
-        mine = [first_above(curve, args.threshold, budget) for curve in mine]
-        logs = [first_above(curve, args.threshold, budget) for curve in logs]
-        observed, counts = rank_sum_distribution(mine, logs)
-        at_least, total = upper_tail(observed, counts)
-        print(f"{env}: ours [{millions(mine)}] M, ACAC's logs [{millions(logs)}] M, "
-              f"one-sided p (ours later) = {at_least}/{total} = {at_least / total:.3f}")
+        if args.late:
+            # Negated, so that the upper tail is "ours lower", as it is "ours later" below.
+            mine = [-late_mean(curve, budget) for curve in mine]
+            logs = [-late_mean(curve, budget) for curve in logs]
+            observed, counts = rank_sum_distribution(mine, logs)
+            at_least, total = upper_tail(observed, counts)
+            means = [", ".join(f"{-m:.1f}" for m in side) for side in (mine, logs)]
+            print(f"{env}: second-half mean return, ours [{means[0]}], ACAC's logs [{means[1]}], "
+                  f"one-sided p (ours lower) = {at_least}/{total} = {at_least / total:.3f}")
+        else:
+            mine = [first_above(curve, args.threshold, budget) for curve in mine]
+            logs = [first_above(curve, args.threshold, budget) for curve in logs]
+            observed, counts = rank_sum_distribution(mine, logs)
+            at_least, total = upper_tail(observed, counts)
+            print(f"{env}: ours [{millions(mine)}] M, ACAC's logs [{millions(logs)}] M, "
+                  f"one-sided p (ours later) = {at_least}/{total} = {at_least / total:.3f}")
         pooled_observed += observed
         merged = Counter()
         for a, na in pooled.items():
