@@ -115,21 +115,22 @@ def main():
         # Equal budgets: a rise after the shortest of ACAC's logs ends counts as none.
         budget = min(curve[-1][0] for curve in logs)
         if args.late:
-            # Negated, so that the upper tail is "ours lower", as it is "ours later" below.
+            # Negated, so that the upper tail is "ours lower", as it is "ours later" otherwise.
             mine = [-late_mean(curve, budget) for curve in mine]
             logs = [-late_mean(curve, budget) for curve in logs]
-            observed, counts = rank_sum_distribution(mine, logs)
-            at_least, total = upper_tail(observed, counts)
-            means = [", ".join(f"{-m:.1f}" for m in side) for side in (mine, logs)]
-            print(f"{env}: second-half mean return, ours [{means[0]}], ACAC's logs [{means[1]}], "
-                  f"one-sided p (ours lower) = {at_least}/{total} = {at_least / total:.3f}")
         else:
             mine = [first_above(curve, args.threshold, budget) for curve in mine]
             logs = [first_above(curve, args.threshold, budget) for curve in logs]
-            observed, counts = rank_sum_distribution(mine, logs)
-            at_least, total = upper_tail(observed, counts)
+        observed, counts = rank_sum_distribution(mine, logs)
+        at_least, total = upper_tail(observed, counts)
+        p = f"{at_least}/{total} = {at_least / total:.3f}"
+        if args.late:
+            means = [", ".join(f"{-m:.1f}" for m in side) for side in (mine, logs)]
+            print(f"{env}: second-half mean return, ours [{means[0]}], ACAC's logs [{means[1]}], "
+                  f"one-sided p (ours lower) = {p}")
+        else:
             print(f"{env}: ours [{millions(mine)}] M, ACAC's logs [{millions(logs)}] M, "
-                  f"one-sided p (ours later) = {at_least}/{total} = {at_least / total:.3f}")
+                  f"one-sided p (ours later) = {p}")
         pooled_observed += observed
         merged = Counter()
         for a, na in pooled.items():
